@@ -1,0 +1,136 @@
+// The authored scene: exactly what a scene file (and later the viewer) describes.
+// Objects refer to each other by index into the category vectors. The renderer never
+// reads this directly; render/prepare.h builds the render scene from it.
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/math.h"
+
+namespace kr {
+
+// One name table per enum, shared by the JSON loader, the CLI and the viewer's combos.
+template <typename Enum, size_t N>
+struct EnumNames {
+    std::array<std::string_view, N> names;
+
+    std::string_view name(Enum e) const { return names[static_cast<size_t>(e)]; }
+    std::optional<Enum> parse(std::string_view s) const {
+        for (size_t i = 0; i < N; ++i)
+            if (names[i] == s) return static_cast<Enum>(i);
+        return std::nullopt;
+    }
+    // "a", "b" or "c": for error messages.
+    std::string list() const {
+        std::string out;
+        for (size_t i = 0; i < N; ++i) {
+            if (i > 0) out += (i + 1 == N) ? " or " : ", ";
+            out += '"';
+            out += names[i];
+            out += '"';
+        }
+        return out;
+    }
+};
+
+enum class CameraType { pinhole, lens };
+inline constexpr EnumNames<CameraType, 2> camera_type_names{{"pinhole", "lens-based"}};
+
+enum class MaterialType { diffuse, specular, glossy, dielectric, translucent };
+inline constexpr EnumNames<MaterialType, 5> material_type_names{
+    {"diffuse", "specular reflection", "glossy reflection", "fresnel dielectric",
+     "translucent dielectric"}};
+
+enum class ShapeType { sphere };
+inline constexpr EnumNames<ShapeType, 1> shape_type_names{{"sphere"}};
+
+enum class LightType { point, area };
+inline constexpr EnumNames<LightType, 2> light_type_names{{"point", "area"}};
+
+enum class PrimitiveType { geometric, emissive };
+inline constexpr EnumNames<PrimitiveType, 2> primitive_type_names{{"geometric", "emissive"}};
+
+enum class RendererType { wrt, pt };
+inline constexpr EnumNames<RendererType, 2> renderer_type_names{{"WRT", "PT"}};
+
+// The brief caps the recursion depth at 20 bounces.
+inline constexpr int kMaxDepth = 20;
+
+struct Camera {
+    std::string id;
+    CameraType type = CameraType::pinhole;
+    double fov = 45;       // vertical field of view, degrees
+    double aspect = 1;     // width / height of the image plane
+    double distance = 5;   // image-plane distance (does not change the image of a pinhole)
+    Vec3 position{0, 0, -15};
+    Vec3 target{0, 0, 0};
+    double focal_distance = 10;  // lens-based only: distance of the plane in focus
+    double alpha = 0;            // lens-based only: aperture radius
+};
+
+struct Material {
+    std::string id;
+    MaterialType type = MaterialType::diffuse;
+    Color rho{0.8};       // diffuse, specular reflection, glossy reflection
+    Color rho_r{1};       // dielectrics: reflected fraction ("rhoR")
+    Color rho_t{1};       // dielectrics: transmitted fraction ("rhoT")
+    double eta = 1.5;     // dielectrics: refractive index inside / outside
+    double roughness = 0; // glossy reflection, translucent dielectric: beta in [0, 1)
+};
+
+struct Shape {
+    std::string id;
+    ShapeType type = ShapeType::sphere;
+    Vec3 centre{};
+    double radius = 1;
+};
+
+struct Light {
+    std::string id;
+    LightType type = LightType::point;
+    Vec3 position{};  // point only
+    Color power{1};   // point: radiant intensity; area: emitted radiance
+    int shape = -1;   // area only: index into Scene::shapes
+};
+
+struct Primitive {
+    std::string id;
+    PrimitiveType type = PrimitiveType::geometric;
+    int shape = -1;     // index into Scene::shapes
+    int material = -1;  // index into Scene::materials
+    int light = -1;     // emissive only: index into Scene::lights
+};
+
+struct RendererSettings {
+    RendererType type = RendererType::pt;
+    int width = 512, height = 512;
+    int samples = 1;
+    int depth = 6;       // maximum ray depth, at most kMaxDepth
+    std::string output;  // as written in the file: relative to the scene file's folder
+};
+
+// The whole file. Unreferenced cameras, materials, shapes and lights are kept (so the
+// viewer can offer them and save the file back) but only the `scene` block is rendered.
+struct Scene {
+    std::vector<Camera> cameras;
+    std::vector<Material> materials;
+    std::vector<Shape> shapes;
+    std::vector<Light> lights;
+
+    int camera = -1;                  // active camera, index into cameras
+    std::vector<int> active_lights;   // indices into lights
+    std::vector<Primitive> primitives;
+    RendererSettings renderer;
+
+    std::filesystem::path source_file;  // where it was loaded from (empty if built in code)
+
+    // Output path resolved against the scene file's folder.
+    std::filesystem::path output_path() const;
+};
+
+}  // namespace kr
