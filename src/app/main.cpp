@@ -1,2 +1,262 @@
-// Placeholder: replaced by the CLI.
-int main() { return 0; }
+// keithray: the headless command-line program. A thin loop over the core library.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <omp.h>
+#include <unistd.h>
+
+#include "core/image.h"
+#include "render/render.h"
+#include "scene/load.h"
+
+namespace fs = std::filesystem;
+using namespace kr;
+
+namespace {
+
+constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere scenes
+
+Usage:
+  keithray render [SCENE.json ...] [options]
+  keithray --help
+
+With no SCENE, renders every *.json in res/scenes/. Defaults come from each scene
+file's renderer block; the options below override them.
+
+Options:
+  --spp N               samples per pixel (default: the file's "samples")
+  --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
+                        pt-naive samples no area light, only point lights)
+  --estimator NAME      primary samples: uniform | stratified (default: stratified)
+  --light-sampling NAME spherical lights: cone | area (default: cone)
+  --depth N             maximum ray depth, 0..20 (default: the file's "depth")
+  --tonemap NAME        sigmoid | linear (default: sigmoid)
+  --blur R              box blur of radius R pixels on the radiance (default: 0)
+  --seed N              random seed (default: 0); same seed, same image
+  --threads N           worker threads (default: all cores)
+  -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
+                        (only with a single scene)
+  -q, --quiet           no progress bar
+  -h, --help            this text
+
+Output: an 8-bit binary PPM and, beside it, the depth map (1 - d/(1+d)) as NAME-depth.ppm,
+each written atomically. One summary line per scene on stdout: spp, seconds, Mrays/s.
+Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
+)";
+
+struct Options {
+    std::vector<fs::path> scenes;
+    std::optional<int> spp, depth, threads;
+    std::optional<Integrator> integrator;
+    std::optional<Estimator> estimator;
+    std::optional<LightSampling> light_sampling;
+    ToneMap tonemap = ToneMap::sigmoid;
+    int blur = 0;
+    uint64_t seed = 0;
+    std::optional<fs::path> output;
+    bool quiet = false;
+};
+
+struct UsageError {
+    std::string message;
+};
+
+long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi) {
+    size_t used = 0;
+    long long value = 0;
+    try {
+        value = std::stoll(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || value < lo || value > hi)
+        throw UsageError{flag + " expects an integer in [" + std::to_string(lo) + ", " +
+                         std::to_string(hi) + "], got \"" + text + "\""};
+    return value;
+}
+
+template <typename Names>
+auto parse_name(const std::string& flag, const std::string& text, const Names& names) {
+    const auto value = names.parse(text);
+    if (!value) throw UsageError{flag + " expects " + names.list() + ", got \"" + text + "\""};
+    return *value;
+}
+
+Options parse_options(int argc, char** argv) {
+    Options o;
+    for (int i = 2; i < argc; ++i) {
+        const std::string arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
+            return argv[++i];
+        };
+        if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
+        else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, 1000));
+        else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, 4096));
+        else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, 4096));
+        else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, (1ll << 62)));
+        else if (arg == "--integrator") o.integrator = parse_name(arg, value(), integrator_names);
+        else if (arg == "--estimator") o.estimator = parse_name(arg, value(), estimator_names);
+        else if (arg == "--light-sampling") o.light_sampling = parse_name(arg, value(), light_sampling_names);
+        else if (arg == "--tonemap") o.tonemap = parse_name(arg, value(), tonemap_names);
+        else if (arg == "-o" || arg == "--output") o.output = value();
+        else if (arg == "-q" || arg == "--quiet") o.quiet = true;
+        else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
+        else o.scenes.emplace_back(arg);
+    }
+    if (o.output && o.scenes.size() != 1)
+        throw UsageError{"-o needs exactly one scene file (it names a single output)"};
+    return o;
+}
+
+// Every *.json in res/scenes: looked up from the working directory, then the source tree.
+std::vector<fs::path> default_scenes() {
+    std::vector<fs::path> dirs{"res/scenes"};
+#ifdef KEITHRAY_SCENES_DIR
+    dirs.emplace_back(KEITHRAY_SCENES_DIR);
+#endif
+    for (const fs::path& dir : dirs) {
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) continue;
+        std::vector<fs::path> found;
+        for (const auto& entry : fs::directory_iterator(dir, ec))
+            if (entry.path().extension() == ".json") found.push_back(entry.path());
+        std::sort(found.begin(), found.end());
+        if (!found.empty()) return found;
+    }
+    return {};
+}
+
+std::string format_seconds(double s) {
+    char buf[32];
+    if (s < 60) std::snprintf(buf, sizeof buf, "%.1f s", s);
+    else std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
+    return buf;
+}
+
+void draw_progress(int done, int total, double elapsed) {
+    constexpr int kWidth = 30;
+    const double fraction = total > 0 ? double(done) / total : 1.0;
+    const int filled = int(fraction * kWidth);
+    std::string bar(filled, '=');
+    if (filled < kWidth) bar += '>' + std::string(kWidth - filled - 1, ' ');
+    const std::string eta = done > 0 ? format_seconds(elapsed * (total - done) / done) : "?";
+    std::fprintf(stderr, "\r  [%s] %3d%%  %d/%d spp  %s  ETA %s   ", bar.c_str(), int(fraction * 100),
+                 done, total, format_seconds(elapsed).c_str(), eta.c_str());
+    std::fflush(stderr);
+}
+
+bool same_file(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+}
+
+// Loads, renders and writes one scene. Returns false (after printing why) on failure.
+bool render_scene_file(const fs::path& scene_file, const Options& opt) {
+    LoadedScene loaded;
+    RenderScene scene;
+    std::vector<std::string> warnings;
+    try {
+        loaded = load_scene_file(scene_file);
+        warnings = loaded.warnings;
+        scene = prepare_scene(loaded.scene, &warnings);
+    } catch (const SceneError& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        return false;
+    }
+    for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.seed = opt.seed;
+    if (opt.spp) settings.target_spp = *opt.spp;
+    if (opt.integrator) settings.integrator = *opt.integrator;
+    if (opt.estimator) settings.estimator = *opt.estimator;
+    if (opt.light_sampling) settings.light_sampling = *opt.light_sampling;
+    if (opt.depth) {
+        if (*opt.depth > kMaxDepth)
+            std::fprintf(stderr, "warning: --depth %d is above the maximum %d; clamped to %d\n", *opt.depth,
+                         kMaxDepth, kMaxDepth);
+        settings.max_depth = std::min(*opt.depth, kMaxDepth);
+    }
+
+    const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
+    const fs::path depth_output = depth_path_for(output);
+    if (same_file(output, scene_file) || same_file(depth_output, scene_file)) {
+        std::fprintf(stderr, "error: %s: the output would overwrite the scene file itself\n",
+                     output.string().c_str());
+        return false;
+    }
+
+    RenderState state(scene.renderer.width, scene.renderer.height);
+    const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    double last_draw = -1;
+    for (int pass = 0; pass < settings.target_spp; ++pass) {
+        render_pass(scene, settings, state);
+        if (show_progress && (elapsed() - last_draw > 0.1 || pass + 1 == settings.target_spp)) {
+            draw_progress(pass + 1, settings.target_spp, elapsed());
+            last_draw = elapsed();
+        }
+    }
+    const double seconds = elapsed();
+    if (show_progress) std::fprintf(stderr, "\n");
+
+    try {
+        const Image radiance = box_blur(state.radiance(), opt.blur);
+        write_ppm(output, tonemap(radiance, opt.tonemap));
+        write_ppm(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
+        return false;
+    }
+    if (state.nonfinite_samples > 0)
+        std::fprintf(stderr, "warning: %s: %llu non-finite samples were dropped\n", scene_file.string().c_str(),
+                     static_cast<unsigned long long>(state.nonfinite_samples));
+    std::printf("%s: %dx%d %s %d spp, %.2f s, %.1f Mrays/s (%.1f M rays) -> %s\n",
+                scene_file.filename().string().c_str(), state.width, state.height,
+                std::string(integrator_names.name(settings.integrator)).c_str(), state.passes, seconds,
+                seconds > 0 ? double(state.rays) / seconds * 1e-6 : 0.0, double(state.rays) * 1e-6,
+                output.string().c_str());
+    std::fflush(stdout);
+    return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string command = argc > 1 ? argv[1] : "";
+    if (command == "-h" || command == "--help" || command == "help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+    }
+    if (command != "render") {
+        std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
+                     command.c_str(), kUsage);
+        return 2;
+    }
+    Options opt;
+    try {
+        opt = parse_options(argc, argv);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "error: %s\nRun 'keithray --help' for the options.\n", e.message.c_str());
+        return 2;
+    }
+    if (opt.threads) omp_set_num_threads(*opt.threads);
+    if (opt.scenes.empty()) {
+        opt.scenes = default_scenes();
+        if (opt.scenes.empty()) {
+            std::fprintf(stderr, "error: no scene given and no res/scenes/*.json found\n");
+            return 2;
+        }
+    }
+    bool ok = true;
+    for (const fs::path& scene : opt.scenes) ok = render_scene_file(scene, opt) && ok;
+    return ok ? 0 : 1;
+}

@@ -1,0 +1,62 @@
+// Radiance images, tone mapping, blur, and 8-bit PPM files.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "scene/scene.h"  // EnumNames
+
+namespace kr {
+
+// Linear radiance, row-major, top row first.
+struct Image {
+    int width = 0, height = 0;
+    std::vector<Color> pixels;
+
+    Image() = default;
+    Image(int w, int h) : width(w), height(h), pixels(static_cast<size_t>(w) * h) {}
+    Color& at(int x, int y) { return pixels[static_cast<size_t>(y) * width + x]; }
+    const Color& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
+};
+
+// 8-bit RGB, row-major, top row first.
+struct Rgb8Image {
+    int width = 0, height = 0;
+    std::vector<uint8_t> bytes;  // 3 per pixel
+};
+
+enum class ToneMap { sigmoid, linear };
+inline constexpr EnumNames<ToneMap, 2> tonemap_names{{"sigmoid", "linear"}};
+
+// Per channel: sigmoid I/(1+I), or linear I/max where max is the largest channel value
+// of the whole image (one scale for all channels, so hues are kept). Then x255 and round,
+// no gamma (the brief's convention). `exposure` scales radiance first.
+Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure = 1.0);
+
+// One channel value of the tone maps above, before quantisation, for callers
+// that tone map themselves (the viewer's shader mirrors this).
+inline double sigmoid_tonemap(double v) { return v / (1.0 + v); }
+uint8_t quantize_unit(double v);  // clamp to [0,1], x255, round
+
+// Box blur of half-width `radius` pixels (a (2r+1)^2 box, clamped at the borders),
+// separable, applied to radiance. radius 0 returns the input.
+Image box_blur(const Image& src, int radius);
+
+// The brief's depth map: each pixel shows 1 - d/(1+d) as grey.
+Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height);
+
+// Binary PPM (P6, maxval 255). Written to a temporary file beside `path` and renamed,
+// so a reader never sees a partial file. Throws std::runtime_error on failure.
+void write_ppm(const std::filesystem::path& path, const Rgb8Image& image);
+Rgb8Image read_ppm(const std::filesystem::path& path);  // P6 with maxval 255; throws
+
+// Peak signal-to-noise ratio in dB of two same-sized 8-bit images (99 when identical).
+double psnr(const Rgb8Image& a, const Rgb8Image& b);
+
+// The path beside OUT.ppm that holds the depth map: OUT-depth.ppm.
+std::filesystem::path depth_path_for(const std::filesystem::path& output);
+
+}  // namespace kr

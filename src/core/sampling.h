@@ -1,0 +1,43 @@
+// Sampling routines. Each maps uniform variates in [0,1)^2 to a distribution and,
+// where the integrators need it, gives that distribution's density.
+#pragma once
+
+#include <cmath>
+
+#include "core/math.h"
+
+namespace kr {
+
+struct Vec2 {
+    double x = 0, y = 0;
+};
+
+// Cosine-weighted direction about +z (Malley: concentric disk lifted to the hemisphere).
+Vec3 sample_cosine_hemisphere(double u1, double u2);
+inline double cosine_hemisphere_pdf(double cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0; }
+
+// Uniform direction on the unit sphere.
+Vec3 sample_uniform_sphere(double u1, double u2);
+inline constexpr double uniform_sphere_pdf() { return 1.0 / (4.0 * kPi); }
+
+// Uniform point on the unit disk (Shirley-Chiu concentric map: low distortion for strata).
+Vec2 sample_concentric_disk(double u1, double u2);
+
+// Uniform direction in the cone about +z with half-angle theta_max, given
+// one_minus_cos_max = 1 - cos(theta_max) (passed directly: it is tiny for far lights and
+// 1 - cos would cancel).
+Vec3 sample_uniform_cone(double u1, double u2, double one_minus_cos_max);
+inline double uniform_cone_pdf(double one_minus_cos_max) {
+    return 1.0 / (2.0 * kPi * one_minus_cos_max);
+}
+
+// The brief's perturbation (eq. 2): a uniform point on the sphere of radius beta.
+inline Vec3 perturbation(double beta, double u1, double u2) { return beta * sample_uniform_sphere(u1, u2); }
+
+// Brief's eq. 2: mirror (or refracted) direction perturbed by roughness beta, renormalised.
+inline Vec3 perturb_direction(const Vec3& dir, double beta, double u1, double u2) {
+    if (beta <= 0) return dir;
+    return normalize(dir + perturbation(beta, u1, u2));
+}
+
+}  // namespace kr

@@ -1,0 +1,209 @@
+// The two integrators: Whitted-style recursive ray tracing and iterative path tracing.
+#include <algorithm>
+
+#include "render/material.h"
+#include "render/render.h"
+
+namespace kr {
+
+namespace {
+
+struct Tracer {
+    const RenderScene& scene;
+    const RenderSettings& settings;
+    Rng& rng;
+    uint64_t rays = 0;
+
+    bool intersect(const Ray& ray, Hit& hit) {
+        ++rays;
+        return scene.intersects(ray, hit);
+    }
+    bool visible(const Ray& ray) {
+        ++rays;
+        return !scene.is_occluded(ray);
+    }
+
+    // A ray leaving hit point `hit` along `dir`.
+    static Ray spawn(const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1) {
+        Ray r;
+        r.o = hit.p;
+        r.d = dir;
+        r.tmax = tmax;
+        r.from_sphere = hit.sphere;
+        r.into_from_sphere = dot(dir, hit.n) < 0;
+        r.to_sphere = to_sphere;
+        return r;
+    }
+
+    // Direct light from one point light at a surface with a smooth lobe (no selection pdf).
+    Color point_light_direct(const PointLight& light, const Material& m, const Hit& hit,
+                             const SurfacePoint& sp) {
+        Vec3 wi = light.position - hit.p;
+        const double d2 = dot(wi, wi);
+        if (!(d2 > 0)) return {};
+        const double d = std::sqrt(d2);
+        wi = wi / d;
+        const Color f_cos = eval_smooth(m, sp, wi);
+        if (is_black(f_cos)) return {};
+        // Irradiance = I cos / d^2 (the power of a point light is its intensity).
+        if (!visible(spawn(hit, wi, d))) return {};
+        return f_cos * light.intensity / d2;
+    }
+
+    // Light sample towards one area light; `mis` weights it against BSDF sampling.
+    Color area_light_direct(const AreaLight& light, const Material& m, const Hit& hit,
+                            const SurfacePoint& sp, bool mis, double select_prob) {
+        if (light.sphere == hit.sphere) return {};  // a convex emitter cannot light itself
+        LightSample ls;
+        const SphereGeom& geom = scene.spheres[light.sphere];
+        if (!sample_sphere_light(geom, hit.p, settings.light_sampling, rng.next(), rng.next(), ls))
+            return {};
+        const Color f_cos = eval_smooth(m, sp, ls.wi);
+        if (is_black(f_cos)) return {};
+        if (!visible(spawn(hit, ls.wi, ls.distance, light.sphere))) return {};
+        double weight = 1;
+        if (mis) {
+            const double p_light = select_prob * ls.pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
+            weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
+        }
+        return f_cos * light.radiance * (weight / (select_prob * ls.pdf));
+    }
+
+    // ---- Whitted-style ray tracing: L D S* E, recursive. ----
+    // `event` counts scattering events; the camera ray's hit is event 1.
+    Color whitted(const Ray& ray, int event, double* primary_distance) {
+        Hit hit;
+        if (!intersect(ray, hit)) return {};  // nothing hit: black
+        if (primary_distance) *primary_distance = hit.t;
+        Color L;
+        const int light_index = scene.sphere_light[hit.sphere];
+        if (light_index >= 0) L += scene.area_lights[light_index].radiance;
+        if (event > settings.max_depth) return L;
+        const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
+        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
+        switch (m.type) {
+            case MaterialType::diffuse:
+                // Every point light exactly; every area light with one sample (distributed RT).
+                for (const PointLight& light : scene.point_lights)
+                    L += point_light_direct(light, m, hit, sp);
+                for (const AreaLight& light : scene.area_lights)
+                    L += area_light_direct(light, m, hit, sp, false, 1.0);
+                break;
+            case MaterialType::specular:
+                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
+                break;
+            case MaterialType::glossy: {
+                ScatterSample s;
+                if (sample_material(m, sp, ray.d, rng, s))
+                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
+                break;
+            }
+            case MaterialType::dielectric:
+            case MaterialType::translucent: {
+                // Both branches, weighted by Fresnel: F rhoR L_r + (1 - F) rhoT L_t.
+                const DielectricSplit split = split_dielectric(m, sp, ray.d);
+                const double beta = m.type == MaterialType::translucent ? m.roughness : 0.0;
+                const Vec3 ns = sp.ns();
+                Vec3 dir = perturb_direction(split.reflected, beta, rng.next(), rng.next());
+                if (dot(dir, ns) > 0)
+                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
+                if (split.reflectance < 1) {
+                    dir = perturb_direction(split.transmitted, beta, rng.next(), rng.next());
+                    if (dot(dir, ns) < 0)
+                        L += ((1 - split.reflectance) * m.rho_t) *
+                             whitted(spawn(hit, dir), event + 1, nullptr);
+                }
+                break;
+            }
+        }
+        return L;
+    }
+
+    // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
+    Color path(Ray ray, double* primary_distance) {
+        const bool naive = settings.integrator == Integrator::pt_naive;
+        Color L, throughput(1.0);
+        bool full_emission = true;  // camera ray, or last bounce had no light sample to match
+        double last_bsdf_pdf = 0;
+        Vec3 last_p;
+        int last_sphere = -1;
+        for (int bounce = 0;; ++bounce) {
+            Hit hit;
+            if (!intersect(ray, hit)) break;
+            if (bounce == 0 && primary_distance) *primary_distance = hit.t;
+
+            // Emission seen along the path, MIS-weighted where a light sample could have found it.
+            const int light_index = scene.sphere_light[hit.sphere];
+            if (light_index >= 0) {
+                const AreaLight& light = scene.area_lights[light_index];
+                double weight = 1;
+                if (!full_emission && hit.sphere != last_sphere) {
+                    const double p_light =
+                        light.select_prob * sphere_light_pdf(scene.spheres[hit.sphere], last_p, ray.d,
+                                                             hit.t, hit.n, settings.light_sampling);
+                    weight = last_bsdf_pdf * last_bsdf_pdf /
+                             (last_bsdf_pdf * last_bsdf_pdf + p_light * p_light);
+                }
+                L += throughput * light.radiance * weight;
+            }
+            if (bounce >= settings.max_depth) break;
+
+            const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
+            const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
+
+            // Next-event estimation: one light, chosen in proportion to its power.
+            // Point lights cannot be hit by chance, so even naive mode samples them.
+            if (has_smooth_lobe(m) && scene.light_count() > 0) L += throughput * sample_one_light(m, hit, sp, naive);
+
+            ScatterSample s;
+            if (!sample_material(m, sp, ray.d, rng, s)) break;
+            throughput *= s.weight;
+            full_emission = naive || !s.smooth;
+            last_bsdf_pdf = s.pdf;
+            last_p = hit.p;
+            last_sphere = hit.sphere;
+            ray = spawn(hit, s.direction);
+
+            // Russian roulette with q = max(throughput) (brief), past the threshold depth.
+            if (bounce + 1 >= settings.rr_depth) {
+                const double q = std::min(1.0, max_component(throughput));
+                if (!(rng.next() < q)) break;
+                throughput /= q;
+            }
+        }
+        return L;
+    }
+
+    Color sample_one_light(const Material& m, const Hit& hit, const SurfacePoint& sp, bool naive) {
+        double u = rng.next();
+        for (const PointLight& light : scene.point_lights) {
+            if (u < light.select_prob) return point_light_direct(light, m, hit, sp) / light.select_prob;
+            u -= light.select_prob;
+        }
+        if (naive || scene.area_lights.empty()) return {};
+        // Falls through to the last area light if rounding left u above the total.
+        for (size_t i = 0; i < scene.area_lights.size(); ++i) {
+            const AreaLight& light = scene.area_lights[i];
+            if (u < light.select_prob || i + 1 == scene.area_lights.size())
+                return light.select_prob > 0
+                           ? area_light_direct(light, m, hit, sp, true, light.select_prob)
+                           : Color();
+            u -= light.select_prob;
+        }
+        return {};
+    }
+};
+
+}  // namespace
+
+SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
+                          Rng& rng) {
+    Tracer tracer{scene, settings, rng};
+    SampleResult result;
+    result.radiance = settings.integrator == Integrator::wrt ? tracer.whitted(ray, 1, &result.primary_distance)
+                                                             : tracer.path(ray, &result.primary_distance);
+    result.rays = tracer.rays;
+    return result;
+}
+
+}  // namespace kr

@@ -1,0 +1,47 @@
+// Material scattering: the BSDF of each material type, as sampling and evaluation.
+#pragma once
+
+#include "core/math.h"
+#include "core/rng.h"
+#include "scene/scene.h"
+
+namespace kr {
+
+// Geometry of a surface interaction as a material sees it.
+struct SurfacePoint {
+    Vec3 n;      // outward geometric normal of the sphere
+    bool front;  // the incoming ray arrived from outside the sphere
+    Vec3 ns() const { return front ? n : -n; }  // normal on the incident side
+};
+
+// One sampled continuation of a path.
+struct ScatterSample {
+    Vec3 direction;
+    Color weight;        // f cos / pdf: what the path throughput is multiplied by
+    double pdf = 0;      // solid-angle density, for smooth lobes that also get light samples
+    bool smooth = false; // true: a density the light sampler can match (MIS); false: a delta or
+                         // a lobe sampled only through its own distribution (no light samples)
+};
+
+// Only the diffuse lobe is evaluated for next-event estimation; the others are
+// reached through sampling. True if the material has such a lobe.
+inline bool has_smooth_lobe(const Material& m) { return m.type == MaterialType::diffuse; }
+
+// f(wi, wo) * |cos(wo)| of the smooth lobe, for wo a unit direction away from the surface.
+Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
+double pdf_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
+
+// Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface).
+// False when the path is absorbed (a perturbed direction fell on the wrong side).
+bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, Rng& rng,
+                     ScatterSample& out);
+
+// Fresnel split of a dielectric for a ray arriving along wi: reflectance and the two directions.
+struct DielectricSplit {
+    double reflectance;   // 1 on total internal reflection
+    Vec3 reflected;
+    Vec3 transmitted;     // valid only if reflectance < 1
+};
+DielectricSplit split_dielectric(const Material& m, const SurfacePoint& sp, const Vec3& wi);
+
+}  // namespace kr

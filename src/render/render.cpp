@@ -1,0 +1,95 @@
+#include "render/render.h"
+
+#include <cmath>
+
+#include <omp.h>
+
+namespace kr {
+
+RenderSettings RenderSettings::from_scene(const RendererSettings& renderer) {
+    RenderSettings s;
+    s.integrator = renderer.type == RendererType::wrt ? Integrator::wrt : Integrator::pt;
+    s.max_depth = std::clamp(renderer.depth, 0, kMaxDepth);
+    s.target_spp = std::max(1, renderer.samples);
+    return s;
+}
+
+void RenderState::reset(int w, int h) {
+    width = w;
+    height = h;
+    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+    radiance_sum.assign(n, Color());
+    depth_sum.assign(n, 0.0);
+    sample_count.assign(n, 0);
+    sample_index.assign(n, 0);
+    passes = 0;
+    rays = 0;
+    nonfinite_samples = 0;
+}
+
+Image RenderState::radiance() const {
+    Image img(width, height);
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+        img.pixels[i] = sample_count[i] ? radiance_sum[i] / double(sample_count[i]) : Color();
+    return img;
+}
+
+std::vector<double> RenderState::mean_depth() const {
+    std::vector<double> d(depth_sum.size(), kMissDepth);
+    for (size_t i = 0; i < d.size(); ++i)
+        if (sample_count[i]) d[i] = depth_sum[i] / double(sample_count[i]);
+    return d;
+}
+
+Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng) {
+    const double u1 = rng.next(), u2 = rng.next();
+    if (estimator == Estimator::stratified) {
+        // Brief: e = floor(sqrt(s)); x_i = (w/e)(i mod e + xi1), y_i = (h/e)(floor(i/e) + xi2).
+        const int e = static_cast<int>(std::sqrt(static_cast<double>(std::max(target, 1))));
+        if (index < e * e) return {((index % e) + u1) / e, ((index / e) + u2) / e};
+    }
+    return {u1, u2};
+}
+
+bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                 const std::atomic<bool>* stop) {
+    const int width = state.width, height = state.height;
+    uint64_t rays = 0, nonfinite = 0;
+    bool stopped = false;
+    // Rows handed out one at a time: rows through glass cost far more than rows of wall.
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, nonfinite)
+    for (int y = 0; y < height; ++y) {
+        if (stop && stop->load(std::memory_order_relaxed)) {
+            stopped = true;  // benign race: every writer stores true
+            continue;
+        }
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = static_cast<size_t>(y) * width + x;
+            const int index = static_cast<int>(state.sample_index[pixel]++);
+            Rng rng = Rng::for_sample(settings.seed, pixel, static_cast<uint64_t>(index));
+            const Vec2 sub = pixel_sample(settings.estimator, index, settings.target_spp, rng);
+            const double lens_u1 = rng.next(), lens_u2 = rng.next();
+            const CameraRay cr = scene.camera.generate((x + sub.x) / width, (y + sub.y) / height, lens_u1, lens_u2);
+            Ray ray;
+            ray.o = cr.origin;
+            ray.d = cr.direction;
+            const SampleResult r = trace_sample(scene, settings, ray, rng);
+            rays += r.rays;
+            // A NaN or Inf sample is dropped and counted, never accumulated.
+            if (!is_finite(r.radiance)) {
+                ++nonfinite;
+                continue;
+            }
+            state.radiance_sum[pixel] += r.radiance;
+            state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
+            state.sample_count[pixel] += 1;
+        }
+    }
+    state.rays += rays;
+    state.nonfinite_samples += nonfinite;
+    if (stopped) return false;
+    ++state.passes;
+    return true;
+}
+
+}  // namespace kr

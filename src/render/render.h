@@ -1,0 +1,79 @@
+// The progressive rendering API: settings + state + render_pass(), which adds one sample to
+// every pixel. The CLI loops over it; the viewer calls it from its render thread.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "core/image.h"
+#include "core/rng.h"
+#include "core/sampling.h"
+#include "render/light.h"
+#include "render/render_scene.h"
+
+namespace kr {
+
+enum class Integrator { wrt, pt, pt_naive };
+inline constexpr EnumNames<Integrator, 3> integrator_names{{"wrt", "pt", "pt-naive"}};
+
+// How the sub-pixel position of each primary sample is chosen (brief, "Image Estimator").
+enum class Estimator { uniform, stratified };
+inline constexpr EnumNames<Estimator, 2> estimator_names{{"uniform", "stratified"}};
+
+// Distance recorded in the depth map for a primary ray that hits nothing.
+inline constexpr double kMissDepth = 1e6;
+
+struct RenderSettings {
+    Integrator integrator = Integrator::pt;
+    Estimator estimator = Estimator::stratified;
+    LightSampling light_sampling = LightSampling::cone;
+    int max_depth = 6;          // scattering events per path, 0..kMaxDepth
+    int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
+    int rr_depth = 3;           // Russian roulette from this many scattering events on
+    uint64_t seed = 0;
+
+    // Defaults from the scene file's renderer block.
+    static RenderSettings from_scene(const RendererSettings& renderer);
+};
+
+struct RenderState {
+    int width = 0, height = 0;
+    std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
+    std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
+    std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
+    std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
+    int passes = 0;                       // completed passes
+    uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
+    uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
+
+    RenderState() = default;
+    RenderState(int w, int h) { reset(w, h); }
+    void reset(int w, int h);
+    Image radiance() const;                  // per-pixel mean radiance
+    std::vector<double> mean_depth() const;  // per-pixel mean primary distance
+};
+
+// Adds one sample to every pixel of `state` (sample index = the pixel's own count of samples drawn).
+// Parallel over rows with OpenMP; each sample has its own RNG stream seeded by
+// (seed, pixel, sample index), so the image does not depend on threads or scheduling.
+// If `stop` becomes true the pass ends early and returns false; pixels it reached keep their
+// sample, others do not, so the state stays a valid (unevenly sampled) estimate.
+bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                 const std::atomic<bool>* stop = nullptr);
+
+// One radiance sample for a camera ray, for tests and tools: the integrator the settings name.
+struct SampleResult {
+    Color radiance;
+    double primary_distance = kMissDepth;
+    uint64_t rays = 0;
+};
+SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
+                          Rng& rng);
+
+// Sub-pixel position in [0,1)^2 of sample `index` of `target` for the given estimator.
+// Stratified: sample i < e^2 lies in stratum (i mod e, i / e); samples beyond e^2 (when the
+// count is not a square) are uniform.
+Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng);
+
+}  // namespace kr

@@ -1,0 +1,168 @@
+#include "render/render_scene.h"
+
+#include <stdexcept>
+
+#include "scene/load.h"
+
+namespace kr {
+
+bool sphere_roots(const SphereGeom& s, const Vec3& o, const Vec3& d, double& t_near, double& t_far) {
+    const Vec3 f = o - s.centre;
+    const double b = dot(f, d);  // half the usual b, since |d| = 1
+    // Discriminant as r^2 - |f - b d|^2: the distance of the line from the centre, computed
+    // without subtracting two large, nearly equal squares.
+    const Vec3 perp = f - b * d;
+    const double r2 = s.radius * s.radius;
+    const double disc = r2 - dot(perp, perp);
+    if (disc < 0) return false;
+    const double c = dot(f, f) - r2;
+    // Vieta: the root of larger magnitude from q, the other from c / q (no cancellation).
+    const double q = -b - std::copysign(std::sqrt(disc), b);
+    if (q == 0) {  // origin at the centre of a zero-size sphere, or tangent at the origin
+        t_near = t_far = 0;
+        return true;
+    }
+    const double t0 = c / q, t1 = q;
+    t_near = std::min(t0, t1);
+    t_far = std::max(t0, t1);
+    return true;
+}
+
+// Root of sphere i accepted for this ray, or +inf. Applies the from/to sphere rules of Ray.
+static inline double accepted_root(const RenderScene& scene, int i, const Ray& ray) {
+    if (i == ray.to_sphere) return kInfinity;
+    const bool is_origin = i == ray.from_sphere;
+    if (is_origin && !ray.into_from_sphere) return kInfinity;
+    double t_near, t_far;
+    if (!sphere_roots(scene.spheres[i], ray.o, ray.d, t_near, t_far)) return kInfinity;
+    if (!is_origin && t_near >= ray.tmin && t_near <= ray.tmax) return t_near;
+    if (t_far >= ray.tmin && t_far <= ray.tmax && (!is_origin || t_far > 0)) return t_far;
+    return kInfinity;
+}
+
+bool RenderScene::intersects(const Ray& ray, Hit& hit) const {
+    double best = kInfinity;
+    int best_sphere = -1;
+    for (int i = 0; i < static_cast<int>(spheres.size()); ++i) {
+        const double t = accepted_root(*this, i, ray);
+        if (t < best) {
+            best = t;
+            best_sphere = i;
+        }
+    }
+    if (best_sphere < 0) return false;
+    const SphereGeom& s = spheres[best_sphere];
+    hit.t = best;
+    hit.sphere = best_sphere;
+    // Project the hit point back onto the sphere so the next ray starts on its surface.
+    const Vec3 offset = ray.o + best * ray.d - s.centre;
+    const double offset_length = length(offset);
+    hit.n = offset_length > 0 ? offset / offset_length : -ray.d;
+    hit.p = s.centre + hit.n * s.radius;
+    return true;
+}
+
+bool RenderScene::is_occluded(const Ray& ray) const {
+    for (int i = 0; i < static_cast<int>(spheres.size()); ++i)
+        if (accepted_root(*this, i, ray) < kInfinity) return true;
+    return false;
+}
+
+RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings) {
+    const std::string file = scene.source_file.string();
+    auto warn = [&](const std::string& path, const std::string& message) {
+        if (warnings) warnings->push_back(file + ": " + path + ": " + message);
+    };
+    RenderScene rs;
+    rs.renderer = scene.renderer;
+    if (scene.camera < 0 || scene.camera >= static_cast<int>(scene.cameras.size()))
+        throw SceneError(file, "/scene/camera", "no active camera");
+    try {
+        rs.camera = CameraModel::from(scene.cameras[scene.camera]);
+    } catch (const std::invalid_argument& e) {
+        throw SceneError(file, "/cameras/" + std::to_string(scene.camera), e.what());
+    }
+
+    // Materials are copied on first use, so the render scene holds only referenced ones.
+    std::vector<int> material_slot(scene.materials.size(), -1);
+    auto use_material = [&](int m) {
+        if (material_slot[m] < 0) {
+            material_slot[m] = static_cast<int>(rs.materials.size());
+            rs.materials.push_back(scene.materials[m]);
+        }
+        return material_slot[m];
+    };
+
+    // One sphere per distinct shape: a repeated primitive would only hit itself again.
+    std::vector<int> shape_sphere(scene.shapes.size(), -1);
+    for (size_t i = 0; i < scene.primitives.size(); ++i) {
+        const Primitive& prim = scene.primitives[i];
+        const std::string path = "/scene/primitives/" + std::to_string(i);
+        if (shape_sphere[prim.shape] >= 0) {
+            const int existing = shape_sphere[prim.shape];
+            if (rs.materials[rs.sphere_material[existing]].id != scene.materials[prim.material].id ||
+                (prim.type == PrimitiveType::emissive) != (rs.sphere_light[existing] >= 0))
+                warn(path, "shape \"" + scene.shapes[prim.shape].id +
+                               "\" is already used by an earlier primitive; this one is ignored");
+            continue;
+        }
+        const Shape& shape = scene.shapes[prim.shape];
+        shape_sphere[prim.shape] = static_cast<int>(rs.spheres.size());
+        rs.spheres.push_back({shape.centre, shape.radius});
+        rs.sphere_material.push_back(use_material(prim.material));
+        int light_index = -1;
+        if (prim.type == PrimitiveType::emissive) {
+            const Light& light = scene.lights[prim.light];
+            light_index = static_cast<int>(rs.area_lights.size());
+            rs.area_lights.push_back({static_cast<int>(rs.spheres.size()) - 1, light.power, 0});
+            bool active = false;
+            for (int l : scene.active_lights) active = active || l == prim.light;
+            if (!active)
+                warn(path + "/light", "light \"" + light.id +
+                                          "\" is not listed in /scene/lights; the primitive emits anyway");
+            if (light.shape != prim.shape)
+                warn(path + "/shape", "differs from the shape of light \"" + light.id +
+                                          "\"; the primitive's shape emits");
+        }
+        rs.sphere_light.push_back(light_index);
+    }
+
+    for (size_t k = 0; k < scene.active_lights.size(); ++k) {
+        const Light& light = scene.lights[scene.active_lights[k]];
+        if (light.type == LightType::point) {
+            rs.point_lights.push_back({light.position, light.power, 0});
+            continue;
+        }
+        bool carried = false;
+        for (const Primitive& prim : scene.primitives)
+            carried = carried || (prim.type == PrimitiveType::emissive && prim.light == scene.active_lights[k]);
+        if (!carried)
+            throw SceneError(file, "/scene/lights/" + std::to_string(k),
+                             "area light \"" + light.id +
+                                 "\" is not carried by any emissive primitive; add one with \"light\": \"" +
+                                 light.id + "\"");
+    }
+
+    // Light selection probabilities proportional to emitted power (luminance):
+    // 4 pi I for a point light, pi A Le for a sphere emitting from its outside.
+    double total = 0;
+    std::vector<double> power;
+    for (const PointLight& l : rs.point_lights) power.push_back(4.0 * kPi * luminance(l.intensity));
+    for (const AreaLight& l : rs.area_lights) {
+        const double r = rs.spheres[l.sphere].radius;
+        power.push_back(kPi * 4.0 * kPi * r * r * luminance(l.radiance));
+    }
+    for (double p : power) total += p;
+    const size_t n = power.size();
+    for (size_t i = 0; i < n; ++i) {
+        // Equal shares when every light is black (keeps pdfs defined).
+        const double prob = total > 0 ? power[i] / total : 1.0 / double(n);
+        if (i < rs.point_lights.size())
+            rs.point_lights[i].select_prob = prob;
+        else
+            rs.area_lights[i - rs.point_lights.size()].select_prob = prob;
+    }
+    return rs;
+}
+
+}  // namespace kr

@@ -1,0 +1,83 @@
+// The prepared render scene: only what the authored scene's `scene` block references,
+// flattened into arrays the integrators read, plus ray casting against it.
+// Rebuilt from the authored scene (scene/scene.h) after every edit.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+#include "render/camera.h"
+#include "scene/scene.h"
+
+namespace kr {
+
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// A ray segment <O, D, tmin, tmax>. D is unit length.
+// A ray that leaves a sphere's surface names it in `from_sphere`: spheres are convex, so a
+// ray heading out of it can never hit it again and one heading into it can only hit its far
+// side. Skipping that sphere (or its near root) replaces epsilon offsets, which fail across
+// the scales of a radius-1e-4 ball and a radius-1e6 wall. `to_sphere` is skipped too: shadow
+// rays end on it.
+struct Ray {
+    Vec3 o, d;
+    double tmin = 0, tmax = kInfinity;
+    int from_sphere = -1;
+    bool into_from_sphere = false;
+    int to_sphere = -1;
+};
+
+struct Hit {
+    double t = kInfinity;
+    int sphere = -1;
+    Vec3 p;  // on the sphere
+    Vec3 n;  // outward unit normal
+};
+
+struct SphereGeom {
+    Vec3 centre;
+    double radius = 1;
+};
+
+struct PointLight {
+    Vec3 position;
+    Color intensity;  // radiant intensity (W/sr per channel)
+    double select_prob = 0;
+};
+
+// A spherical emitter: an emissive primitive. Emits `radiance` from both sides of its surface.
+struct AreaLight {
+    int sphere = -1;
+    Color radiance;
+    double select_prob = 0;
+};
+
+struct RenderScene {
+    std::vector<SphereGeom> spheres;
+    std::vector<int> sphere_material;  // per sphere: index into materials
+    std::vector<int> sphere_light;     // per sphere: index into area_lights, or -1
+    std::vector<Material> materials;   // only those the primitives use
+    std::vector<PointLight> point_lights;
+    std::vector<AreaLight> area_lights;
+    CameraModel camera;
+    RendererSettings renderer;  // the file's renderer block
+
+    // Closest hit within [tmin, tmax]. Fills `hit` and returns true if there is one.
+    bool intersects(const Ray& ray, Hit& hit) const;
+    // Any hit within [tmin, tmax].
+    bool is_occluded(const Ray& ray) const;
+    size_t light_count() const { return point_lights.size() + area_lights.size(); }
+};
+
+// Ray-sphere roots of |o + t d - c|^2 = r^2 for unit d, in a cancellation-free form
+// (Haines et al., Ray Tracing Gems ch. 7). Returns false when the line misses.
+bool sphere_roots(const SphereGeom& s, const Vec3& o, const Vec3& d, double& t_near, double& t_far);
+
+// Builds the render scene from what `scene.scene` references. Identical repeated primitives
+// (same shape) are merged, with a warning if their materials differ. Throws SceneError for
+// problems only visible at this stage (e.g. an active area light no primitive carries).
+RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings = nullptr);
+
+}  // namespace kr

@@ -1,0 +1,807 @@
+// Strict scene loading: every problem becomes one SceneError naming the file, the JSON
+// pointer and what was expected. Validation runs in three steps: the raw text (nesting
+// depth), the JSON syntax (nlohmann, plus duplicate keys and non-finite numbers), then the
+// scene format itself.
+#include "scene/load.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <system_error>
+#include <tuple>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+#include <nlohmann/json.hpp>
+
+namespace kr {
+
+namespace {
+
+std::string format_message(const std::string& file, const std::string& json_path,
+                           const std::string& message) {
+    // The root pointer is the empty string; "file: : message" would read like a typo.
+    if (json_path.empty()) return file + ": " + message;
+    return file + ": " + json_path + ": " + message;
+}
+
+}  // namespace
+
+SceneError::SceneError(std::string file, std::string json_path, std::string message)
+    : std::runtime_error(format_message(file, json_path, message)),
+      file_(std::move(file)),
+      json_path_(std::move(json_path)),
+      message_(std::move(message)) {}
+
+namespace {
+
+// ordered_json keeps keys in document order, so "the first error" is the first in the file.
+using Json = nlohmann::ordered_json;
+
+constexpr int kMaxNesting = 64;
+constexpr double kMaxDimension = 32768;
+constexpr double kMaxSamples = 1 << 24;
+constexpr size_t kMaxListedIds = 10;
+constexpr size_t kMaxQuotedLength = 40;
+
+// ---------------------------------------------------------------------------------------
+// Small formatting helpers
+
+// RFC 6901 escaping: only '~' and '/' are special; spaces stay as they are.
+std::string child(const std::string& pointer, std::string_view key) {
+    std::string out = pointer + '/';
+    for (char c : key) {
+        if (c == '~') out += "~0";
+        else if (c == '/') out += "~1";
+        else out += c;
+    }
+    return out;
+}
+
+std::string child(const std::string& pointer, size_t index) {
+    return pointer + '/' + std::to_string(index);
+}
+
+// A JSON string literal; the replace handler keeps a message from throwing on bad UTF-8.
+std::string in_quotes(std::string_view s) {
+    std::string text(s);
+    if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
+    return Json(text).dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+// "a", "b", "c": the form used for lists of keys and ids.
+std::string quoted_list(const std::vector<std::string>& items) {
+    std::string out;
+    for (size_t i = 0; i < items.size(); ++i) {
+        if (i > 0) out += ", ";
+        out += in_quotes(items[i]);
+    }
+    return out;
+}
+
+std::string number_text(const Json& j) { return j.dump(); }
+
+// What a value is, for "expected X, got Y" messages.
+std::string describe(const Json& j) {
+    switch (j.type()) {
+        case Json::value_t::string: return "string " + in_quotes(j.get_ref<const std::string&>());
+        case Json::value_t::boolean: return j.get<bool>() ? "boolean true" : "boolean false";
+        case Json::value_t::null: return "null";
+        case Json::value_t::object: return "an object";
+        case Json::value_t::array:
+            return j.size() == 1 ? "an array of 1 element"
+                                 : "an array of " + std::to_string(j.size()) + " elements";
+        case Json::value_t::number_integer:
+        case Json::value_t::number_unsigned:
+        case Json::value_t::number_float: return "number " + number_text(j);
+        default: return "an unsupported value";
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Text and syntax
+
+// nlohmann's DOM (and its destructor) are recursive, so hostile nesting is refused before
+// parsing. Brackets inside strings do not count.
+void check_nesting(std::string_view text, const std::string& file) {
+    int depth = 0, line = 1, column = 0;
+    bool in_string = false, escaped = false;
+    for (char c : text) {
+        if (c == '\n') {
+            ++line;
+            column = 0;
+        } else {
+            ++column;
+        }
+        if (in_string) {
+            if (escaped) escaped = false;
+            else if (c == '\\') escaped = true;
+            else if (c == '"') in_string = false;
+            continue;
+        }
+        if (c == '"') {
+            in_string = true;
+        } else if (c == '{' || c == '[') {
+            if (++depth > kMaxNesting)
+                throw SceneError(file, "",
+                                 "JSON nesting deeper than " + std::to_string(kMaxNesting) +
+                                     " levels at line " + std::to_string(line) + ", column " +
+                                     std::to_string(column));
+        } else if ((c == '}' || c == ']') && depth > 0) {
+            --depth;
+        }
+    }
+}
+
+// Builds the DOM from nlohmann's SAX events. Doing it here rather than with a parser
+// callback keeps parsing linear (the callback parser rescans the parent array at every
+// object end), and lets us refuse duplicate keys and know the JSON pointer of the value
+// being parsed, where nlohmann itself only knows a byte offset.
+class DomBuilder : public nlohmann::json_sax<Json> {
+public:
+    Json root;
+    // Set when parsing stopped on our own finding rather than a syntax error.
+    std::optional<std::string> duplicate_key;
+    std::string error_pointer;                 // where parsing stopped
+    int error_id = 0;                          // nlohmann's exception id (101, 406, ...)
+    std::string error_text;
+
+    bool null() override { return add(Json(nullptr)); }
+    bool boolean(bool v) override { return add(Json(v)); }
+    bool number_integer(number_integer_t v) override { return add(Json(v)); }
+    bool number_unsigned(number_unsigned_t v) override { return add(Json(v)); }
+    bool number_float(number_float_t v, const string_t&) override { return add(Json(v)); }
+    bool string(string_t& v) override { return add(Json(std::move(v))); }
+    bool binary(binary_t&) override { return add(Json(nullptr)); }  // not produced by JSON text
+
+    bool start_object(std::size_t) override { return open(Json::object()); }
+    bool start_array(std::size_t) override { return open(Json::array()); }
+    bool key(string_t& k) override {
+        Level& top = levels_.back();
+        top.key = k;
+        if (!top.keys.insert(k).second) {
+            duplicate_key = k;
+            error_pointer = pointer();
+            return false;
+        }
+        return true;
+    }
+    bool end_object() override { return close(); }
+    bool end_array() override { return close(); }
+
+    bool parse_error(std::size_t, const std::string&, const nlohmann::json::exception& e) override {
+        error_id = e.id;
+        error_text = e.what();
+        error_pointer = pointer();
+        return false;
+    }
+
+private:
+    struct Level {
+        Json* value;
+        std::string key;   // objects: the key whose value is being parsed
+        size_t count = 0;  // arrays: elements completed so far = index of the current one
+        std::unordered_set<std::string> keys;
+    };
+
+    // Pointer of the value being parsed now.
+    std::string pointer() const {
+        std::string out;
+        for (const Level& level : levels_)
+            out = level.value->is_object() ? child(out, level.key) : child(out, level.count);
+        return out;
+    }
+
+    // Stores a value in the innermost container and returns where it now lives. Only that
+    // container grows while it is open, so the pointers held in levels_ stay valid.
+    Json* place(Json&& value) {
+        if (levels_.empty()) {
+            root = std::move(value);
+            return &root;
+        }
+        Level& top = levels_.back();
+        if (top.value->is_array()) {
+            auto& array = top.value->get_ref<Json::array_t&>();
+            array.push_back(std::move(value));
+            return &array.back();
+        }
+        // Keys are known unique (key() checked), so skip ordered_map's linear lookup.
+        auto& object = top.value->get_ref<Json::object_t&>();
+        object.Container::emplace_back(top.key, std::move(value));
+        return &object.back().second;
+    }
+
+    bool add(Json&& value) {
+        place(std::move(value));
+        element_done();
+        return true;
+    }
+    bool open(Json&& container) {
+        Json* where = place(std::move(container));
+        levels_.push_back({where, {}, 0, {}});
+        return true;
+    }
+    bool close() {
+        levels_.pop_back();
+        element_done();
+        return true;
+    }
+    void element_done() {
+        if (!levels_.empty() && levels_.back().value->is_array()) ++levels_.back().count;
+    }
+
+    std::vector<Level> levels_;
+};
+
+Json parse_json(std::string_view text, const std::string& file) {
+    check_nesting(text, file);
+    DomBuilder builder;
+    if (Json::sax_parse(text.begin(), text.end(), &builder)) return std::move(builder.root);
+
+    if (builder.duplicate_key)
+        throw SceneError(file, builder.error_pointer,
+                         "duplicate key " + in_quotes(*builder.duplicate_key) +
+                             "; each key may appear only once in an object");
+    if (builder.error_id == 406) {
+        // A float literal such as 1e999 that overflows to infinity: nlohmann's text
+        // quotes it as "number overflow parsing '1e999'".
+        const std::string& what = builder.error_text;
+        const size_t open = what.find('\''), close = what.rfind('\'');
+        const std::string token =
+            open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
+        throw SceneError(file, builder.error_pointer,
+                         "number " + token + " is not a finite number; expected a finite number");
+    }
+    // nlohmann's text reads "[json.exception.parse_error.101] parse error at line 4, ...".
+    std::string detail = builder.error_text;
+    const size_t at = detail.find("at line ");
+    if (at != std::string::npos) detail = detail.substr(at);
+    // Its "last read" excerpt may hold the very bytes that are not valid UTF-8.
+    for (char& c : detail)
+        if (static_cast<unsigned char>(c) >= 0x80) c = '?';
+    throw SceneError(file, "", "malformed JSON " + detail);
+}
+
+// ---------------------------------------------------------------------------------------
+// The scene format
+
+enum class Category { cameras, materials, shapes, lights, scene };
+
+// Which object a deferred range problem belongs to: it is an error only if the scene
+// block uses that object.
+struct Owner {
+    Category category;
+    size_t index;
+};
+
+struct RangeProblem {
+    Owner owner;
+    std::string pointer, message;
+};
+
+// Ids of one category, for resolving references and listing the valid ones.
+struct IdIndex {
+    std::string singular;  // "material"
+    std::string plural;    // "materials"
+    std::unordered_map<std::string, size_t> by_id;
+    std::vector<std::string> ids;
+};
+
+// One key an object may have: read is called with its value and pointer.
+struct Field {
+    std::string name;
+    std::string expected;  // for "missing key" messages
+    std::function<void(const Json&, const std::string&)> read;
+    bool required = true;
+};
+
+class Loader {
+public:
+    explicit Loader(std::string file) : file_(std::move(file)) {
+        cameras_ = {"camera", "cameras", {}, {}};
+        materials_ = {"material", "materials", {}, {}};
+        shapes_ = {"shape", "shapes", {}, {}};
+        lights_ = {"light", "lights", {}, {}};
+    }
+
+    LoadedScene load(const Json& root);
+
+private:
+    [[noreturn]] void fail(const std::string& pointer, const std::string& message) const {
+        throw SceneError(file_, pointer, message);
+    }
+    void warn(const std::string& pointer, const std::string& message) {
+        out_.warnings.push_back(format_message(file_, pointer, message));
+    }
+    void range_problem(Owner owner, const std::string& pointer, std::string message) {
+        problems_.push_back({owner, pointer, std::move(message)});
+    }
+
+    // --- typed readers: structural problems fail at once, range problems are deferred
+    void require_object(const Json& j, const std::string& pointer, std::string_view what) const;
+    void read_fields(const Json& object, const std::string& pointer,
+                     const std::vector<Field>& fields) const;
+    double number(const Json& j, const std::string& pointer) const;
+    double checked(const Json& j, const std::string& pointer, Owner owner,
+                   std::string_view expected, bool (*ok)(double));
+    double integer(const Json& j, const std::string& pointer, std::string_view expected) const;
+    Vec3 vec3(const Json& j, const std::string& pointer) const;
+    Color color(const Json& j, const std::string& pointer, Owner owner, bool reflectance);
+    std::string nonempty_string(const Json& j, const std::string& pointer, std::string_view expected) const;
+    size_t resolve(const IdIndex& index, const Json& j, const std::string& pointer) const;
+
+    template <typename Enum, size_t N>
+    std::pair<std::string, Enum> header(const Json& j, const std::string& pointer,
+                                        IdIndex* index, const EnumNames<Enum, N>& names,
+                                        std::string_view kind);
+    Field id_field() const { return {"id", "a non-empty string", [](const Json&, const std::string&) {}}; }
+    Field type_field() const { return {"type", "a type name", [](const Json&, const std::string&) {}}; }
+
+    template <typename Item>
+    void read_category(const Json& root, std::string_view key, std::vector<Item>& items,
+                       void (Loader::*read)(const Json&, const std::string&, size_t));
+    void read_camera(const Json& j, const std::string& pointer, size_t index);
+    void read_material(const Json& j, const std::string& pointer, size_t index);
+    void read_shape(const Json& j, const std::string& pointer, size_t index);
+    void read_light(const Json& j, const std::string& pointer, size_t index);
+    void read_scene(const Json& j, const std::string& pointer);
+    void read_primitive(const Json& j, const std::string& pointer);
+    void read_renderer(const Json& j, const std::string& pointer);
+
+    struct Usage {
+        std::vector<bool> cameras, materials, shapes, lights;
+    };
+    Usage usage() const;
+    void settle_range_problems();
+
+    std::string file_;
+    LoadedScene out_;
+    IdIndex cameras_, materials_, shapes_, lights_;
+    std::vector<RangeProblem> problems_;
+};
+
+void Loader::require_object(const Json& j, const std::string& pointer, std::string_view what) const {
+    if (!j.is_object()) fail(pointer, "expected " + std::string(what) + " (a JSON object), got " + describe(j));
+}
+
+// Unknown keys first (in document order), then missing ones, then each value in
+// document order.
+void Loader::read_fields(const Json& object, const std::string& pointer,
+                         const std::vector<Field>& fields) const {
+    auto find = [&](const std::string& key) -> const Field* {
+        for (const Field& f : fields)
+            if (f.name == key) return &f;
+        return nullptr;
+    };
+    for (const auto& [key, value] : object.items()) {
+        if (find(key)) continue;
+        std::vector<std::string> names;
+        for (const Field& f : fields) names.push_back(f.name);
+        fail(child(pointer, key), "unknown key " + in_quotes(key) + "; expected one of " + quoted_list(names));
+    }
+    for (const Field& f : fields)
+        if (f.required && !object.contains(f.name))
+            fail(pointer, "missing key " + in_quotes(f.name) + "; expected " + f.expected);
+    for (const auto& [key, value] : object.items()) find(key)->read(value, child(pointer, key));
+}
+
+double Loader::number(const Json& j, const std::string& pointer) const {
+    if (!j.is_number()) fail(pointer, "expected a number, got " + describe(j));
+    const double v = j.get<double>();
+    // The parser already refuses overflowing literals; this keeps the promise local.
+    if (!std::isfinite(v)) fail(pointer, "expected a finite number, got " + number_text(j));
+    return v;
+}
+
+double Loader::checked(const Json& j, const std::string& pointer, Owner owner,
+                       std::string_view expected, bool (*ok)(double)) {
+    const double v = number(j, pointer);
+    if (!ok(v)) range_problem(owner, pointer, "expected " + std::string(expected) + ", got " + number_text(j));
+    return v;
+}
+
+double Loader::integer(const Json& j, const std::string& pointer, std::string_view expected) const {
+    if (!j.is_number()) fail(pointer, "expected " + std::string(expected) + ", got " + describe(j));
+    const double v = number(j, pointer);
+    if (std::floor(v) != v) fail(pointer, "expected " + std::string(expected) + ", got " + describe(j));
+    return v;
+}
+
+Vec3 Loader::vec3(const Json& j, const std::string& pointer) const {
+    if (!j.is_array() || j.size() != 3)
+        fail(pointer, "expected an array of 3 finite numbers, got " + describe(j));
+    const double x = number(j[0], child(pointer, size_t{0}));
+    const double y = number(j[1], child(pointer, size_t{1}));
+    const double z = number(j[2], child(pointer, size_t{2}));
+    return {x, y, z};
+}
+
+Color Loader::color(const Json& j, const std::string& pointer, Owner owner, bool reflectance) {
+    const Color c = vec3(j, pointer);
+    bool warned = false;
+    for (size_t i = 0; i < 3; ++i) {
+        const std::string p = child(pointer, i);
+        if (c[static_cast<int>(i)] < 0)
+            range_problem(owner, p, "expected a value >= 0, got " + number_text(j[i]));
+        else if (reflectance && c[static_cast<int>(i)] > 1 && !warned) {
+            // Legal (the renderer copes), but almost always a typo, so say so.
+            warn(p, "reflectance " + number_text(j[i]) + " is above 1: not energy conserving");
+            warned = true;
+        }
+    }
+    return c;
+}
+
+std::string Loader::nonempty_string(const Json& j, const std::string& pointer, std::string_view expected) const {
+    if (!j.is_string() || j.get_ref<const std::string&>().empty())
+        fail(pointer, "expected " + std::string(expected) + ", got " + describe(j));
+    return j.get<std::string>();
+}
+
+size_t Loader::resolve(const IdIndex& index, const Json& j, const std::string& pointer) const {
+    if (!j.is_string()) fail(pointer, "expected a " + index.singular + " id (a string), got " + describe(j));
+    const std::string& id = j.get_ref<const std::string&>();
+    if (auto it = index.by_id.find(id); it != index.by_id.end()) return it->second;
+    std::string message = "no " + index.singular + " with id " + in_quotes(id);
+    if (index.ids.empty())
+        message += "; the file defines no " + index.plural;
+    else if (index.ids.size() <= kMaxListedIds)
+        message += "; expected one of " + quoted_list(index.ids);
+    else
+        message += " among the " + std::to_string(index.ids.size()) + " " + index.plural + " defined";
+    fail(pointer, message);
+}
+
+// The id and type of a category entry: needed before its other keys can be checked.
+template <typename Enum, size_t N>
+std::pair<std::string, Enum> Loader::header(const Json& j, const std::string& pointer,
+                                            IdIndex* index, const EnumNames<Enum, N>& names,
+                                            std::string_view kind) {
+    const std::string kind_text(kind);
+    require_object(j, pointer, "a " + kind_text);
+    if (!j.contains("id")) fail(pointer, "missing key \"id\"; expected a non-empty string");
+    const std::string id = nonempty_string(j["id"], child(pointer, "id"), "a non-empty string id");
+    if (!j.contains("type")) fail(pointer, "missing key \"type\"; expected " + names.list());
+    const Json& type = j["type"];
+    if (!type.is_string())
+        fail(child(pointer, "type"), "expected a " + kind_text + " type (a string), got " + describe(type));
+    const auto parsed = names.parse(type.get_ref<const std::string&>());
+    if (!parsed)
+        fail(child(pointer, "type"), "unknown " + kind_text + " type " +
+                                         in_quotes(type.get_ref<const std::string&>()) + "; expected " +
+                                         names.list());
+    if (index) {
+        const size_t position = index->ids.size();
+        const auto [it, inserted] = index->by_id.emplace(id, position);
+        if (!inserted)
+            fail(child(pointer, "id"), "duplicate " + index->singular + " id " + in_quotes(id) +
+                                           ": also the id of /" + index->plural + "/" +
+                                           std::to_string(it->second) +
+                                           "; ids must be unique within " + in_quotes(index->plural));
+        index->ids.push_back(id);
+    }
+    return {id, *parsed};
+}
+
+template <typename Item>
+void Loader::read_category(const Json& root, std::string_view key, std::vector<Item>& items,
+                           void (Loader::*read)(const Json&, const std::string&, size_t)) {
+    const std::string k(key);
+    if (!root.contains(k)) return;  // an absent category is an empty one
+    const Json& list = root[k];
+    const std::string pointer = child("", key);
+    if (!list.is_array()) fail(pointer, "expected an array of " + k + ", got " + describe(list));
+    items.reserve(list.size());
+    for (size_t i = 0; i < list.size(); ++i) (this->*read)(list[i], child(pointer, i), i);
+}
+
+void Loader::read_camera(const Json& j, const std::string& pointer, size_t index) {
+    Camera cam;
+    const Owner owner{Category::cameras, index};
+    std::tie(cam.id, cam.type) = header(j, pointer, &cameras_, camera_type_names, "camera");
+    std::vector<Field> fields = {
+        id_field(),
+        type_field(),
+        {"fov", "a number in (0, 180) degrees",
+         [&](const Json& v, const std::string& p) {
+             cam.fov = checked(v, p, owner, "a field of view in (0, 180) degrees",
+                               [](double x) { return x > 0 && x < 180; });
+         }},
+        {"aspect", "a number > 0",
+         [&](const Json& v, const std::string& p) {
+             cam.aspect = checked(v, p, owner, "an aspect ratio > 0", [](double x) { return x > 0; });
+         }},
+        {"distance", "a number > 0",
+         [&](const Json& v, const std::string& p) {
+             cam.distance = checked(v, p, owner, "a distance > 0", [](double x) { return x > 0; });
+         },
+         false},
+        {"position", "an array of 3 finite numbers",
+         [&](const Json& v, const std::string& p) { cam.position = vec3(v, p); }},
+        {"target", "an array of 3 finite numbers",
+         [&](const Json& v, const std::string& p) { cam.target = vec3(v, p); }},
+    };
+    if (cam.type == CameraType::lens) {
+        fields.push_back({"focal distance", "a number > 0", [&](const Json& v, const std::string& p) {
+                              cam.focal_distance = checked(v, p, owner, "a focal distance > 0",
+                                                           [](double x) { return x > 0; });
+                          }});
+        fields.push_back({"alpha", "an aperture radius >= 0", [&](const Json& v, const std::string& p) {
+                              cam.alpha = checked(v, p, owner, "an aperture radius >= 0",
+                                                  [](double x) { return x >= 0; });
+                          }});
+    }
+    read_fields(j, pointer, fields);
+    // Without a view direction there is no camera frame.
+    if (cam.position == cam.target) range_problem(owner, pointer, "camera position equals target; expected distinct points");
+    out_.scene.cameras.push_back(std::move(cam));
+}
+
+void Loader::read_material(const Json& j, const std::string& pointer, size_t index) {
+    Material mat;
+    const Owner owner{Category::materials, index};
+    std::tie(mat.id, mat.type) = header(j, pointer, &materials_, material_type_names, "material");
+    auto rho = [this, owner](Color& target) {
+        return [this, owner, t = &target](const Json& v, const std::string& p) {
+            *t = color(v, p, owner, true);
+        };
+    };
+    const Field roughness{"roughness", "a number in [0, 1)", [&](const Json& v, const std::string& p) {
+                              mat.roughness = checked(v, p, owner, "a roughness in [0, 1)",
+                                                      [](double x) { return x >= 0 && x < 1; });
+                          }};
+    const Field eta{"eta", "a number > 0", [&](const Json& v, const std::string& p) {
+                        mat.eta = checked(v, p, owner, "a refractive index eta > 0",
+                                          [](double x) { return x > 0; });
+                    }};
+    const std::string colour = "an array of 3 numbers >= 0";
+    std::vector<Field> fields = {id_field(), type_field()};
+    switch (mat.type) {
+        case MaterialType::diffuse:
+        case MaterialType::specular: fields.push_back({"rho", colour, rho(mat.rho)}); break;
+        case MaterialType::glossy:
+            fields.push_back({"rho", colour, rho(mat.rho)});
+            fields.push_back(roughness);
+            break;
+        case MaterialType::dielectric:
+        case MaterialType::translucent:
+            fields.push_back({"rhoR", colour, rho(mat.rho_r)});
+            fields.push_back({"rhoT", colour, rho(mat.rho_t)});
+            fields.push_back(eta);
+            if (mat.type == MaterialType::translucent) fields.push_back(roughness);
+            break;
+    }
+    read_fields(j, pointer, fields);
+    out_.scene.materials.push_back(std::move(mat));
+}
+
+void Loader::read_shape(const Json& j, const std::string& pointer, size_t index) {
+    Shape shape;
+    const Owner owner{Category::shapes, index};
+    std::tie(shape.id, shape.type) = header(j, pointer, &shapes_, shape_type_names, "shape");
+    read_fields(j, pointer,
+                {id_field(), type_field(),
+                 {"centre", "an array of 3 finite numbers",
+                  [&](const Json& v, const std::string& p) { shape.centre = vec3(v, p); }},
+                 {"radius", "a number > 0", [&](const Json& v, const std::string& p) {
+                      shape.radius = checked(v, p, owner, "a radius > 0", [](double x) { return x > 0; });
+                  }}});
+    out_.scene.shapes.push_back(std::move(shape));
+}
+
+void Loader::read_light(const Json& j, const std::string& pointer, size_t index) {
+    Light light;
+    const Owner owner{Category::lights, index};
+    std::tie(light.id, light.type) = header(j, pointer, &lights_, light_type_names, "light");
+    std::vector<Field> fields = {id_field(), type_field()};
+    if (light.type == LightType::point)
+        fields.push_back({"position", "an array of 3 finite numbers",
+                          [&](const Json& v, const std::string& p) { light.position = vec3(v, p); }});
+    else
+        fields.push_back({"shape", "a shape id", [&](const Json& v, const std::string& p) {
+                              light.shape = static_cast<int>(resolve(shapes_, v, p));
+                          }});
+    fields.push_back({"power", "an array of 3 numbers >= 0", [&](const Json& v, const std::string& p) {
+                          light.power = color(v, p, owner, false);
+                      }});
+    read_fields(j, pointer, fields);
+    out_.scene.lights.push_back(std::move(light));
+}
+
+void Loader::read_primitive(const Json& j, const std::string& pointer) {
+    Primitive prim;
+    // Primitive ids may repeat (assignment_04 lists "floor" twice), so no index.
+    std::tie(prim.id, prim.type) = header(j, pointer, nullptr, primitive_type_names, "primitive");
+    std::vector<Field> fields = {
+        id_field(),
+        type_field(),
+        {"shape", "a shape id",
+         [&](const Json& v, const std::string& p) { prim.shape = static_cast<int>(resolve(shapes_, v, p)); }},
+        {"material", "a material id",
+         [&](const Json& v, const std::string& p) {
+             prim.material = static_cast<int>(resolve(materials_, v, p));
+         }},
+    };
+    if (prim.type == PrimitiveType::emissive)
+        fields.push_back({"light", "an area light id", [&](const Json& v, const std::string& p) {
+                              const size_t l = resolve(lights_, v, p);
+                              const Light& light = out_.scene.lights[l];
+                              if (light.type != LightType::area)
+                                  fail(p, "light " + in_quotes(light.id) + " is a " +
+                                              in_quotes(light_type_names.name(light.type)) +
+                                              " light; an emissive primitive expects an \"area\" light");
+                              prim.light = static_cast<int>(l);
+                          }});
+    read_fields(j, pointer, fields);
+    out_.scene.primitives.push_back(std::move(prim));
+}
+
+void Loader::read_renderer(const Json& j, const std::string& pointer) {
+    RendererSettings& r = out_.scene.renderer;
+    const Owner owner{Category::scene, 0};
+    require_object(j, pointer, "renderer settings");
+    const std::string dimension_range = "an integer in [1, " + std::to_string(int(kMaxDimension)) + "]";
+    const std::string samples_range = "an integer in [1, " + std::to_string(int(kMaxSamples)) + "]";
+    read_fields(
+        j, pointer,
+        {{"type", renderer_type_names.list(),
+          [&](const Json& v, const std::string& p) {
+              if (!v.is_string()) fail(p, "expected a renderer type (a string), got " + describe(v));
+              const auto type = renderer_type_names.parse(v.get_ref<const std::string&>());
+              if (!type)
+                  fail(p, "unknown renderer type " + in_quotes(v.get_ref<const std::string&>()) +
+                              "; expected " + renderer_type_names.list());
+              r.type = *type;
+          }},
+         {"dimensions", "an array of 2 integers [width, height]",
+          [&](const Json& v, const std::string& p) {
+              if (!v.is_array() || v.size() != 2)
+                  fail(p, "expected an array of 2 integers [width, height], got " + describe(v));
+              int* targets[2] = {&r.width, &r.height};
+              for (size_t i = 0; i < 2; ++i) {
+                  const std::string pi = child(p, i);
+                  const double d = integer(v[i], pi, dimension_range);
+                  if (d < 1 || d > kMaxDimension)
+                      range_problem(owner, pi, "expected " + dimension_range + ", got " + number_text(v[i]));
+                  // Clamped before the cast so an out-of-range double never overflows an int.
+                  *targets[i] = static_cast<int>(std::clamp(d, 1.0, kMaxDimension));
+              }
+          }},
+         {"samples", samples_range,
+          [&](const Json& v, const std::string& p) {
+              const double s = integer(v, p, samples_range);
+              if (s < 1 || s > kMaxSamples)
+                  range_problem(owner, p, "expected " + samples_range + ", got " + number_text(v));
+              r.samples = static_cast<int>(std::clamp(s, 1.0, kMaxSamples));
+          }},
+         {"depth", "an integer >= 0",
+          [&](const Json& v, const std::string& p) {
+              const double d = integer(v, p, "an integer >= 0");
+              if (d < 0) range_problem(owner, p, "expected an integer >= 0, got " + number_text(v));
+              if (d > kMaxDepth)
+                  warn(p, "depth " + number_text(v) + " is above the maximum " +
+                              std::to_string(kMaxDepth) + "; clamped to " + std::to_string(kMaxDepth));
+              r.depth = static_cast<int>(std::clamp(d, 0.0, double(kMaxDepth)));
+          }},
+         {"output", "a non-empty string (the output PPM path)",
+          [&](const Json& v, const std::string& p) {
+              r.output = nonempty_string(v, p, "a non-empty string (the output PPM path)");
+          }}});
+}
+
+void Loader::read_scene(const Json& j, const std::string& pointer) {
+    Scene& scene = out_.scene;
+    require_object(j, pointer, "the scene block");
+    read_fields(
+        j, pointer,
+        {{"camera", "a camera id",
+          [&](const Json& v, const std::string& p) { scene.camera = static_cast<int>(resolve(cameras_, v, p)); }},
+         {"lights", "an array of light ids",
+          [&](const Json& v, const std::string& p) {
+              if (!v.is_array()) fail(p, "expected an array of light ids, got " + describe(v));
+              for (size_t i = 0; i < v.size(); ++i) {
+                  const int l = static_cast<int>(resolve(lights_, v[i], child(p, i)));
+                  for (size_t k = 0; k < scene.active_lights.size(); ++k)
+                      if (scene.active_lights[k] == l)
+                          fail(child(p, i), "light " + in_quotes(scene.lights[size_t(l)].id) +
+                                                " is already listed at " + child(p, k) +
+                                                "; expected each active light once");
+                  scene.active_lights.push_back(l);
+              }
+          }},
+         {"primitives", "an array of primitives",
+          [&](const Json& v, const std::string& p) {
+              if (!v.is_array()) fail(p, "expected an array of primitives, got " + describe(v));
+              for (size_t i = 0; i < v.size(); ++i) read_primitive(v[i], child(p, i));
+          }},
+         {"renderer", "the renderer settings (an object)",
+          [&](const Json& v, const std::string& p) { read_renderer(v, p); }}});
+}
+
+// Which objects the scene block uses: the active camera, the active lights, the
+// primitives' shapes, materials and lights, and the shapes of the area lights used.
+Loader::Usage Loader::usage() const {
+    const Scene& s = out_.scene;
+    Usage used;
+    used.cameras.assign(s.cameras.size(), false);
+    used.materials.assign(s.materials.size(), false);
+    used.shapes.assign(s.shapes.size(), false);
+    used.lights.assign(s.lights.size(), false);
+    if (s.camera >= 0) used.cameras[size_t(s.camera)] = true;
+    for (int l : s.active_lights) used.lights[size_t(l)] = true;
+    for (const Primitive& p : s.primitives) {
+        used.shapes[size_t(p.shape)] = true;
+        used.materials[size_t(p.material)] = true;
+        if (p.light >= 0) used.lights[size_t(p.light)] = true;
+    }
+    for (size_t l = 0; l < s.lights.size(); ++l)
+        if (used.lights[l] && s.lights[l].shape >= 0) used.shapes[size_t(s.lights[l].shape)] = true;
+    return used;
+}
+
+// Files keep unused variants, so a bad value only matters where the scene block uses it.
+void Loader::settle_range_problems() {
+    const Usage used = usage();
+    for (const RangeProblem& problem : problems_) {
+        const size_t i = problem.owner.index;
+        bool referenced = true;
+        switch (problem.owner.category) {
+            case Category::scene: break;
+            case Category::cameras: referenced = used.cameras[i]; break;
+            case Category::materials: referenced = used.materials[i]; break;
+            case Category::shapes: referenced = used.shapes[i]; break;
+            case Category::lights: referenced = used.lights[i]; break;
+        }
+        if (referenced) fail(problem.pointer, problem.message);
+        warn(problem.pointer, problem.message + " (unused by the scene block, so only a warning)");
+    }
+}
+
+LoadedScene Loader::load(const Json& root) {
+    if (!root.is_object()) fail("", "expected a JSON object at the top level, got " + describe(root));
+    const std::vector<std::string> top_keys = {"cameras", "materials", "shapes", "lights", "scene"};
+    for (const auto& [key, value] : root.items()) {
+        if (std::find(top_keys.begin(), top_keys.end(), key) == top_keys.end())
+            fail(child("", key), "unknown key " + in_quotes(key) + "; expected one of " + quoted_list(top_keys));
+    }
+    if (!root.contains("scene")) fail("", "missing key \"scene\"; expected the scene block (an object)");
+    // Dependency order, not document order: area lights name shapes, the scene names all.
+    read_category(root, "cameras", out_.scene.cameras, &Loader::read_camera);
+    read_category(root, "materials", out_.scene.materials, &Loader::read_material);
+    read_category(root, "shapes", out_.scene.shapes, &Loader::read_shape);
+    read_category(root, "lights", out_.scene.lights, &Loader::read_light);
+    read_scene(root["scene"], "/scene");
+    settle_range_problems();
+    return std::move(out_);
+}
+
+}  // namespace
+
+LoadedScene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
+    const std::string name = file.string();
+    const Json root = parse_json(json_text, name);
+    LoadedScene loaded = Loader(name).load(root);
+    loaded.scene.source_file = file;
+    return loaded;
+}
+
+LoadedScene load_scene_file(const std::filesystem::path& file) {
+    const std::string name = file.string();
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(name.c_str(), "rb"), &std::fclose);
+    if (!f) throw SceneError(name, "", "cannot open scene file: " + std::generic_category().message(errno));
+    std::string text;
+    char buffer[1 << 16];
+    size_t n = 0;
+    while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) text.append(buffer, n);
+    // fopen succeeds on a directory on Linux; the read is what fails (EISDIR).
+    if (std::ferror(f.get()))
+        throw SceneError(name, "", "cannot read scene file: " + std::generic_category().message(errno));
+    return parse_scene(text, file);
+}
+
+}  // namespace kr

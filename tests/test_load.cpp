@@ -1,0 +1,476 @@
+// Scene loading: the eight reference scenes load with their content, and every kind of
+// bad input gives one SceneError naming the file, the JSON pointer and what was expected.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "scene/load.h"
+
+namespace fs = std::filesystem;
+
+namespace kr {
+namespace {
+
+fs::path scene_file(int n) {
+    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
+}
+
+int find_id(const auto& items, const std::string& id) {
+    for (size_t i = 0; i < items.size(); ++i)
+        if (items[i].id == id) return static_cast<int>(i);
+    return -1;
+}
+
+TEST(LoadReferenceScenes, AllEightLoadWithoutWarnings) {
+    for (int n = 1; n <= 8; ++n) {
+        SCOPED_TRACE(n);
+        const LoadedScene loaded = load_scene_file(scene_file(n));
+        const Scene& s = loaded.scene;
+        EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+        EXPECT_EQ(s.source_file, scene_file(n));
+        EXPECT_EQ(s.cameras[size_t(s.camera)].id, "pinhole");
+        EXPECT_EQ(s.renderer.width, 512);
+        EXPECT_EQ(s.renderer.height, 512);
+        EXPECT_FALSE(s.primitives.empty());
+        const fs::path expected =
+            (fs::path(KEITHRAY_RES_DIR) / "output" / ("assignment_0" + std::to_string(n) + ".ppm"))
+                .lexically_normal();
+        EXPECT_EQ(s.output_path(), expected);
+    }
+}
+
+TEST(LoadReferenceScenes, Assignment01Content) {
+    const Scene s = load_scene_file(scene_file(1)).scene;
+    EXPECT_EQ(s.cameras.size(), 1u);
+    EXPECT_EQ(s.materials.size(), 7u);
+    EXPECT_EQ(s.shapes.size(), 7u);
+    EXPECT_EQ(s.lights.size(), 1u);
+    ASSERT_EQ(s.primitives.size(), 7u);
+    EXPECT_EQ(s.renderer.type, RendererType::wrt);
+    EXPECT_EQ(s.renderer.samples, 8);
+    EXPECT_EQ(s.renderer.depth, 12);
+    EXPECT_EQ(s.renderer.output, "../output/assignment_01.ppm");
+
+    const Camera& cam = s.cameras[0];
+    EXPECT_EQ(cam.type, CameraType::pinhole);
+    EXPECT_DOUBLE_EQ(cam.fov, 45);
+    EXPECT_DOUBLE_EQ(cam.distance, 5);
+    EXPECT_EQ(cam.position, Vec3(0, 0, -15));
+
+    // sphere 01 is the Fresnel dielectric, rhoR/rhoT mapped to rho_r/rho_t.
+    const Primitive& sphere = s.primitives[5];
+    EXPECT_EQ(sphere.id, "sphere 01");
+    EXPECT_EQ(s.shapes[size_t(sphere.shape)].id, "sphere 01");
+    EXPECT_DOUBLE_EQ(s.shapes[size_t(sphere.shape)].radius, 1.5);
+    const Material& glass = s.materials[size_t(sphere.material)];
+    EXPECT_EQ(glass.type, MaterialType::dielectric);
+    EXPECT_DOUBLE_EQ(glass.eta, 1.5);
+    EXPECT_EQ(glass.rho_r, Color(0.9));
+    EXPECT_EQ(glass.rho_t, Color(0.9));
+
+    ASSERT_EQ(s.active_lights.size(), 1u);
+    const Light& light = s.lights[size_t(s.active_lights[0])];
+    EXPECT_EQ(light.type, LightType::point);
+    EXPECT_EQ(light.position, Vec3(0, 4, -1));
+    EXPECT_EQ(light.power, Color(300));
+}
+
+TEST(LoadReferenceScenes, Assignment03LensCameraAndAreaLight) {
+    const Scene s = load_scene_file(scene_file(3)).scene;
+    ASSERT_EQ(s.cameras.size(), 2u);
+    const int lens = find_id(s.cameras, "lens-based");
+    ASSERT_GE(lens, 0);
+    EXPECT_EQ(s.cameras[size_t(lens)].type, CameraType::lens);
+    EXPECT_DOUBLE_EQ(s.cameras[size_t(lens)].focal_distance, 14.0);
+    EXPECT_DOUBLE_EQ(s.cameras[size_t(lens)].alpha, 1.0);
+    EXPECT_EQ(s.cameras[size_t(s.camera)].type, CameraType::pinhole);
+
+    EXPECT_EQ(s.renderer.type, RendererType::pt);
+    EXPECT_EQ(s.renderer.samples, 128);
+    EXPECT_EQ(s.renderer.depth, 6);
+
+    const Material& glossy = s.materials[size_t(find_id(s.materials, "glossy"))];
+    EXPECT_EQ(glossy.type, MaterialType::glossy);
+    EXPECT_DOUBLE_EQ(glossy.roughness, 0.1);
+
+    ASSERT_EQ(s.active_lights.size(), 1u);
+    const Light& area = s.lights[size_t(s.active_lights[0])];
+    EXPECT_EQ(area.id, "area light");
+    EXPECT_EQ(area.type, LightType::area);
+    EXPECT_EQ(s.shapes[size_t(area.shape)].id, "area light");
+    EXPECT_EQ(area.power, Color(30));
+    EXPECT_EQ(s.primitives[0].type, PrimitiveType::emissive);
+    EXPECT_EQ(s.primitives[0].light, s.active_lights[0]);
+}
+
+TEST(LoadReferenceScenes, Assignment04RepeatsAPrimitive) {
+    const Scene s = load_scene_file(scene_file(4)).scene;
+    ASSERT_EQ(s.primitives.size(), 5u);
+    EXPECT_EQ(s.primitives[1].id, "floor");
+    EXPECT_EQ(s.primitives[2].id, "floor");
+    EXPECT_EQ(s.primitives[1].shape, s.primitives[2].shape);
+    EXPECT_EQ(s.renderer.samples, 4096);
+}
+
+TEST(LoadReferenceScenes, Assignment07TwoPointLights) {
+    const Scene s = load_scene_file(scene_file(7)).scene;
+    ASSERT_EQ(s.active_lights.size(), 2u);
+    EXPECT_EQ(s.lights[size_t(s.active_lights[0])].power, Color(320, 300, 280));
+    EXPECT_EQ(s.lights[size_t(s.active_lights[1])].power, Color(50, 60, 70));
+    EXPECT_EQ(s.renderer.samples, 36);
+    EXPECT_EQ(s.renderer.type, RendererType::wrt);
+}
+
+TEST(LoadReferenceScenes, Assignment08TwoEmissivePrimitives) {
+    const Scene s = load_scene_file(scene_file(8)).scene;
+    std::vector<const Primitive*> emissive;
+    for (const Primitive& p : s.primitives)
+        if (p.type == PrimitiveType::emissive) emissive.push_back(&p);
+    ASSERT_EQ(emissive.size(), 2u);
+
+    EXPECT_EQ(emissive[0]->id, "area light");
+    const Light& first = s.lights[size_t(emissive[0]->light)];
+    EXPECT_EQ(first.id, "area light");
+    EXPECT_EQ(first.power, Color(32, 30, 28));
+    EXPECT_EQ(s.shapes[size_t(first.shape)].centre, Vec3(6, 2, -1));
+
+    EXPECT_EQ(emissive[1]->id, "sphere 05");
+    const Light& second = s.lights[size_t(emissive[1]->light)];
+    EXPECT_EQ(second.id, "area light 02");
+    EXPECT_EQ(second.power, Color(5, 6, 7));
+    EXPECT_EQ(s.shapes[size_t(emissive[1]->shape)].id, "area light 02");
+
+    ASSERT_EQ(s.active_lights.size(), 2u);
+    EXPECT_EQ(s.active_lights[0], emissive[0]->light);
+    EXPECT_EQ(s.active_lights[1], emissive[1]->light);
+    EXPECT_EQ(s.materials[size_t(emissive[0]->material)].id, "white diffuse");
+}
+
+TEST(SceneOutputPath, WithoutSourceFileIsRelativeToCurrentDir) {
+    Scene s;
+    s.renderer.output = "out/../img.ppm";
+    EXPECT_EQ(s.output_path(), fs::path("img.ppm"));
+}
+
+// A small valid scene; each bad-input test changes one thing in it.
+// Materials: 0 red (used), 1 glass (used), 2 shiny (used), 3 spare (unused).
+// Lights: 0 lamp (area, used), 1 bulb (point, unused).
+constexpr const char* kBaseScene = R"({
+  "cameras": [{"id": "cam", "type": "pinhole", "fov": 45, "aspect": 1,
+               "position": [0, 0, -10], "target": [0, 0, 0]}],
+  "materials": [
+    {"id": "red", "type": "diffuse", "rho": [0.9, 0, 0]},
+    {"id": "glass", "type": "fresnel dielectric", "rhoR": [1, 1, 1], "rhoT": [1, 1, 1], "eta": 1.5},
+    {"id": "shiny", "type": "glossy reflection", "rho": [0.9, 0.9, 0.9], "roughness": 0.2},
+    {"id": "spare", "type": "diffuse", "rho": [0.5, 0.5, 0.5]}
+  ],
+  "shapes": [
+    {"id": "ball", "type": "sphere", "centre": [0, 0, 0], "radius": 1},
+    {"id": "lamp", "type": "sphere", "centre": [0, 5, 0], "radius": 0.5}
+  ],
+  "lights": [
+    {"id": "lamp", "type": "area", "shape": "lamp", "power": [10, 10, 10]},
+    {"id": "bulb", "type": "point", "position": [0, 4, 0], "power": [100, 100, 100]}
+  ],
+  "scene": {
+    "camera": "cam",
+    "lights": ["lamp"],
+    "primitives": [
+      {"id": "ball", "type": "geometric", "shape": "ball", "material": "red"},
+      {"id": "ball", "type": "geometric", "shape": "ball", "material": "glass"},
+      {"id": "ball", "type": "geometric", "shape": "ball", "material": "shiny"},
+      {"id": "lamp", "type": "emissive", "shape": "lamp", "material": "red", "light": "lamp"}
+    ],
+    "renderer": {"type": "PT", "dimensions": [64, 48], "samples": 4, "depth": 6,
+                 "output": "out.ppm"}
+  }
+})";
+
+// Replaces the single occurrence of `from` (failing the test if it is not there once).
+std::string edit(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << "base scene lacks: " << from;
+    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "ambiguous edit: " << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+}
+
+class LoadErrors : public ::testing::Test {
+protected:
+    void SetUp() override {
+        // A fresh folder per test, so messages name a real file and runs do not collide.
+        const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+        for (int attempt = 0;; ++attempt) {
+            dir_ = fs::temp_directory_path() /
+                   ("keithray_test_load_" + std::to_string(stamp) + "_" + std::to_string(attempt));
+            if (fs::create_directory(dir_)) break;
+        }
+    }
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(dir_, ec);
+    }
+
+    fs::path write(const std::string& text) {
+        const fs::path file = dir_ / ("scene_" + std::to_string(count_++) + ".json");
+        std::ofstream(file, std::ios::binary) << text;
+        return file;
+    }
+
+    // Loads `text` and checks the one error it must raise.
+    void expect_error(const std::string& text, const std::string& pointer, const std::string& phrase) {
+        const fs::path file = write(text);
+        try {
+            load_scene_file(file);
+            ADD_FAILURE() << "no error; expected " << pointer << ": " << phrase;
+        } catch (const SceneError& e) {
+            const std::string what = e.what();
+            EXPECT_EQ(e.file(), file.string());
+            EXPECT_EQ(e.json_path(), pointer) << what;
+            EXPECT_NE(what.find(file.string()), std::string::npos) << what;
+            if (!pointer.empty()) {
+                EXPECT_NE(what.find(": " + pointer + ": "), std::string::npos) << what;
+            }
+            EXPECT_NE(e.message().find(phrase), std::string::npos) << what;
+            EXPECT_NE(what.find(phrase), std::string::npos) << what;
+        }
+    }
+
+    LoadedScene load_ok(const std::string& text) { return load_scene_file(write(text)); }
+
+    fs::path dir_;
+    int count_ = 0;
+};
+
+TEST_F(LoadErrors, BaseSceneIsValid) {
+    const LoadedScene loaded = load_ok(kBaseScene);
+    EXPECT_TRUE(loaded.warnings.empty());
+    EXPECT_EQ(loaded.scene.primitives.size(), 4u);
+    EXPECT_DOUBLE_EQ(loaded.scene.cameras[0].distance, 5);  // optional, defaults to 5
+    EXPECT_EQ(loaded.scene.output_path(), (dir_ / "out.ppm").lexically_normal());
+}
+
+TEST_F(LoadErrors, MissingFile) {
+    const fs::path file = dir_ / "nope.json";
+    try {
+        load_scene_file(file);
+        ADD_FAILURE() << "no error for a missing file";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(e.json_path(), "");
+        EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos);
+        EXPECT_NE(e.message().find("cannot open scene file"), std::string::npos) << e.what();
+        EXPECT_NE(e.message().find("No such file"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(LoadErrors, DirectoryIsNotAFile) {
+    try {
+        load_scene_file(dir_);
+        ADD_FAILURE() << "no error for a directory";
+    } catch (const SceneError& e) {
+        EXPECT_NE(e.message().find("cannot"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(LoadErrors, MalformedJsonNamesLineAndColumn) {
+    expect_error("{\n  \"cameras\": [\n    ,\n  ]\n}", "", "malformed JSON at line 3, column 5");
+    expect_error("", "", "malformed JSON at line 1");
+}
+
+TEST_F(LoadErrors, DuplicateKey) {
+    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("rho": [0.9, 0, 0], "rho": [1, 1, 1]})"),
+                 "/materials/0/rho", "duplicate key \"rho\"");
+}
+
+TEST_F(LoadErrors, NestingTooDeep) {
+    const std::string deep = std::string(100, '[') + std::string(100, ']');
+    expect_error(deep, "", "nesting deeper than 64");
+    // Brackets inside strings do not count.
+    std::string text = kBaseScene;
+    text = edit(text, R"("output": "out.ppm")", R"("output": ")" + std::string(100, '[') + R"(.ppm")");
+    EXPECT_NO_THROW(load_ok(text));
+}
+
+TEST_F(LoadErrors, InfiniteNumber) {
+    expect_error(edit(kBaseScene, R"("radius": 1})", R"("radius": 1e999})"), "/shapes/0/radius",
+                 "not a finite number");
+    expect_error(edit(kBaseScene, R"("position": [0, 4, 0])", R"("position": [0, -1e400, 0])"),
+                 "/lights/1/position/1", "1e400");
+}
+
+TEST_F(LoadErrors, MissingField) {
+    expect_error(edit(kBaseScene, R"(, "radius": 1})", "}"), "/shapes/0", "missing key \"radius\"");
+    expect_error(edit(kBaseScene, R"("lights": ["lamp"],)", ""), "/scene", "missing key \"lights\"");
+}
+
+TEST_F(LoadErrors, StringForANumber) {
+    expect_error(edit(kBaseScene, R"("fov": 45)", R"("fov": "45")"), "/cameras/0/fov",
+                 "expected a number, got string \"45\"");
+}
+
+TEST_F(LoadErrors, NotAVec3) {
+    expect_error(edit(kBaseScene, R"("target": [0, 0, 0])", R"("target": [0, 0])"), "/cameras/0/target",
+                 "expected an array of 3 finite numbers, got an array of 2 elements");
+}
+
+TEST_F(LoadErrors, UnknownMaterialTypeListsTheValidOnes) {
+    expect_error(edit(kBaseScene, R"("type": "diffuse", "rho": [0.9, 0, 0])",
+                      R"("type": "plastic", "rho": [0.9, 0, 0])"),
+                 "/materials/0/type",
+                 "unknown material type \"plastic\"; expected \"diffuse\", \"specular reflection\", "
+                 "\"glossy reflection\", \"fresnel dielectric\" or \"translucent dielectric\"");
+}
+
+TEST_F(LoadErrors, UnknownKey) {
+    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("colour": [0.9, 0, 0]})"),
+                 "/materials/0/colour", "unknown key \"colour\"; expected one of \"id\", \"type\", \"rho\"");
+    expect_error(edit(kBaseScene, R"("cameras": [)", R"("textures": [], "cameras": [)"), "/textures",
+                 "unknown key \"textures\"");
+    // "light" belongs to emissive primitives only.
+    expect_error(edit(kBaseScene, R"("material": "red"},)", R"("material": "red", "light": "lamp"},)"),
+                 "/scene/primitives/0/light", "unknown key \"light\"");
+}
+
+TEST_F(LoadErrors, DanglingMaterialId) {
+    expect_error(edit(kBaseScene, R"("material": "glass")", R"("material": "chalk")"),
+                 "/scene/primitives/1/material",
+                 "no material with id \"chalk\"; expected one of \"red\", \"glass\", \"shiny\", \"spare\"");
+}
+
+TEST_F(LoadErrors, DanglingCameraLightAndShapeIds) {
+    expect_error(edit(kBaseScene, R"("camera": "cam")", R"("camera": "eye")"), "/scene/camera",
+                 "no camera with id \"eye\"; expected one of \"cam\"");
+    expect_error(edit(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "sun"])"), "/scene/lights/1",
+                 "no light with id \"sun\"");
+    expect_error(edit(kBaseScene, R"("shape": "lamp", "power")", R"("shape": "moon", "power")"),
+                 "/lights/0/shape", "no shape with id \"moon\"");
+}
+
+TEST_F(LoadErrors, LightListedTwice) {
+    expect_error(edit(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "lamp"])"),
+                 "/scene/lights/1", "already listed at /scene/lights/0");
+}
+
+TEST_F(LoadErrors, EmissivePrimitiveNeedsAnAreaLight) {
+    expect_error(edit(kBaseScene, R"("light": "lamp")", R"("light": "bulb")"), "/scene/primitives/3/light",
+                 "expects an \"area\" light");
+}
+
+TEST_F(LoadErrors, NegativeRadius) {
+    expect_error(edit(kBaseScene, R"("radius": 1})", R"("radius": -1})"), "/shapes/0/radius",
+                 "expected a radius > 0, got -1");
+}
+
+TEST_F(LoadErrors, EtaNotPositive) {
+    expect_error(edit(kBaseScene, R"("eta": 1.5)", R"("eta": 0)"), "/materials/1/eta",
+                 "expected a refractive index eta > 0, got 0");
+}
+
+TEST_F(LoadErrors, RoughnessOne) {
+    expect_error(edit(kBaseScene, R"("roughness": 0.2)", R"("roughness": 1)"), "/materials/2/roughness",
+                 "expected a roughness in [0, 1), got 1");
+}
+
+TEST_F(LoadErrors, NegativeReflectance) {
+    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [0.9, -0.5, 0])"), "/materials/0/rho/1",
+                 "expected a value >= 0, got -0.5");
+}
+
+TEST_F(LoadErrors, ZeroDimension) {
+    expect_error(edit(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [0, 48])"),
+                 "/scene/renderer/dimensions/0", "expected an integer in [1, 32768], got 0");
+    expect_error(edit(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [64, 40000])"),
+                 "/scene/renderer/dimensions/1", "expected an integer in [1, 32768], got 40000");
+}
+
+TEST_F(LoadErrors, ZeroSamples) {
+    expect_error(edit(kBaseScene, R"("samples": 4)", R"("samples": 0)"), "/scene/renderer/samples",
+                 "expected an integer in [1, 16777216], got 0");
+    expect_error(edit(kBaseScene, R"("samples": 4)", R"("samples": 2.5)"), "/scene/renderer/samples",
+                 "got number 2.5");
+}
+
+TEST_F(LoadErrors, UnknownRendererType) {
+    expect_error(edit(kBaseScene, R"("type": "PT")", R"("type": "MLT")"), "/scene/renderer/type",
+                 "unknown renderer type \"MLT\"; expected \"WRT\" or \"PT\"");
+}
+
+TEST_F(LoadErrors, PositionEqualsTarget) {
+    expect_error(edit(kBaseScene, R"("position": [0, 0, -10])", R"("position": [0, 0, 0])"), "/cameras/0",
+                 "camera position equals target");
+}
+
+TEST_F(LoadErrors, DuplicateIdInACategory) {
+    expect_error(edit(kBaseScene, R"("id": "spare")", R"("id": "glass")"), "/materials/3/id",
+                 "duplicate material id \"glass\": also the id of /materials/1");
+}
+
+TEST_F(LoadErrors, TopLevelMustBeAnObjectWithAScene) {
+    expect_error("[1, 2]", "", "expected a JSON object at the top level, got an array of 2 elements");
+    expect_error(R"({"cameras": []})", "", "missing key \"scene\"");
+}
+
+TEST_F(LoadErrors, DepthAboveTwentyIsClampedWithAWarning) {
+    const LoadedScene loaded = load_ok(edit(kBaseScene, R"("depth": 6)", R"("depth": 25)"));
+    EXPECT_EQ(loaded.scene.renderer.depth, kMaxDepth);
+    ASSERT_EQ(loaded.warnings.size(), 1u);
+    EXPECT_NE(loaded.warnings[0].find("/scene/renderer/depth"), std::string::npos) << loaded.warnings[0];
+    EXPECT_NE(loaded.warnings[0].find("clamped to 20"), std::string::npos) << loaded.warnings[0];
+}
+
+TEST_F(LoadErrors, OutOfRangeInUnreferencedObjectsIsOnlyAWarning) {
+    std::string text = edit(kBaseScene, R"("rho": [0.5, 0.5, 0.5])", R"("rho": [-1, 0.5, 0.5])");
+    text = edit(text, R"("power": [100, 100, 100])", R"("power": [100, -2, 100])");
+    const LoadedScene loaded = load_ok(text);
+    ASSERT_EQ(loaded.warnings.size(), 2u);
+    EXPECT_NE(loaded.warnings[0].find(": /materials/3/rho/0: expected a value >= 0, got -1"), std::string::npos)
+        << loaded.warnings[0];
+    EXPECT_NE(loaded.warnings[1].find(": /lights/1/power/1: "), std::string::npos) << loaded.warnings[1];
+    // Used by a primitive, the same value is an error.
+    expect_error(edit(text, R"("material": "glass")", R"("material": "spare")"), "/materials/3/rho/0",
+                 "expected a value >= 0, got -1");
+}
+
+TEST_F(LoadErrors, ReflectanceAboveOneIsAWarning) {
+    const LoadedScene loaded = load_ok(edit(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [1.2, 0, 0])"));
+    ASSERT_EQ(loaded.warnings.size(), 1u);
+    EXPECT_NE(loaded.warnings[0].find("/materials/0/rho/0: "), std::string::npos) << loaded.warnings[0];
+    EXPECT_NE(loaded.warnings[0].find("not energy conserving"), std::string::npos) << loaded.warnings[0];
+}
+
+TEST_F(LoadErrors, TranslucentDielectricLoads) {
+    const LoadedScene loaded =
+        load_ok(edit(kBaseScene, R"("type": "fresnel dielectric", "rhoR": [1, 1, 1], "rhoT": [1, 1, 1], "eta": 1.5})",
+                     R"("type": "translucent dielectric", "rhoR": [1, 1, 1], "rhoT": [0.8, 0.8, 0.8], "eta": 1.33, "roughness": 0.3})"));
+    const Material& m = loaded.scene.materials[1];
+    EXPECT_EQ(m.type, MaterialType::translucent);
+    EXPECT_DOUBLE_EQ(m.eta, 1.33);
+    EXPECT_DOUBLE_EQ(m.roughness, 0.3);
+    EXPECT_EQ(m.rho_t, Color(0.8));
+    // Its roughness is required and range checked like a glossy one.
+    expect_error(edit(kBaseScene, R"("type": "fresnel dielectric")", R"("type": "translucent dielectric")"),
+                 "/materials/1", "missing key \"roughness\"");
+}
+
+TEST_F(LoadErrors, LensCameraNeedsFocalDistanceAndAlpha) {
+    expect_error(edit(kBaseScene, R"("type": "pinhole")", R"("type": "lens-based")"), "/cameras/0",
+                 "missing key \"focal distance\"");
+    expect_error(edit(kBaseScene, R"("type": "pinhole")",
+                      R"("type": "lens-based", "focal distance": -3, "alpha": 0.5)"),
+                 "/cameras/0/focal distance", "expected a focal distance > 0, got -3");
+}
+
+TEST(ParseScene, FromTextUsesTheNameInMessages) {
+    try {
+        parse_scene("{}", "virtual/scene.json");
+        ADD_FAILURE() << "no error";
+    } catch (const SceneError& e) {
+        EXPECT_EQ(std::string(e.what()), "virtual/scene.json: missing key \"scene\"; expected the scene block (an object)");
+    }
+}
+
+}  // namespace
+}  // namespace kr
