@@ -1,0 +1,97 @@
+// Shared helpers for the test suite.
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "render/render_scene.h"
+#include "scene/load.h"
+#include "scene/scene.h"
+
+namespace kr::test {
+
+// Upper critical value of the chi-square distribution with `dof` degrees of freedom at
+// significance `alpha` (Wilson-Hilferty; accurate to a few percent for dof >= 10).
+inline double chi_square_critical(int dof, double z_alpha = 3.719 /* alpha = 1e-4 */) {
+    const double k = dof;
+    const double a = 2.0 / (9.0 * k);
+    return k * std::pow(1.0 - a + z_alpha * std::sqrt(a), 3.0);
+}
+
+// Pearson's statistic of observed counts against expected counts (cells with tiny
+// expectations merged by the caller).
+inline double chi_square(const std::vector<double>& observed, const std::vector<double>& expected) {
+    double stat = 0;
+    for (size_t i = 0; i < observed.size(); ++i) {
+        const double d = observed[i] - expected[i];
+        stat += d * d / expected[i];
+    }
+    return stat;
+}
+
+// Minimal scene builder for analytic tests. Everything it adds is referenced.
+struct SceneBuilder {
+    Scene scene;
+
+    SceneBuilder() {
+        Camera cam;
+        cam.id = "cam";
+        cam.position = {0, 0, -10};
+        cam.target = {0, 0, 0};
+        scene.cameras.push_back(cam);
+        scene.camera = 0;
+        scene.renderer.width = 8;
+        scene.renderer.height = 8;
+        scene.renderer.samples = 16;
+        scene.renderer.depth = 6;
+        scene.renderer.output = "out.ppm";
+    }
+    int material(MaterialType type, Color rho = Color(0.8)) {
+        Material m;
+        m.id = "m" + std::to_string(scene.materials.size());
+        m.type = type;
+        m.rho = rho;
+        scene.materials.push_back(m);
+        return int(scene.materials.size()) - 1;
+    }
+    int sphere(Vec3 centre, double radius, int material) {
+        Shape s;
+        s.id = "s" + std::to_string(scene.shapes.size());
+        s.centre = centre;
+        s.radius = radius;
+        scene.shapes.push_back(s);
+        Primitive p;
+        p.id = s.id;
+        p.shape = int(scene.shapes.size()) - 1;
+        p.material = material;
+        scene.primitives.push_back(p);
+        return p.shape;
+    }
+    // An emissive sphere with its area light, active.
+    int emitter(Vec3 centre, double radius, Color radiance, int material) {
+        const int shape = sphere(centre, radius, material);
+        Light l;
+        l.id = "l" + std::to_string(scene.lights.size());
+        l.type = LightType::area;
+        l.shape = shape;
+        l.power = radiance;
+        scene.lights.push_back(l);
+        scene.active_lights.push_back(int(scene.lights.size()) - 1);
+        scene.primitives.back().type = PrimitiveType::emissive;
+        scene.primitives.back().light = int(scene.lights.size()) - 1;
+        return shape;
+    }
+    void point_light(Vec3 position, Color intensity) {
+        Light l;
+        l.id = "l" + std::to_string(scene.lights.size());
+        l.type = LightType::point;
+        l.position = position;
+        l.power = intensity;
+        scene.lights.push_back(l);
+        scene.active_lights.push_back(int(scene.lights.size()) - 1);
+    }
+    RenderScene build() const { return prepare_scene(scene); }
+};
+
+}  // namespace kr::test
