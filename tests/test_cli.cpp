@@ -1,0 +1,168 @@
+// The keithray command line: flags, exit codes, outputs, and error messages.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/image.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+    int status;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+class Cli : public testing::Test {
+protected:
+    fs::path dir;
+
+    void SetUp() override {
+        dir = fs::temp_directory_path() /
+              ("keithray_cli_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+               std::to_string(::getpid()));
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    void TearDown() override { fs::remove_all(dir); }
+
+    CliRun run(const std::string& args) {
+        const std::string cmd = std::string("'") + KEITHRAY_EXE + "' " + args + " >'" + (dir / "stdout").string() +
+                                "' 2>'" + (dir / "stderr").string() + "'";
+        const int raw = std::system(cmd.c_str());
+        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir / "stdout"), slurp(dir / "stderr")};
+    }
+
+    // A small valid scene: a diffuse ball under a point light, 16x12 pixels.
+    fs::path write_scene(const std::string& name, const std::string& material_type = "diffuse",
+                         int depth = 4, const std::string& output = "out/render.ppm") {
+        const fs::path file = dir / name;
+        std::ofstream(file) << R"({
+  "cameras": [{"id": "cam", "type": "pinhole", "fov": 45, "aspect": 1.333, "position": [0, 0, -5], "target": [0, 0, 0]}],
+  "materials": [{"id": "white", "type": ")" << material_type << R"(", "rho": [0.8, 0.8, 0.8]}],
+  "shapes": [{"id": "ball", "type": "sphere", "centre": [0, 0, 0], "radius": 1}],
+  "lights": [{"id": "lamp", "type": "point", "position": [0, 3, -3], "power": [50, 50, 50]}],
+  "scene": {
+    "camera": "cam", "lights": ["lamp"],
+    "primitives": [{"id": "ball", "type": "geometric", "shape": "ball", "material": "white"}],
+    "renderer": {"type": "WRT", "dimensions": [16, 12], "samples": 2, "depth": )"
+                          << depth << R"(, "output": ")" << output << R"("}
+  }
+})";
+        return file;
+    }
+};
+
+}  // namespace
+
+TEST_F(Cli, HelpDocumentsEveryFlag) {
+    const CliRun r = run("--help");
+    EXPECT_EQ(r.status, 0);
+    for (const char* flag : {"render", "--spp", "--integrator", "wrt", "pt-naive", "--estimator", "uniform",
+                             "stratified", "--tonemap", "sigmoid", "linear", "--blur", "--seed", "--threads", "-o",
+                             "--light-sampling", "--depth"})
+        EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+TEST_F(Cli, RendersImageAndDepthBesideIt) {
+    const fs::path scene = write_scene("ok.json");
+    const CliRun r = run("render '" + scene.string() + "' --spp 3 -o '" + (dir / "x.ppm").string() + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const kr::Rgb8Image img = kr::read_ppm(dir / "x.ppm");
+    EXPECT_EQ(img.width, 16);
+    EXPECT_EQ(img.height, 12);
+    const kr::Rgb8Image depth = kr::read_ppm(dir / "x-depth.ppm");
+    EXPECT_EQ(depth.width, 16);
+    // The summary line: spp, seconds and Mrays/s.
+    EXPECT_NE(r.out.find("3 spp"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("Mrays/s"), std::string::npos) << r.out;
+    // The ball is lit: the centre pixel is not black; the corner (a miss) is.
+    EXPECT_GT(img.bytes[(6 * 16 + 8) * 3], 0);
+    EXPECT_EQ(img.bytes[0], 0);
+    // No temporary files are left behind.
+    for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
+}
+
+TEST_F(Cli, OutputIsRelativeToTheSceneFolder) {
+    const fs::path scene = write_scene("rel.json");
+    const CliRun r = run("render '" + scene.string() + "' -q");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "out" / "render.ppm"));
+    EXPECT_TRUE(fs::exists(dir / "out" / "render-depth.ppm"));
+}
+
+TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
+    const fs::path scene = write_scene("seed.json");
+    const std::string base = "render '" + scene.string() + "' --integrator pt --spp 4 --threads ";
+    ASSERT_EQ(run(base + "1 -o '" + (dir / "a.ppm").string() + "'").status, 0);
+    ASSERT_EQ(run(base + "2 -o '" + (dir / "b.ppm").string() + "'").status, 0);
+    ASSERT_EQ(run(base + "2 --seed 7 -o '" + (dir / "c.ppm").string() + "'").status, 0);
+    EXPECT_EQ(slurp(dir / "a.ppm"), slurp(dir / "b.ppm"));
+    EXPECT_NE(slurp(dir / "a.ppm"), slurp(dir / "c.ppm"));
+    const CliRun linear = run(base + "2 --tonemap linear --blur 1 --estimator uniform -o '" + (dir / "d.ppm").string() + "'");
+    EXPECT_EQ(linear.status, 0) << linear.err;
+    // Linear tone mapping scales the brightest channel to 255.
+    const kr::Rgb8Image d = kr::read_ppm(dir / "d.ppm");
+    EXPECT_EQ(*std::max_element(d.bytes.begin(), d.bytes.end()), 255);
+}
+
+TEST_F(Cli, BadSceneGivesOneMessageAndNoOutput) {
+    const fs::path scene = write_scene("bad.json", "plastic");
+    const CliRun r = run("render '" + scene.string() + "' -o '" + (dir / "x.ppm").string() + "'");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("/materials/0/type"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"specular reflection\""), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+    EXPECT_FALSE(fs::exists(dir / "x-depth.ppm"));
+    EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+TEST_F(Cli, MissingFileAndBadFlags) {
+    CliRun r = run("render '" + (dir / "nope.json").string() + "'");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("nope.json"), std::string::npos);
+    EXPECT_NE(r.err.find("cannot open"), std::string::npos);
+    r = run("render --spp 0");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--spp"), std::string::npos);
+    r = run("render --integrator magic");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("\"pt-naive\""), std::string::npos);
+    r = run("render --frobnicate");
+    EXPECT_EQ(r.status, 2);
+    r = run("paint");
+    EXPECT_EQ(r.status, 2);
+}
+
+TEST_F(Cli, DepthAbove20IsClampedWithAWarning) {
+    const fs::path scene = write_scene("deep.json", "diffuse", 25);
+    const CliRun r = run("render '" + scene.string() + "' -q");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("clamped to 20"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, NeverOverwritesTheSceneFile) {
+    const fs::path scene = write_scene("self.json");
+    const std::string before = slurp(scene);
+    const CliRun r = run("render '" + scene.string() + "' -o '" + scene.string() + "'");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_NE(r.err.find("overwrite"), std::string::npos) << r.err;
+    EXPECT_EQ(slurp(scene), before);
+}

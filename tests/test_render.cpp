@@ -1,0 +1,249 @@
+// Analytic scenes: furnaces and direct lighting with known answers, for every integrator.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <omp.h>
+
+#include "render/render.h"
+#include "test_util.h"
+
+using namespace kr;
+
+namespace {
+
+struct Estimate {
+    Color mean;
+    double stderr_lum = 0;  // standard error of the luminance mean
+};
+
+// Mean radiance of n independent samples along one ray.
+Estimate estimate(const RenderScene& scene, const RenderSettings& settings, const Ray& ray, int n) {
+    Color sum;
+    double sum_l = 0, sum_l2 = 0;
+    for (int i = 0; i < n; ++i) {
+        Rng rng = Rng::for_sample(settings.seed, 0, uint64_t(i));
+        const SampleResult r = trace_sample(scene, settings, ray, rng);
+        sum += r.radiance;
+        const double l = luminance(r.radiance);
+        sum_l += l;
+        sum_l2 += l * l;
+    }
+    const double mean_l = sum_l / n;
+    return {sum / double(n), std::sqrt(std::max(0.0, sum_l2 / n - mean_l * mean_l) / n)};
+}
+
+Ray ray_towards(Vec3 from, Vec3 to) {
+    Ray r;
+    r.o = from;
+    r.d = normalize(to - from);
+    return r;
+}
+
+RenderSettings settings_for(Integrator integrator, LightSampling ls = LightSampling::cone, int depth = 6) {
+    RenderSettings s;
+    s.integrator = integrator;
+    s.light_sampling = ls;
+    s.max_depth = depth;
+    return s;
+}
+
+// A sphere of material `m` inside a black emitting sphere of radiance Le.
+test::SceneBuilder furnace(MaterialType type, Color rho, double le) {
+    test::SceneBuilder b;
+    const int m = b.material(type, rho);
+    b.scene.materials[m].rho_r = rho;
+    b.scene.materials[m].rho_t = rho;
+    b.sphere({0, 0, 0}, 1, m);
+    b.emitter({0, 0, 0}, 20, Color(le), b.material(MaterialType::diffuse, Color(0)));
+    return b;
+}
+
+}  // namespace
+
+// The brief's furnace: a diffuse sphere of albedo rho inside an emitter of radiance Le shows
+// rho * Le, whichever integrator or light sampling strategy renders it.
+TEST(Furnace, DiffuseSphereShowsRhoTimesLe) {
+    const Color rho(0.2, 0.5, 0.8);
+    const RenderScene scene = furnace(MaterialType::diffuse, rho, 2.0).build();
+    const Ray ray = ray_towards({0, 0, -5}, {0.3, 0.2, 0});
+    for (Integrator integrator : {Integrator::pt, Integrator::pt_naive, Integrator::wrt})
+        for (LightSampling ls : {LightSampling::cone, LightSampling::area}) {
+            const Estimate e = estimate(scene, settings_for(integrator, ls), ray, 20000);
+            const Color expected = rho * 2.0;
+            for (int k = 0; k < 3; ++k)
+                EXPECT_NEAR(e.mean[k], expected[k], 5 * e.stderr_lum + 1e-3)
+                    << integrator_names.name(integrator) << " " << light_sampling_names.name(ls) << " channel " << k;
+        }
+}
+
+// A wrong convention (BRDF rho instead of rho/pi, or missing the emission) fails this test:
+// check it is sensitive by also requiring the camera-facing emitter to show exactly Le.
+TEST(Furnace, EmitterSeenDirectlyShowsLe) {
+    const RenderScene scene = furnace(MaterialType::diffuse, Color(0.5), 3.0).build();
+    const Ray ray = ray_towards({0, 0, -5}, {0, 10, -5});  // misses the inner sphere
+    for (Integrator integrator : {Integrator::pt, Integrator::pt_naive, Integrator::wrt}) {
+        const Estimate e = estimate(scene, settings_for(integrator), ray, 100);
+        EXPECT_NEAR(e.mean.x, 3.0, 1e-12);
+    }
+}
+
+// Mirrors and clear glass with rho = 1 lose nothing: in the furnace they show Le exactly
+// (glass: up to the energy still inside the sphere when the depth cap cuts the path).
+TEST(Furnace, SpecularAndGlassConserveEnergy) {
+    const Ray ray = ray_towards({0, 0, -5}, {0.4, -0.3, 0});
+    {
+        const RenderScene scene = furnace(MaterialType::specular, Color(0.9), 1.0).build();
+        for (Integrator integrator : {Integrator::pt, Integrator::wrt})
+            EXPECT_NEAR(estimate(scene, settings_for(integrator), ray, 100).mean.x, 0.9, 1e-12);
+    }
+    {
+        const RenderScene scene = furnace(MaterialType::dielectric, Color(1.0), 1.0).build();
+        EXPECT_NEAR(estimate(scene, settings_for(Integrator::wrt, LightSampling::cone, 20), ray, 1).mean.x, 1.0, 1e-6);
+        const Estimate e = estimate(scene, settings_for(Integrator::pt, LightSampling::cone, 20), ray, 20000);
+        EXPECT_NEAR(e.mean.x, 1.0, 1e-6);  // every path escapes with weight exactly 1
+    }
+    {
+        // rhoR/rhoT scale the two Fresnel branches: 0.5 everywhere halves each escape
+        // after 2 events (in, out) at least; the value stays within (0, 0.5].
+        const RenderScene scene = furnace(MaterialType::dielectric, Color(0.5), 1.0).build();
+        const double v = estimate(scene, settings_for(Integrator::wrt, LightSampling::cone, 20), ray, 1).mean.x;
+        EXPECT_GT(v, 0.25 - 1e-9);
+        EXPECT_LE(v, 0.5);
+    }
+}
+
+// Roughness 0 reduces the glossy and translucent materials to the mirror and clear glass.
+TEST(Furnace, ZeroRoughnessEqualsDeltaMaterials) {
+    const Ray ray = ray_towards({0, 0, -5}, {0.4, -0.3, 0});
+    for (Integrator integrator : {Integrator::pt, Integrator::wrt}) {
+        test::SceneBuilder glossy = furnace(MaterialType::glossy, Color(0.7), 1.0);
+        glossy.scene.materials[0].roughness = 0;
+        EXPECT_NEAR(estimate(glossy.build(), settings_for(integrator), ray, 50).mean.x, 0.7, 1e-12);
+        test::SceneBuilder translucent = furnace(MaterialType::translucent, Color(1.0), 1.0);
+        translucent.scene.materials[0].roughness = 0;
+        EXPECT_NEAR(estimate(translucent.build(), settings_for(integrator, LightSampling::cone, 20), ray, 2000).mean.x,
+                    1.0, 1e-6);
+    }
+}
+
+// Direct light from a sphere light of radiance Le and radius r at distance d from a diffuse
+// point whose normal makes angle theta with the light: L = rho Le (r/d)^2 cos(theta),
+// the irradiance pi Le sin^2(theta_max) cos(theta) times rho/pi.
+TEST(DirectLighting, SphereLightOnDiffuseFloor) {
+    test::SceneBuilder b;
+    const double rho = 0.5, le = 4.0, r = 0.5;
+    b.sphere({0, -1e4, 0}, 1e4, b.material(MaterialType::diffuse, Color(rho)));  // floor y = 0
+    const Vec3 light_centre{0, 3, 0};
+    b.emitter(light_centre, r, Color(le), b.material(MaterialType::diffuse, Color(0)));
+    const RenderScene scene = b.build();
+    const Vec3 x{2, 0, 1};
+    const Ray ray = ray_towards({2, 5, -4}, x);
+    Hit hit;
+    ASSERT_TRUE(scene.intersects(ray, hit));
+    ASSERT_EQ(hit.sphere, 0);
+    const Vec3 to_light = light_centre - hit.p;
+    const double d = length(to_light);
+    const double expected = rho * le * (r / d) * (r / d) * dot(hit.n, to_light / d);
+    for (Integrator integrator : {Integrator::pt, Integrator::pt_naive, Integrator::wrt})
+        for (LightSampling ls : {LightSampling::cone, LightSampling::area}) {
+            const int n = integrator == Integrator::pt_naive ? 400000 : 40000;
+            const Estimate e = estimate(scene, settings_for(integrator, ls), ray, n);
+            EXPECT_NEAR(e.mean.x, expected, 5 * e.stderr_lum + 1e-4 * expected)
+                << integrator_names.name(integrator) << " " << light_sampling_names.name(ls);
+        }
+}
+
+// A point light's power is its radiant intensity: E = I cos / d^2, L = rho/pi E.
+TEST(DirectLighting, PointLightIntensityConvention) {
+    test::SceneBuilder b;
+    const double rho = 0.8;
+    b.sphere({0, -1e4, 0}, 1e4, b.material(MaterialType::diffuse, Color(rho)));
+    const Vec3 light{1, 4, 2};
+    b.point_light(light, Color(300));
+    const RenderScene scene = b.build();
+    const Ray ray = ray_towards({0, 3, -6}, {0, 0, 0});
+    Hit hit;
+    ASSERT_TRUE(scene.intersects(ray, hit));
+    const Vec3 to_light = light - hit.p;
+    const double d2 = dot(to_light, to_light);
+    const double expected = rho / kPi * 300 * dot(hit.n, to_light / std::sqrt(d2)) / d2;
+    for (Integrator integrator : {Integrator::wrt, Integrator::pt, Integrator::pt_naive})
+        EXPECT_NEAR(estimate(scene, settings_for(integrator), ray, 1).mean.x, expected, 1e-9 * expected);
+}
+
+TEST(DirectLighting, OccluderCastsShadow) {
+    test::SceneBuilder b;
+    b.sphere({0, -1e4, 0}, 1e4, b.material(MaterialType::diffuse));
+    b.sphere({0, 2, 0}, 0.5, b.material(MaterialType::diffuse));
+    b.point_light({0, 4, 0}, Color(100));
+    const RenderScene scene = b.build();
+    const Ray ray = ray_towards({0, 3, -6}, {0, 0, 0});
+    EXPECT_EQ(estimate(scene, settings_for(Integrator::wrt), ray, 1).mean.x, 0.0);
+}
+
+// Depth 0 shows emitters only; each extra depth adds a bounce.
+TEST(Depth, CapCountsScatteringEvents) {
+    const RenderScene scene = furnace(MaterialType::specular, Color(0.5), 1.0).build();
+    const Ray ray = ray_towards({0, 0, -5}, {0, 0, 0});
+    // Mirror in a furnace: depth 0 -> black sphere, depth >= 1 -> 0.5.
+    EXPECT_EQ(estimate(scene, settings_for(Integrator::pt, LightSampling::cone, 0), ray, 1).mean.x, 0.0);
+    EXPECT_EQ(estimate(scene, settings_for(Integrator::wrt, LightSampling::cone, 0), ray, 1).mean.x, 0.0);
+    EXPECT_NEAR(estimate(scene, settings_for(Integrator::pt, LightSampling::cone, 1), ray, 1).mean.x, 0.5, 1e-12);
+    EXPECT_NEAR(estimate(scene, settings_for(Integrator::wrt, LightSampling::cone, 1), ray, 1).mean.x, 0.5, 1e-12);
+}
+
+// The image is the same whatever the number of threads: per-pixel, per-sample RNG streams.
+TEST(Progressive, ImageIndependentOfThreadCount) {
+    test::SceneBuilder b = furnace(MaterialType::diffuse, Color(0.5), 1.0);
+    b.sphere({0.5, 1.2, -1}, 0.4, b.material(MaterialType::dielectric, Color(0.9)));
+    b.scene.renderer.width = 24;
+    b.scene.renderer.height = 16;
+    const RenderScene scene = b.build();
+    RenderSettings settings = settings_for(Integrator::pt);
+    settings.target_spp = 4;
+    auto render = [&](int threads) {
+        omp_set_num_threads(threads);
+        RenderState state(24, 16);
+        for (int i = 0; i < 4; ++i) render_pass(scene, settings, state);
+        return state;
+    };
+    const RenderState one = render(1), two = render(2), three = render(3);
+    omp_set_num_threads(omp_get_num_procs());
+    for (size_t i = 0; i < one.radiance_sum.size(); ++i) {
+        EXPECT_EQ(one.radiance_sum[i], two.radiance_sum[i]);
+        EXPECT_EQ(one.radiance_sum[i], three.radiance_sum[i]);
+    }
+    EXPECT_EQ(one.rays, two.rays);
+    EXPECT_EQ(one.passes, 4);
+}
+
+// A stop request ends the pass early and leaves a consistent state.
+TEST(Progressive, StopFlagEndsPass) {
+    const RenderScene scene = furnace(MaterialType::diffuse, Color(0.5), 1.0).build();
+    RenderState state(8, 8);
+    std::atomic<bool> stop{true};
+    EXPECT_FALSE(render_pass(scene, settings_for(Integrator::pt), state, &stop));
+    EXPECT_EQ(state.passes, 0);
+    for (uint32_t c : state.sample_count) EXPECT_EQ(c, 0u);
+    stop = false;
+    EXPECT_TRUE(render_pass(scene, settings_for(Integrator::pt), state, &stop));
+    EXPECT_EQ(state.passes, 1);
+    for (uint32_t c : state.sample_count) EXPECT_EQ(c, 1u);
+}
+
+// The depth map records the primary hit distance, and a finite maximum for misses.
+TEST(Progressive, DepthOfPrimaryHit) {
+    test::SceneBuilder b;
+    b.sphere({0, 0, 0}, 1, b.material(MaterialType::diffuse));
+    b.scene.cameras[0].fov = 1;  // the whole image sees the sphere's near point
+    b.scene.renderer.width = b.scene.renderer.height = 2;
+    const RenderScene scene = b.build();
+    RenderState state(2, 2);
+    render_pass(scene, settings_for(Integrator::pt), state);
+    for (double d : state.mean_depth()) EXPECT_NEAR(d, 9.0, 1e-2);
+    test::SceneBuilder empty;
+    empty.sphere({0, 100, 0}, 1, empty.material(MaterialType::diffuse));
+    RenderState miss(2, 2);
+    render_pass(empty.build(), settings_for(Integrator::pt), miss);
+    for (double d : miss.mean_depth()) EXPECT_EQ(d, kMissDepth);
+}
