@@ -67,7 +67,7 @@ TEST(Furnace, DiffuseSphereShowsRhoTimesLe) {
     const RenderScene scene = furnace(MaterialType::diffuse, rho, 2.0).build();
     const Ray ray = ray_towards({0, 0, -5}, {0.3, 0.2, 0});
     for (Integrator integrator : {Integrator::pt, Integrator::pt_naive, Integrator::wrt})
-        for (LightSampling ls : {LightSampling::cone, LightSampling::area}) {
+        for (LightSampling ls : {LightSampling::brief, LightSampling::cone, LightSampling::area}) {
             const Estimate e = estimate(scene, settings_for(integrator, ls), ray, 20000);
             const Color expected = rho * 2.0;
             for (int k = 0; k < 3; ++k)

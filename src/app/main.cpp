@@ -34,7 +34,9 @@ Options:
   --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
                         pt-naive samples no area light, only point lights)
   --estimator NAME      primary samples: uniform | stratified (default: stratified)
-  --light-sampling NAME spherical lights: cone | area (default: cone)
+  --light-sampling NAME spherical lights: brief | cone | area (default: brief, the
+                        estimator of the brief's reference images; cone and area are
+                        exact, see docs/fidelity.md)
   --depth N             maximum ray depth, 0..20 (default: the file's "depth")
   --tonemap NAME        sigmoid | linear (default: sigmoid)
   --blur R              box blur of radius R pixels on the radiance (default: 0)

@@ -137,7 +137,9 @@ struct Tracer {
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
                 double weight = 1;
-                if (!full_emission && hit.sphere != last_sphere) {
+                if (!full_emission && hit.sphere != last_sphere && !is_exact(settings.light_sampling)) {
+                    weight = 0;  // the brief's estimator already counted this light at the last vertex
+                } else if (!full_emission && hit.sphere != last_sphere) {
                     const double p_light =
                         light.select_prob * sphere_light_pdf(scene.spheres[hit.sphere], last_p, ray.d,
                                                              hit.t, hit.n, settings.light_sampling);
@@ -153,7 +155,8 @@ struct Tracer {
 
             // Next-event estimation: one light, chosen in proportion to its power.
             // Point lights cannot be hit by chance, so even naive mode samples them.
-            if (has_smooth_lobe(m) && scene.light_count() > 0) L += throughput * sample_one_light(m, hit, sp, naive);
+            if (has_smooth_lobe(m) && scene.light_count() > 0)
+                L += throughput * sample_one_light(m, hit, sp, naive);
 
             ScatterSample s;
             if (!sample_material(m, sp, ray.d, rng, s)) break;
@@ -186,7 +189,8 @@ struct Tracer {
             const AreaLight& light = scene.area_lights[i];
             if (u < light.select_prob || i + 1 == scene.area_lights.size())
                 return light.select_prob > 0
-                           ? area_light_direct(light, m, hit, sp, true, light.select_prob)
+                           ? area_light_direct(light, m, hit, sp, is_exact(settings.light_sampling),
+                                               light.select_prob)
                            : Color();
             u -= light.select_prob;
         }

@@ -23,6 +23,20 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
     const double d2 = dot(to_centre, to_centre);
     const double r2 = light.radius * light.radius;
     const bool outside = d2 > r2;
+    if (strategy == LightSampling::brief && outside) {
+        // Uniform on the hemisphere facing p (density 2/A), cosine about its axis.
+        const Vec3 axis = -to_centre / std::sqrt(d2);
+        Vec3 n = sample_uniform_sphere(u1, u2);
+        if (dot(n, axis) < 0) n = -n;
+        const Vec3 w = light.centre + light.radius * n - p;
+        const double dist = length(w);
+        const double cos_axis = dot(n, axis);
+        if (!(dist > 0) || !(cos_axis > 0)) return false;
+        out.wi = w / dist;
+        out.distance = dist;
+        out.pdf = dist * dist / (0.5 * sphere_area(light) * cos_axis);
+        return true;
+    }
     if (strategy == LightSampling::cone && outside) {
         const double one_minus_cos_max = cone_one_minus_cos(r2, d2);
         const double d = std::sqrt(d2);
@@ -56,6 +70,7 @@ double sphere_light_pdf(const SphereGeom& light, const Vec3& p, const Vec3& wi, 
     const double d2 = dot(to_centre, to_centre);
     const double r2 = light.radius * light.radius;
     const bool outside = d2 > r2;
+    if (strategy == LightSampling::brief && outside) return 0;  // never MIS-weighted
     if (strategy == LightSampling::cone && outside) return uniform_cone_pdf(cone_one_minus_cos(r2, d2));
     const double cos_abs = std::abs(dot(n_light, wi));
     if (!(cos_abs > 0)) return 0;

@@ -27,7 +27,7 @@ inline constexpr double kMissDepth = 1e6;
 struct RenderSettings {
     Integrator integrator = Integrator::pt;
     Estimator estimator = Estimator::stratified;
-    LightSampling light_sampling = LightSampling::cone;
+    LightSampling light_sampling = LightSampling::brief;
     int max_depth = 6;          // scattering events per path, 0..kMaxDepth
     int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
     int rr_depth = 3;           // Russian roulette from this many scattering events on
