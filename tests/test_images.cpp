@@ -64,20 +64,22 @@ INSTANTIATE_TEST_SUITE_P(Scenes, WhittedReference, testing::Values(1, 2, 7));
 
 // Path-traced scenes at a few samples per pixel, compared on 8x8 block means (the
 // full-sample comparison is the fidelity benchmark in docs/fidelity.md, too slow for CI).
-class PathTracedReference : public testing::TestWithParam<std::tuple<int, double>> {};
+// Parameters: scene, samples per pixel, minimum block PSNR (scene 5's caustics through glass
+// stay noisy longest, hence more samples and a lower bar).
+class PathTracedReference : public testing::TestWithParam<std::tuple<int, int, double>> {};
 
 TEST_P(PathTracedReference, BlockMeansMatch) {
-    const auto [n, min_db] = GetParam();
-    const Rgb8Image image = render(load(n), 16);
+    const auto [n, spp, min_db] = GetParam();
+    const Rgb8Image image = render(load(n), spp);
     const double db = psnr(block_average(image, 8), block_average(reference(n), 8));
     RecordProperty("block_psnr_db", std::to_string(db));
     EXPECT_GE(db, min_db) << "scene " << n;
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, PathTracedReference,
-                         testing::Values(std::make_tuple(3, 30.0), std::make_tuple(4, 30.0),
-                                         std::make_tuple(5, 30.0), std::make_tuple(6, 30.0),
-                                         std::make_tuple(8, 30.0)));
+                         testing::Values(std::make_tuple(3, 16, 30.0), std::make_tuple(4, 16, 30.0),
+                                         std::make_tuple(5, 32, 26.0), std::make_tuple(6, 16, 30.0),
+                                         std::make_tuple(8, 16, 30.0)));
 
 // The same tests fail under a wrong convention: a point light's power taken as flux
 // (I = P / 4 pi) or a Lambertian BRDF of rho instead of rho / pi (light x pi).
