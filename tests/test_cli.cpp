@@ -76,7 +76,7 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
     EXPECT_EQ(r.status, 0);
     for (const char* flag : {"render", "--spp", "--integrator", "wrt", "pt-naive", "--estimator", "uniform",
                              "stratified", "--tonemap", "sigmoid", "linear", "--blur", "--seed", "--threads", "-o",
-                             "--light-sampling", "--depth"})
+                             "--light-sampling", "--depth", "psnr"})
         EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 

@@ -24,6 +24,7 @@ constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere 
 
 Usage:
   keithray render [SCENE.json ...] [options]
+  keithray psnr IMAGE.ppm REFERENCE.ppm     PSNR in dB of two 8-bit PPMs
   keithray --help
 
 With no SCENE, renders every *.json in res/scenes/. Defaults come from each scene
@@ -237,6 +238,19 @@ int main(int argc, char** argv) {
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(kUsage, stdout);
         return 0;
+    }
+    if (command == "psnr") {
+        if (argc != 4) {
+            std::fprintf(stderr, "error: psnr needs two PPM files\n");
+            return 2;
+        }
+        try {
+            std::printf("%.2f\n", psnr(read_ppm(argv[2]), read_ppm(argv[3])));
+            return 0;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
+            return 1;
+        }
     }
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
