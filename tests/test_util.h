@@ -72,24 +72,27 @@ struct SceneBuilder {
     int emitter(Vec3 centre, double radius, Color radiance, int material) {
         const int shape = sphere(centre, radius, material);
         Light l;
-        l.id = "l" + std::to_string(scene.lights.size());
         l.type = LightType::area;
         l.shape = shape;
         l.power = radiance;
-        scene.lights.push_back(l);
-        scene.active_lights.push_back(int(scene.lights.size()) - 1);
         scene.primitives.back().type = PrimitiveType::emissive;
-        scene.primitives.back().light = int(scene.lights.size()) - 1;
+        scene.primitives.back().light = active_light(l);
         return shape;
     }
     void point_light(Vec3 position, Color intensity) {
         Light l;
-        l.id = "l" + std::to_string(scene.lights.size());
         l.type = LightType::point;
         l.position = position;
         l.power = intensity;
+        active_light(l);
+    }
+    // Adds a light, lists it in the scene block, returns its index.
+    int active_light(Light l) {
+        l.id = "l" + std::to_string(scene.lights.size());
         scene.lights.push_back(l);
-        scene.active_lights.push_back(int(scene.lights.size()) - 1);
+        const int index = int(scene.lights.size()) - 1;
+        scene.active_lights.push_back(index);
+        return index;
     }
     RenderScene build() const { return prepare_scene(scene); }
 };
