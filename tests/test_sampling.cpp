@@ -267,3 +267,16 @@ TEST(Sampling, BriefLightEstimatorBias) {
     EXPECT_GT(near, 1.4);
     EXPECT_LT(near, 1.65);
 }
+
+TEST(Sampling, SinCosTurnsMatchesLibm) {
+    Rng rng(7, 1);
+    double worst = 0;
+    for (int i = 0; i < 200000; ++i) {
+        // Whole turns, their boundaries and values outside [0, 1) (the disk mapping uses -1/8..3/8).
+        const double t = i < 16 ? i / 8.0 - 1.0 : 4.0 * rng.next() - 2.0;
+        double s, c;
+        sin_cos_turns(t, s, c);
+        worst = std::max({worst, std::abs(s - std::sin(2 * kPi * t)), std::abs(c - std::cos(2 * kPi * t))});
+    }
+    EXPECT_LT(worst, 2e-15);
+}

@@ -20,6 +20,7 @@ void RenderState::reset(int w, int h) {
     const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
     radiance_sum.assign(n, Color());
     depth_sum.assign(n, 0.0);
+    luminance_sq_sum.assign(n, 0.0);
     sample_count.assign(n, 0);
     sample_index.assign(n, 0);
     passes = 0;
@@ -39,6 +40,28 @@ std::vector<double> RenderState::mean_depth() const {
     for (size_t i = 0; i < d.size(); ++i)
         if (sample_count[i]) d[i] = depth_sum[i] / double(sample_count[i]);
     return d;
+}
+
+double RenderState::pixel_standard_error(size_t i) const {
+    const double n = sample_count[i];
+    if (n < 2) return kInfinity;
+    const double mean = luminance(radiance_sum[i]) / n;
+    // Unbiased sample variance of one sample, then of the mean of n.
+    const double variance = std::max(0.0, (luminance_sq_sum[i] - n * mean * mean) / (n - 1));
+    return std::sqrt(variance / n);
+}
+
+double RenderState::relative_error() const {
+    double error_sq = 0, signal_sq = 0;
+    for (size_t i = 0; i < sample_count.size(); ++i) {
+        const double se = pixel_standard_error(i);
+        if (!std::isfinite(se)) return kInfinity;
+        error_sq += se * se;
+        const double mean = luminance(radiance_sum[i]) / sample_count[i];
+        signal_sq += mean * mean;
+    }
+    if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
+    return std::sqrt(error_sq / signal_sq);
 }
 
 Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng) {
@@ -82,6 +105,8 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             }
             state.radiance_sum[pixel] += r.radiance;
             state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
+            const double lum = luminance(r.radiance);
+            state.luminance_sq_sum[pixel] += lum * lum;
             state.sample_count[pixel] += 1;
         }
     }

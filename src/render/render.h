@@ -41,6 +41,7 @@ struct RenderState {
     int width = 0, height = 0;
     std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
     std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
+    std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
     std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
     std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
     int passes = 0;                       // completed passes
@@ -52,6 +53,13 @@ struct RenderState {
     void reset(int w, int h);
     Image radiance() const;                  // per-pixel mean radiance
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
+
+    // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
+    // two samples).
+    double pixel_standard_error(size_t i) const;
+    // Estimated relative RMS error of the whole image: sqrt(sum of per-pixel variances of the
+    // mean) / sqrt(sum of squared mean luminances). Infinite before two samples per pixel.
+    double relative_error() const;
 };
 
 // Adds one sample to every pixel of `state` (sample index = the pixel's own count of samples drawn).

@@ -40,7 +40,30 @@ static inline double accepted_root(const RenderScene& scene, int i, const Ray& r
     return kInfinity;
 }
 
+// Fills `hit` for sphere `index` at distance `t` along the ray.
+static void fill_hit(const RenderScene& scene, const Ray& ray, int best_sphere, double best, Hit& hit) {
+    const SphereGeom& s = scene.spheres[best_sphere];
+    hit.t = best;
+    hit.sphere = best_sphere;
+    // Project the hit point back onto the sphere so the next ray starts on its surface.
+    const Vec3 offset = ray.o + best * ray.d - s.centre;
+    const double offset_length = length(offset);
+    hit.n = offset_length > 0 ? offset / offset_length : -ray.d;
+    hit.p = s.centre + hit.n * s.radius;
+}
+
 bool RenderScene::intersects(const Ray& ray, Hit& hit) const {
+    if (linear_scan) return intersects_linear(ray, hit);
+    double t;
+    const int sphere = bvh.closest(ray, t);
+    if (sphere < 0) return false;
+    fill_hit(*this, ray, sphere, t, hit);
+    return true;
+}
+
+bool RenderScene::is_occluded(const Ray& ray) const { return linear_scan ? is_occluded_linear(ray) : bvh.any(ray); }
+
+bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {
     double best = kInfinity;
     int best_sphere = -1;
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i) {
@@ -51,18 +74,11 @@ bool RenderScene::intersects(const Ray& ray, Hit& hit) const {
         }
     }
     if (best_sphere < 0) return false;
-    const SphereGeom& s = spheres[best_sphere];
-    hit.t = best;
-    hit.sphere = best_sphere;
-    // Project the hit point back onto the sphere so the next ray starts on its surface.
-    const Vec3 offset = ray.o + best * ray.d - s.centre;
-    const double offset_length = length(offset);
-    hit.n = offset_length > 0 ? offset / offset_length : -ray.d;
-    hit.p = s.centre + hit.n * s.radius;
+    fill_hit(*this, ray, best_sphere, best, hit);
     return true;
 }
 
-bool RenderScene::is_occluded(const Ray& ray) const {
+bool RenderScene::is_occluded_linear(const Ray& ray) const {
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i)
         if (accepted_root(*this, i, ray) < kInfinity) return true;
     return false;
@@ -162,6 +178,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         else
             rs.area_lights[i - rs.point_lights.size()].select_prob = prob;
     }
+    rs.build_accel();
     return rs;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/math.h"
+#include "render/accel.h"
 #include "render/camera.h"
 #include "scene/scene.h"
 
@@ -64,10 +65,17 @@ struct RenderScene {
     CameraModel camera;
     RendererSettings renderer;  // the file's renderer block
 
+    SphereBvh bvh;  // over `spheres`; built by prepare_scene (call build_accel after edits)
+    bool linear_scan = false;  // test every sphere instead of the BVH (the plain path, for checks)
+
     // Closest hit within [tmin, tmax]. Fills `hit` and returns true if there is one.
     bool intersects(const Ray& ray, Hit& hit) const;
     // Any hit within [tmin, tmax].
     bool is_occluded(const Ray& ray) const;
+    // The same two by testing every sphere in turn: the plain path the BVH is checked against.
+    bool intersects_linear(const Ray& ray, Hit& hit) const;
+    bool is_occluded_linear(const Ray& ray) const;
+    void build_accel() { bvh.build(spheres); }
     size_t light_count() const { return point_lights.size() + area_lights.size(); }
 };
 

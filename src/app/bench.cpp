@@ -1,0 +1,280 @@
+// `keithray bench --throughput`: ray throughput and render time per scene, medians of
+// several runs; `--stress N,...`: cost per ray on generated scenes of N spheres (BVH scaling).
+#include "app/bench.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <omp.h>
+
+#include "render/render.h"
+#include "scene/load.h"
+
+namespace fs = std::filesystem;
+
+namespace kr {
+
+namespace {
+
+constexpr const char* kBenchUsage = R"(Usage:
+  keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear]
+  keithray bench --stress N[,N...] [--runs N] [--threads N] [--size W]
+  keithray bench --write-stress N OUT.json
+
+--throughput  renders each scene (default: every res/scenes/*.json) at F times its own
+              sample count (default F = 1/32, at least 1 spp), --runs times (default 3),
+              and prints the median seconds and Mrays/s (all rays: camera, bounce, shadow),
+              the seconds the file's full sample count takes at that speed, and the median
+              time of one full-resolution 1-spp pass.
+--linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
+--stress      generated scenes of N random spheres under a sphere light, path traced at
+              W x W (default 256) with 4 spp: ns per ray and ns per ray / log2(N).
+--write-stress writes such a scene as a scene file (for the viewer).
+)";
+
+double now_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    const size_t n = v.size();
+    return n == 0 ? 0.0 : (n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]));
+}
+
+struct Timing {
+    double seconds = 0;
+    uint64_t rays = 0;
+};
+
+// Renders `passes` passes into a fresh state; returns wall time and rays.
+Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes) {
+    RenderState state(width, height);
+    const double start = now_seconds();
+    for (int i = 0; i < passes; ++i) render_pass(scene, settings, state);
+    return {now_seconds() - start, state.rays};
+}
+
+// N random spheres of a few diffuse colours in a cube of side 20, on a floor, under one
+// sphere light: a scene whose cost is all in ray casting.
+nlohmann::json stress_scene_json(int n, uint64_t seed) {
+    using nlohmann::json;
+    json j;
+    j["cameras"] = json::array({{{"id", "camera"}, {"type", "pinhole"}, {"fov", 45}, {"aspect", 1.0},
+                                 {"distance", 5.0}, {"position", {0, 4, -45}}, {"target", {0, 0, 0}}}});
+    j["materials"] = json::array({{{"id", "red"}, {"type", "diffuse"}, {"rho", {0.8, 0.3, 0.3}}},
+                                  {{"id", "green"}, {"type", "diffuse"}, {"rho", {0.3, 0.8, 0.3}}},
+                                  {{"id", "blue"}, {"type", "diffuse"}, {"rho", {0.3, 0.3, 0.8}}},
+                                  {{"id", "grey"}, {"type", "diffuse"}, {"rho", {0.7, 0.7, 0.7}}}});
+    json shapes = json::array(), primitives = json::array();
+    Rng rng(seed, 17);
+    // Radii so the spheres fill about a tenth of the cube whatever N is.
+    const double mean_radius = 20.0 * std::cbrt(0.1 * 3.0 / (4.0 * kPi * n));
+    for (int i = 0; i < n; ++i) {
+        const std::string id = "s" + std::to_string(i);
+        shapes.push_back({{"id", id}, {"type", "sphere"},
+                          {"centre", {20 * rng.next() - 10, 20 * rng.next() - 10, 20 * rng.next() - 10}},
+                          {"radius", mean_radius * (0.5 + rng.next())}});
+        static const char* kColours[] = {"red", "green", "blue"};
+        primitives.push_back({{"id", "p" + id}, {"type", "geometric"}, {"shape", id},
+                              {"material", kColours[i % 3]}});
+    }
+    shapes.push_back({{"id", "floor"}, {"type", "sphere"}, {"centre", {0, -1011, 0}}, {"radius", 1000}});
+    shapes.push_back({{"id", "lamp"}, {"type", "sphere"}, {"centre", {10, 30, -20}}, {"radius", 6}});
+    primitives.push_back({{"id", "floor"}, {"type", "geometric"}, {"shape", "floor"}, {"material", "grey"}});
+    primitives.push_back({{"id", "lamp"}, {"type", "emissive"}, {"shape", "lamp"}, {"material", "grey"},
+                          {"light", "lamp"}});
+    j["shapes"] = shapes;
+    j["lights"] = json::array({{{"id", "lamp"}, {"type", "area"}, {"shape", "lamp"}, {"power", {8, 8, 8}}}});
+    j["scene"] = {{"camera", "camera"},
+                  {"lights", {"lamp"}},
+                  {"primitives", primitives},
+                  {"renderer", {{"type", "PT"}, {"dimensions", {512, 512}}, {"samples", 64}, {"depth", 4},
+                                {"output", "stress_" + std::to_string(n) + ".ppm"}}}};
+    return j;
+}
+
+std::vector<fs::path> all_scenes() {
+    std::vector<fs::path> dirs{"res/scenes"};
+#ifdef KEITHRAY_SCENES_DIR
+    dirs.emplace_back(KEITHRAY_SCENES_DIR);
+#endif
+    for (const fs::path& dir : dirs) {
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) continue;
+        std::vector<fs::path> found;
+        for (const auto& entry : fs::directory_iterator(dir, ec))
+            if (entry.path().extension() == ".json") found.push_back(entry.path());
+        std::sort(found.begin(), found.end());
+        if (!found.empty()) return found;
+    }
+    return {};
+}
+
+struct BenchOptions {
+    bool throughput = false, linear = false;
+    std::vector<int> stress;
+    int write_stress = 0;
+    fs::path write_path;
+    std::vector<fs::path> scenes;
+    double fraction = 1.0 / 32;
+    int runs = 3, threads = 0, size = 256;
+};
+
+struct BadUsage {
+    std::string message;
+};
+
+double parse_number(const std::string& flag, const std::string& text, double lo, double hi) {
+    size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (text.empty() || used != text.size() || !(v >= lo && v <= hi))
+        throw BadUsage{flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                       "], got \"" + text + "\""};
+    return v;
+}
+
+BenchOptions parse(int argc, char** argv) {
+    BenchOptions o;
+    for (int i = 2; i < argc; ++i) {
+        const std::string arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) throw BadUsage{arg + " needs a value"};
+            return argv[++i];
+        };
+        if (arg == "--throughput") o.throughput = true;
+        else if (arg == "--linear") o.linear = true;
+        else if (arg == "--fraction") o.fraction = parse_number(arg, value(), 1e-6, 1.0);
+        else if (arg == "--runs") o.runs = int(parse_number(arg, value(), 1, 1000));
+        else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
+        else if (arg == "--size") o.size = int(parse_number(arg, value(), 1, 8192));
+        else if (arg == "--stress") {
+            std::string list = value();
+            size_t start = 0;
+            while (start <= list.size()) {
+                const size_t comma = list.find(',', start);
+                const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+                o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
+                if (comma == std::string::npos) break;
+                start = comma + 1;
+            }
+        } else if (arg == "--write-stress") {
+            o.write_stress = int(parse_number(arg, value(), 1, 1e7));
+            o.write_path = value();
+        } else if (arg == "-h" || arg == "--help") throw BadUsage{""};
+        else if (!arg.empty() && arg[0] == '-') throw BadUsage{"unknown option " + arg};
+        else o.scenes.emplace_back(arg);
+    }
+    if (!o.throughput && o.stress.empty() && o.write_stress == 0)
+        throw BadUsage{"choose --throughput, --stress or --write-stress"};
+    return o;
+}
+
+int bench_throughput(const BenchOptions& o) {
+    std::vector<fs::path> scenes = o.scenes.empty() ? all_scenes() : o.scenes;
+    std::printf("| scene | renderer | spp run | median s | Mrays/s | est. s at file spp | 1-spp pass ms |\n");
+    std::printf("|---|---|---|---|---|---|---|\n");
+    double total_estimate = 0;
+    for (const fs::path& file : scenes) {
+        RenderScene scene;
+        try {
+            scene = prepare_scene(load_scene_file(file).scene);
+        } catch (const SceneError& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
+            return 1;
+        }
+        scene.linear_scan = o.linear;
+        const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        const int spp = std::max(1, int(std::lround(settings.target_spp * o.fraction)));
+        const int w = scene.renderer.width, h = scene.renderer.height;
+        std::vector<double> seconds, mrays, pass_ms;
+        for (int run = 0; run < o.runs; ++run) {
+            const Timing t = time_render(scene, settings, w, h, spp);
+            seconds.push_back(t.seconds);
+            mrays.push_back(t.seconds > 0 ? t.rays / t.seconds * 1e-6 : 0);
+            // A lone first pass, as the viewer's first full-resolution refinement.
+            pass_ms.push_back(time_render(scene, settings, w, h, 1).seconds * 1e3);
+        }
+        const double s = median(seconds), estimate = s * settings.target_spp / spp;
+        total_estimate += estimate;
+        std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f |\n", file.stem().string().c_str(),
+                    std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
+                    median(mrays), estimate, median(pass_ms));
+        std::fflush(stdout);
+    }
+    std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s).\n", total_estimate,
+                omp_get_max_threads(), o.linear ? "linear scan" : "BVH");
+    return 0;
+}
+
+int bench_stress(const BenchOptions& o) {
+    std::printf("| spheres | BVH nodes | depth | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N |\n");
+    std::printf("|---|---|---|---|---|---|---|---|\n");
+    for (int n : o.stress) {
+        const double build_start = now_seconds();
+        RenderScene scene = prepare_scene(parse_scene(stress_scene_json(n, 1).dump(), "stress.json").scene);
+        const double build_ms = (now_seconds() - build_start) * 1e3;
+        scene.linear_scan = o.linear;
+        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.target_spp = 4;
+        std::vector<double> seconds, ns;
+        for (int run = 0; run < o.runs; ++run) {
+            const Timing t = time_render(scene, settings, o.size, o.size, 4);
+            seconds.push_back(t.seconds);
+            // Per-ray cost on all threads together, as a user sees it.
+            ns.push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
+        }
+        const double ns_ray = median(ns);
+        std::printf("| %d | %zu | %d | %.0f | %.2f | %.1f | %.1f | %.2f |\n", n, scene.bvh.node_count(),
+                    scene.bvh.depth(), build_ms, median(seconds), ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray,
+                    ns_ray / std::log2(double(n) + 1));
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
+}  // namespace
+
+int run_bench(int argc, char** argv) {
+    BenchOptions o;
+    try {
+        o = parse(argc, argv);
+    } catch (const BadUsage& e) {
+        if (!e.message.empty()) std::fprintf(stderr, "error: %s\n", e.message.c_str());
+        std::fprintf(e.message.empty() ? stdout : stderr, "%s", kBenchUsage);
+        return e.message.empty() ? 0 : 2;
+    }
+    if (o.threads > 0) omp_set_num_threads(o.threads);
+    if (o.write_stress > 0) {
+        std::error_code ec;
+        if (fs::exists(o.write_path, ec)) {
+            std::fprintf(stderr, "error: %s exists; not overwriting it\n", o.write_path.string().c_str());
+            return 1;
+        }
+        std::ofstream out(o.write_path);
+        out << stress_scene_json(o.write_stress, 1).dump(1) << "\n";
+        if (!out) {
+            std::fprintf(stderr, "error: cannot write %s\n", o.write_path.string().c_str());
+            return 1;
+        }
+        std::printf("wrote %s (%d spheres)\n", o.write_path.string().c_str(), o.write_stress);
+    }
+    int status = 0;
+    if (o.throughput) status = bench_throughput(o);
+    if (status == 0 && !o.stress.empty()) status = bench_stress(o);
+    return status;
+}
+
+}  // namespace kr

@@ -1,0 +1,333 @@
+#include "render/accel.h"
+
+#include <algorithm>
+#include <limits>
+
+#include "render/render_scene.h"
+
+namespace kr {
+
+namespace {
+
+constexpr int kBins = 16;
+constexpr int kMaxLeafSpheres = 16;  // larger sets are always split
+constexpr int kMaxTreeDepth = 60;    // traversal stack size; deeper sets become leaves
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+struct Box {
+    double lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+    void grow(const double* l, const double* h) {
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::min(lo[a], l[a]);
+            hi[a] = std::max(hi[a], h[a]);
+        }
+    }
+    double half_area() const {
+        const double x = hi[0] - lo[0], y = hi[1] - lo[1], z = hi[2] - lo[2];
+        return (x < 0) ? 0 : x * y + y * z + z * x;
+    }
+};
+
+struct BuildItem {
+    double lo[3], hi[3], centre[3];
+    int id;
+};
+
+int blocks_for(int spheres) { return (spheres + 3) / 4; }
+
+struct Builder {
+    std::vector<BuildItem> items;
+    std::vector<BvhNode>& nodes;
+    std::vector<SphereBlock>& blocks;
+    int depth = 0;
+
+    uint32_t make_leaf(uint32_t node, int begin, int end) {
+        // Largest first: big spheres (walls, floors) are candidates for almost every ray, so
+        // grouping them leaves blocks of small ones that most rays skip whole.
+        std::sort(items.begin() + begin, items.begin() + end, [](const BuildItem& a, const BuildItem& b) {
+            return a.hi[0] - a.lo[0] > b.hi[0] - b.lo[0] || (a.hi[0] - a.lo[0] == b.hi[0] - b.lo[0] && a.id < b.id);
+        });
+        nodes[node].index = static_cast<uint32_t>(blocks.size());
+        nodes[node].blocks = static_cast<uint16_t>(blocks_for(end - begin));
+        for (int first = begin; first < end; first += 4) {
+            SphereBlock b;
+            for (int lane = 0; lane < 4; ++lane) {
+                const int k = first + lane;
+                if (k < end) {
+                    const BuildItem& it = items[k];
+                    const double r = 0.5 * (it.hi[0] - it.lo[0]);
+                    b.cx[lane] = it.centre[0];
+                    b.cy[lane] = it.centre[1];
+                    b.cz[lane] = it.centre[2];
+                    b.r2[lane] = r * r;
+                    b.id[lane] = it.id;
+                } else {
+                    b.cx[lane] = b.cy[lane] = b.cz[lane] = 0;
+                    b.r2[lane] = -1;
+                    b.id[lane] = -2;  // never a ray's from/to sphere (those are >= -1)
+                }
+            }
+            blocks.push_back(b);
+        }
+        return node;
+    }
+
+    uint32_t build(int begin, int end, int level) {
+        depth = std::max(depth, level + 1);
+        const uint32_t node = static_cast<uint32_t>(nodes.size());
+        nodes.emplace_back();
+        Box bounds, centres;
+        for (int i = begin; i < end; ++i) {
+            bounds.grow(items[i].lo, items[i].hi);
+            centres.grow(items[i].centre, items[i].centre);
+        }
+        for (int a = 0; a < 3; ++a) {
+            nodes[node].lo[a] = bounds.lo[a];
+            nodes[node].hi[a] = bounds.hi[a];
+        }
+        const int n = end - begin;
+        if (n <= 4 || level + 1 >= kMaxTreeDepth) return make_leaf(node, begin, end);
+
+        // Binned SAH over the centroid extent of each axis; costs in blocks of four spheres
+        // (one traversal step costs about one block test).
+        double best_cost = kInf;
+        int best_axis = -1, best_bin = 0;
+        for (int a = 0; a < 3; ++a) {
+            const double extent = centres.hi[a] - centres.lo[a];
+            if (!(extent > 0)) continue;
+            Box bin_box[kBins];
+            int bin_count[kBins] = {};
+            for (int i = begin; i < end; ++i) {
+                const int b = std::min(kBins - 1, int(kBins * (items[i].centre[a] - centres.lo[a]) / extent));
+                bin_box[b].grow(items[i].lo, items[i].hi);
+                ++bin_count[b];
+            }
+            // Sweep from the right to get suffix areas, then from the left.
+            double right_area[kBins];
+            int right_count[kBins];
+            Box acc;
+            int count = 0;
+            for (int b = kBins - 1; b > 0; --b) {
+                acc.grow(bin_box[b].lo, bin_box[b].hi);
+                count += bin_count[b];
+                right_area[b] = acc.half_area();
+                right_count[b] = count;
+            }
+            acc = Box();
+            count = 0;
+            for (int b = 0; b + 1 < kBins; ++b) {
+                acc.grow(bin_box[b].lo, bin_box[b].hi);
+                count += bin_count[b];
+                if (count == 0 || right_count[b + 1] == 0) continue;
+                const double cost = acc.half_area() * blocks_for(count) +
+                                    right_area[b + 1] * blocks_for(right_count[b + 1]);
+                if (cost < best_cost) {
+                    best_cost = cost;
+                    best_axis = a;
+                    best_bin = b;
+                }
+            }
+        }
+        const double parent_area = bounds.half_area();
+        const double leaf_cost = blocks_for(n);
+        const double split_cost = parent_area > 0 ? 1.0 + best_cost / parent_area : kInf;
+        int mid;
+        if (best_axis >= 0 && (split_cost < leaf_cost || n > kMaxLeafSpheres)) {
+            const double extent = centres.hi[best_axis] - centres.lo[best_axis];
+            auto it = std::partition(items.begin() + begin, items.begin() + end, [&](const BuildItem& s) {
+                const int b = std::min(kBins - 1, int(kBins * (s.centre[best_axis] - centres.lo[best_axis]) / extent));
+                return b <= best_bin;
+            });
+            mid = static_cast<int>(it - items.begin());
+            nodes[node].axis = static_cast<uint8_t>(best_axis);
+        } else if (n > kMaxLeafSpheres) {
+            // All centres coincide (or SAH found nothing): split the list in half.
+            mid = begin + n / 2;
+        } else {
+            return make_leaf(node, begin, end);
+        }
+        build(begin, mid, level + 1);
+        const uint32_t second = build(mid, end, level + 1);
+        nodes[node].index = second;
+        return node;
+    }
+};
+
+// The lanes below never cross a non-inlined call, so the vector ABI note does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+// Four lanes of doubles (GCC vector extension): SSE2 pairs by default, one AVX register in
+// the x86-64-v3 clone.
+typedef double v4d __attribute__((vector_size(32)));
+typedef int64_t v4l __attribute__((vector_size(32)));
+
+inline v4d load4(const double* p) {
+    v4d v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+inline v4d sqrt4(v4d x) { return v4d{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])}; }
+inline v4d select4(v4l mask, v4d a, v4d b) { return mask ? a : b; }
+
+// Accepted distance of each lane's sphere for `ray` within [ray.tmin, tmax], or +inf.
+// The same root choice as the scalar sphere_roots + accept rules of render_scene.cpp,
+// written without branches so all four lanes go together.
+inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, const Ray& ray, double tmax) {
+    const v4d inf = v4d{} + kInf, zero = v4d{};
+    const v4d fx = ray.o.x - load4(b.cx), fy = ray.o.y - load4(b.cy), fz = ray.o.z - load4(b.cz);
+    const v4d r2 = load4(b.r2);
+    const v4d half_b = fx * ray.d.x + fy * ray.d.y + fz * ray.d.z;
+    // Discriminant from the line's distance to the centre (no cancellation).
+    const v4d px = fx - half_b * ray.d.x, py = fy - half_b * ray.d.y, pz = fz - half_b * ray.d.z;
+    const v4d disc = r2 - (px * px + py * py + pz * pz);
+    const v4d c = (fx * fx + fy * fy + fz * fz) - r2;
+    v4l ids;
+    __builtin_memcpy(&ids, b.id, sizeof ids);
+    const v4l origin = ids == static_cast<int64_t>(ray.from_sphere);
+    // Most lanes miss: the line passes the sphere by, or the sphere lies behind an origin
+    // outside it. Skip the square root and division when all four do.
+    const v4l candidate = (disc >= 0) & ~((c > 0) & (half_b > 0) & ~origin);
+    if (!(candidate[0] | candidate[1] | candidate[2] | candidate[3])) return inf;
+    const v4d root = sqrt4(select4(disc > 0, disc, zero));
+    // Vieta: q = -b - sign(b) sqrt(disc); roots q and c / q (both 0 when q is).
+    const v4d q = -half_b - select4(half_b >= 0, root, -root);
+    const v4d t0 = select4(q != 0, c / q, zero);
+    const v4d t_near = select4(t0 < q, t0, q), t_far = select4(t0 < q, q, t0);
+    const v4l near_ok = ~origin & (t_near >= ray.tmin) & (t_near <= tmax);
+    const v4l far_origin_ok = ray.into_from_sphere ? (t_far > 0) : v4l{};
+    const v4l far_ok = (t_far >= ray.tmin) & (t_far <= tmax) & (~origin | far_origin_ok);
+    const v4d t = select4(near_ok, t_near, select4(far_ok, t_far, inf));
+    const v4l rejected = ~candidate | (ids == static_cast<int64_t>(ray.to_sphere));
+    return select4(rejected, inf, t);
+}
+
+struct SlabRay {
+    double o[3], inv[3];
+    explicit SlabRay(const Ray& ray) {
+        const double d[3] = {ray.d.x, ray.d.y, ray.d.z};
+        const double o_[3] = {ray.o.x, ray.o.y, ray.o.z};
+        for (int a = 0; a < 3; ++a) {
+            o[a] = o_[a];
+            inv[a] = 1.0 / d[a];  // +-inf for a zero component: that slab test degenerates safely
+        }
+    }
+    // Entry distance into the node's box within [tmin, tmax], or +inf if missed.
+    double enter(const BvhNode& n, double tmin, double tmax) const {
+        // tmax widened by 2 gamma(3) (pbrt's bound) so rounding never culls a grazing hit.
+        constexpr double kWiden = 1.0 + 2.0 * 3.0 * std::numeric_limits<double>::epsilon();
+        for (int a = 0; a < 3; ++a) {
+            double t0 = (n.lo[a] - o[a]) * inv[a], t1 = (n.hi[a] - o[a]) * inv[a];
+            if (t0 > t1) std::swap(t0, t1);
+            t1 *= kWiden;
+            tmin = t0 > tmin ? t0 : tmin;  // NaN (0 * inf) leaves the bound unchanged
+            tmax = t1 < tmax ? t1 : tmax;
+        }
+        return tmin <= tmax ? tmin : kInf;
+    }
+};
+
+template <bool kAny>
+inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& nodes,
+                                                   const std::vector<SphereBlock>& blocks, const Ray& ray,
+                                                   double& t_best) {
+    const SlabRay slab(ray);
+    const bool dir_negative[3] = {ray.d.x < 0, ray.d.y < 0, ray.d.z < 0};
+    double best = ray.tmax;
+    int best_id = -1;
+    uint32_t stack[kMaxTreeDepth + 1];
+    int top = 0;
+    uint32_t node = 0;
+    if (slab.enter(nodes[0], ray.tmin, best) == kInf) return -1;
+    for (;;) {
+        const BvhNode& n = nodes[node];
+        if (n.blocks > 0) {
+            for (uint32_t k = 0; k < n.blocks; ++k) {
+                const v4d t = block_distances(blocks[n.index + k], ray, best);
+                for (int lane = 0; lane < 4; ++lane) {
+                    // Lanes already passed t <= best; ties keep the first found.
+                    if (t[lane] < kInf && (t[lane] < best || best_id < 0)) {
+                        best = t[lane];
+                        best_id = blocks[n.index + k].id[lane];
+                        if constexpr (kAny) {
+                            t_best = best;
+                            return best_id;
+                        }
+                    }
+                }
+            }
+        } else {
+            // Visit the child on the ray's side of the split first; skip boxes beyond `best`.
+            uint32_t first = node + 1, second = n.index;
+            if (dir_negative[n.axis]) std::swap(first, second);
+            const bool hit_first = slab.enter(nodes[first], ray.tmin, best) < kInf;
+            const bool hit_second = slab.enter(nodes[second], ray.tmin, best) < kInf;
+            if (hit_first) {
+                if (hit_second) stack[top++] = second;
+                node = first;
+                continue;
+            }
+            if (hit_second) {
+                node = second;
+                continue;
+            }
+        }
+        if (top == 0) break;
+        node = stack[--top];
+        // A box pushed earlier may now lie beyond the closest hit found since.
+        while (slab.enter(nodes[node], ray.tmin, best) == kInf) {
+            if (top == 0) {
+                t_best = best;
+                return best_id;
+            }
+            node = stack[--top];
+        }
+    }
+    t_best = best;
+    return best_id;
+}
+
+}  // namespace
+
+void SphereBvh::build(const std::vector<SphereGeom>& spheres) {
+    nodes_.clear();
+    blocks_.clear();
+    depth_ = 0;
+    Builder builder{{}, nodes_, blocks_};
+    builder.items.reserve(spheres.size());
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const SphereGeom& s = spheres[i];
+        BuildItem it;
+        const double c[3] = {s.centre.x, s.centre.y, s.centre.z};
+        for (int a = 0; a < 3; ++a) {
+            it.centre[a] = c[a];
+            it.lo[a] = c[a] - s.radius;
+            it.hi[a] = c[a] + s.radius;
+        }
+        it.id = static_cast<int>(i);
+        builder.items.push_back(it);
+    }
+    if (spheres.empty()) return;
+    builder.build(0, static_cast<int>(spheres.size()), 0);
+    depth_ = builder.depth;
+}
+
+// Two versions of each entry point: the default x86-64 one and an AVX2/FMA one, chosen by
+// the dynamic loader from the CPU's features (GCC function multi-versioning).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+#define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KR_CLONES
+#endif
+
+KR_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
+    if (nodes_.empty()) return -1;
+    return traverse<false>(nodes_, blocks_, ray, t);
+}
+
+KR_CLONES bool SphereBvh::any(const Ray& ray) const {
+    if (nodes_.empty()) return false;
+    double t;
+    return traverse<true>(nodes_, blocks_, ray, t) >= 0;
+}
+
+}  // namespace kr
