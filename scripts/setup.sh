@@ -4,7 +4,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev)
+packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
+          # the viewer (keithray view) and its offscreen display (render --gl), and
+          # the X server its window test runs under
+          libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xauth)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

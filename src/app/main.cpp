@@ -11,9 +11,12 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include "app/bench.h"
 #include "core/image.h"
 #include "render/render.h"
 #include "scene/load.h"
+#include "viewer/gl_offscreen.h"
+#include "viewer/viewer.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -25,13 +28,20 @@ constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere 
 Usage:
   keithray render [SCENE.json ...] [options]
   keithray psnr IMAGE.ppm REFERENCE.ppm     PSNR in dB of two 8-bit PPMs
+  keithray bench --throughput|--stress ...  speed figures ('keithray bench --help')
+  keithray view [SCENE.json] [options]      interactive viewer (GLFW window; see
+                                            'keithray view --help' and README.md)
   keithray --help
 
 With no SCENE, renders every *.json in res/scenes/. Defaults come from each scene
 file's renderer block; the options below override them.
 
 Options:
-  --spp N               samples per pixel (default: the file's "samples")
+  --spp N               samples per pixel (default: the file's "samples"; with --time
+                        or --noise, an upper bound, unlimited if not given)
+  --time SECONDS        render as many passes as fit in SECONDS (checked between passes)
+  --noise X             stop when the estimated relative RMS error of the image falls
+                        below X (e.g. 0.01); adaptive: passes go to the noisiest pixels
   --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
                         pt-naive samples no area light, only point lights)
   --estimator NAME      primary samples: uniform | stratified (default: stratified)
@@ -40,6 +50,8 @@ Options:
                         exact, see docs/fidelity.md)
   --depth N             maximum ray depth, 0..20 (default: the file's "depth")
   --tonemap NAME        sigmoid | linear (default: sigmoid)
+  --gl                  tone map through the viewer's GLSL display shaders in an
+                        offscreen OSMesa framebuffer (no display, no GPU needed)
   --blur R              box blur of radius R pixels on the radiance (default: 0)
   --seed N              random seed (default: 0); same seed, same image
   --threads N           worker threads (default: all cores)
@@ -56,6 +68,7 @@ Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage
 struct Options {
     std::vector<fs::path> scenes;
     std::optional<int> spp, depth, threads;
+    double time_limit = 0, noise = 0;  // 0: rule off
     std::optional<Integrator> integrator;
     std::optional<Estimator> estimator;
     std::optional<LightSampling> light_sampling;
@@ -64,6 +77,7 @@ struct Options {
     uint64_t seed = 0;
     std::optional<fs::path> output;
     bool quiet = false;
+    bool gl = false;  // tone map on the viewer's display path (OSMesa)
 };
 
 struct UsageError {
@@ -100,6 +114,19 @@ Options parse_options(int argc, char** argv) {
             return argv[++i];
         };
         if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
+        else if (arg == "--time" || arg == "--noise") {
+            const std::string text = value();
+            size_t used = 0;
+            double v = 0;
+            try {
+                v = std::stod(text, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (text.empty() || used != text.size() || !(v > 0 && v < 1e9))
+                throw UsageError{arg + " expects a positive number, got \"" + text + "\""};
+            (arg == "--time" ? o.time_limit : o.noise) = v;
+        }
         else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, 1000));
         else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, 4096));
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, 4096));
@@ -110,6 +137,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--tonemap") o.tonemap = parse_name(arg, value(), tonemap_names);
         else if (arg == "-o" || arg == "--output") o.output = value();
         else if (arg == "-q" || arg == "--quiet") o.quiet = true;
+        else if (arg == "--gl") o.gl = true;
         else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
         else o.scenes.emplace_back(arg);
     }
@@ -201,19 +229,36 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     double last_draw = -1;
-    for (int pass = 0; pass < settings.target_spp; ++pass) {
-        render_pass(scene, settings, state);
-        if (show_progress && (elapsed() - last_draw > 0.1 || pass + 1 == settings.target_spp)) {
-            draw_progress(pass + 1, settings.target_spp, elapsed());
+    StopRule rule;
+    rule.seconds = opt.time_limit;
+    rule.noise = opt.noise;
+    const bool open_ended = opt.time_limit > 0 || opt.noise > 0;
+    rule.max_passes = open_ended && !opt.spp ? (1 << 24) : settings.target_spp;
+    const StopReason reason = render_until(scene, settings, state, rule, [&](const RenderState& s) {
+        if (show_progress && elapsed() - last_draw > 0.1) {
+            if (open_ended) {
+                std::fprintf(stderr, "\r  %d passes  %s  est. error %.4f   ", s.passes, format_seconds(elapsed()).c_str(),
+                             s.relative_error());
+                std::fflush(stderr);
+            } else {
+                draw_progress(s.passes, settings.target_spp, elapsed());
+            }
             last_draw = elapsed();
         }
-    }
+        return true;
+    });
     const double seconds = elapsed();
+    if (open_ended)
+        std::fprintf(stderr, "%s%s: stopped by %s after %d passes, estimated relative error %.4f\n",
+                     show_progress ? "\n" : "", scene_file.filename().string().c_str(),
+                     reason == StopReason::noise ? "--noise" : reason == StopReason::time ? "--time" : "--spp",
+                     state.passes, state.relative_error());
     if (show_progress) std::fprintf(stderr, "\n");
 
     try {
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        write_ppm(output, tonemap(radiance, opt.tonemap));
+        write_ppm(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
+                                 : tonemap(radiance, opt.tonemap));
         write_ppm(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
@@ -239,6 +284,7 @@ int main(int argc, char** argv) {
         std::fputs(kUsage, stdout);
         return 0;
     }
+    if (command == "bench") return run_bench(argc, argv);
     if (command == "psnr") {
         if (argc != 4) {
             std::fprintf(stderr, "error: psnr needs two PPM files\n");
@@ -252,6 +298,7 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
+    if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
                      command.c_str(), kUsage);

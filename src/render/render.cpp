@@ -1,5 +1,6 @@
 #include "render/render.h"
 
+#include <chrono>
 #include <cmath>
 
 #include <omp.h>
@@ -26,6 +27,7 @@ void RenderState::reset(int w, int h) {
     passes = 0;
     rays = 0;
     nonfinite_samples = 0;
+    active.clear();
 }
 
 Image RenderState::radiance() const {
@@ -64,6 +66,39 @@ double RenderState::relative_error() const {
     return std::sqrt(error_sq / signal_sq);
 }
 
+size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
+    const size_t n = sample_count.size();
+    double signal_sq = 0;
+    std::vector<double> error_sq(n);
+    for (size_t i = 0; i < n; ++i) {
+        const double mean = sample_count[i] ? luminance(radiance_sum[i]) / sample_count[i] : 0.0;
+        signal_sq += mean * mean;
+        const double se = pixel_standard_error(i);
+        error_sq[i] = se * se;
+    }
+    const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
+    active.assign(n, 0);
+    size_t count = 0;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            // A few samples can miss a rare bright path and show almost no variance; the
+            // mean over the 3x3 neighbourhood (variance varies smoothly) guards against that.
+            double sum = 0;
+            int cells = 0;
+            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
+                    sum += error_sq[size_t(yy) * width + xx];
+                    ++cells;
+                }
+            const size_t i = size_t(y) * width + x;
+            const double local = std::max(error_sq[i], sum / cells);
+            const bool needs_more = sample_count[i] < min_samples || !(local <= share);
+            active[i] = needs_more;
+            count += needs_more;
+        }
+    return count;
+}
+
 Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng) {
     const double u1 = rng.next(), u2 = rng.next();
     if (estimator == Estimator::stratified) {
@@ -88,6 +123,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         }
         for (int x = 0; x < width; ++x) {
             const size_t pixel = static_cast<size_t>(y) * width + x;
+            if (!state.active.empty() && !state.active[pixel]) continue;
             const int index = static_cast<int>(state.sample_index[pixel]++);
             Rng rng = Rng::for_sample(settings.seed, pixel, static_cast<uint64_t>(index));
             const Vec2 sub = pixel_sample(settings.estimator, index, settings.target_spp, rng);
@@ -115,6 +151,23 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     if (stopped) return false;
     ++state.passes;
     return true;
+}
+
+StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass) {
+    const auto start = std::chrono::steady_clock::now();
+    for (int pass = 0; pass < rule.max_passes; ++pass) {
+        render_pass(scene, settings, state);
+        if (on_pass && !on_pass(state)) return StopReason::cancelled;
+        if (rule.noise > 0 && pass + 1 >= int(rule.min_samples) && (pass + 1) % rule.adapt_every == 0) {
+            if (state.relative_error() <= rule.noise) return StopReason::noise;
+            // Every pixel within its share means the whole image is within the target too.
+            if (state.update_adaptive(rule.noise, rule.min_samples) == 0) return StopReason::noise;
+        }
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (rule.seconds > 0 && elapsed >= rule.seconds) return StopReason::time;
+    }
+    return StopReason::passes;
 }
 
 }  // namespace kr

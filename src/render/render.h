@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "core/image.h"
@@ -47,6 +48,8 @@ struct RenderState {
     int passes = 0;                       // completed passes
     uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
     uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
+    // Adaptive sampling: render_pass samples only pixels whose entry is 1 (empty: all of them).
+    std::vector<uint8_t> active;
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
@@ -60,6 +63,12 @@ struct RenderState {
     // Estimated relative RMS error of the whole image: sqrt(sum of per-pixel variances of the
     // mean) / sqrt(sum of squared mean luminances). Infinite before two samples per pixel.
     double relative_error() const;
+
+    // Adaptive sampling towards an image relative error `target` (as relative_error()): a
+    // pixel stays active while the variance of its mean exceeds an equal share of the allowed
+    // total, target^2 * sum(mean^2) / pixels, or it has fewer than `min_samples` samples.
+    // When no pixel is active the image meets the target. Returns the active count.
+    size_t update_adaptive(double target, uint32_t min_samples = 16);
 };
 
 // Adds one sample to every pixel of `state` (sample index = the pixel's own count of samples drawn).
@@ -69,6 +78,24 @@ struct RenderState {
 // sample, others do not, so the state stays a valid (unevenly sampled) estimate.
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop = nullptr);
+
+// When a progressive render stops: after `max_passes`, after `seconds` of wall time (checked
+// between passes), or when the estimated relative error reaches `noise` (adaptive sampling
+// then spends passes only on pixels above their share of the error). 0 disables a rule.
+struct StopRule {
+    int max_passes = 1;
+    double seconds = 0;
+    double noise = 0;
+    uint32_t min_samples = 16;  // per pixel before the noise rule trusts a variance
+    int adapt_every = 4;        // passes between updates of the adaptive mask
+};
+
+enum class StopReason { passes, time, noise, cancelled };
+
+// Runs passes until a rule stops it. `on_pass`, if given, is called after each pass and
+// may return false to cancel.
+StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass = {});
 
 // One radiance sample for a camera ray, for tests and tools: the integrator the settings name.
 struct SampleResult {

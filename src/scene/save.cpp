@@ -1,0 +1,153 @@
+#include "scene/save.h"
+
+#include <fstream>
+#include <stdexcept>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+namespace kr {
+
+namespace {
+
+// Keys in the order the brief's files use, so a saved file diffs well against its source.
+using Json = nlohmann::ordered_json;
+
+Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
+
+Json camera_json(const Camera& c) {
+    Json j;
+    j["id"] = c.id;
+    j["type"] = camera_type_names.name(c.type);
+    if (c.type == CameraType::lens) {
+        j["focal distance"] = c.focal_distance;
+        j["alpha"] = c.alpha;
+    }
+    j["fov"] = c.fov;
+    j["aspect"] = c.aspect;
+    j["distance"] = c.distance;
+    j["position"] = vec3(c.position);
+    j["target"] = vec3(c.target);
+    return j;
+}
+
+Json material_json(const Material& m) {
+    Json j;
+    j["id"] = m.id;
+    j["type"] = material_type_names.name(m.type);
+    switch (m.type) {
+        case MaterialType::diffuse:
+        case MaterialType::specular: j["rho"] = vec3(m.rho); break;
+        case MaterialType::glossy:
+            j["rho"] = vec3(m.rho);
+            j["roughness"] = m.roughness;
+            break;
+        case MaterialType::dielectric:
+        case MaterialType::translucent:
+            j["rhoR"] = vec3(m.rho_r);
+            j["rhoT"] = vec3(m.rho_t);
+            j["eta"] = m.eta;
+            if (m.type == MaterialType::translucent) j["roughness"] = m.roughness;
+            break;
+    }
+    return j;
+}
+
+}  // namespace
+
+std::string scene_to_json(const Scene& scene) {
+    // Indices are checked here, not trusted: a bad one would write a file that cannot load.
+    auto id_of = [](const auto& items, int index, const char* what) -> const std::string& {
+        if (index < 0 || size_t(index) >= items.size())
+            throw std::runtime_error(std::string("scene_to_json: ") + what + " index " + std::to_string(index) +
+                                     " out of range");
+        return items[size_t(index)].id;
+    };
+    Json root;
+    root["cameras"] = Json::array();
+    for (const Camera& c : scene.cameras) root["cameras"].push_back(camera_json(c));
+    root["materials"] = Json::array();
+    for (const Material& m : scene.materials) root["materials"].push_back(material_json(m));
+    root["shapes"] = Json::array();
+    for (const Shape& s : scene.shapes) {
+        Json j;
+        j["id"] = s.id;
+        j["type"] = shape_type_names.name(s.type);
+        j["centre"] = vec3(s.centre);
+        j["radius"] = s.radius;
+        root["shapes"].push_back(j);
+    }
+    root["lights"] = Json::array();
+    for (const Light& l : scene.lights) {
+        Json j;
+        j["id"] = l.id;
+        j["type"] = light_type_names.name(l.type);
+        if (l.type == LightType::point) j["position"] = vec3(l.position);
+        else j["shape"] = id_of(scene.shapes, l.shape, "light shape");
+        j["power"] = vec3(l.power);
+        root["lights"].push_back(j);
+    }
+    Json block;
+    block["camera"] = id_of(scene.cameras, scene.camera, "camera");
+    block["lights"] = Json::array();
+    for (int l : scene.active_lights) block["lights"].push_back(id_of(scene.lights, l, "active light"));
+    block["primitives"] = Json::array();
+    for (const Primitive& p : scene.primitives) {
+        Json j;
+        j["id"] = p.id;
+        j["type"] = primitive_type_names.name(p.type);
+        j["shape"] = id_of(scene.shapes, p.shape, "primitive shape");
+        if (p.type == PrimitiveType::emissive) j["light"] = id_of(scene.lights, p.light, "primitive light");
+        j["material"] = id_of(scene.materials, p.material, "primitive material");
+        block["primitives"].push_back(j);
+    }
+    const RendererSettings& r = scene.renderer;
+    Json renderer;
+    renderer["type"] = renderer_type_names.name(r.type);
+    renderer["dimensions"] = Json::array({r.width, r.height});
+    renderer["samples"] = r.samples;
+    renderer["depth"] = r.depth;
+    renderer["output"] = r.output;
+    block["renderer"] = renderer;
+    root["scene"] = block;
+    // nlohmann prints doubles in their shortest round-trip form, so values load back equal.
+    return root.dump(2) + "\n";
+}
+
+void save_scene_json(const Scene& scene, const std::filesystem::path& file) {
+    namespace fs = std::filesystem;
+    Scene moved = scene;
+    const fs::path dir = file.parent_path();
+    if (!scene.renderer.output.empty()) {
+        // Same target file seen from the new folder; absolute when no relative path exists.
+        const fs::path target = scene.output_path();
+        const fs::path base = fs::absolute(dir.empty() ? fs::path(".") : dir).lexically_normal();
+        const fs::path absolute_target = fs::absolute(target).lexically_normal();
+        fs::path relative = absolute_target.lexically_relative(base);
+        moved.renderer.output = (relative.empty() ? absolute_target : relative).generic_string();
+    }
+    const std::string text = scene_to_json(moved);
+    std::error_code ec;
+    if (!dir.empty()) fs::create_directories(dir, ec);
+    const fs::path tmp = file.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
+    {
+        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
+        if (!f) throw std::runtime_error("cannot write " + tmp.string());
+        f << text;
+        f.flush();
+        if (!f) {
+            f.close();
+            fs::remove(tmp, ec);
+            throw std::runtime_error("cannot write " + tmp.string());
+        }
+    }
+    fs::rename(tmp, file, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw std::runtime_error("cannot rename " + tmp.string() + " to " + file.string());
+    }
+}
+
+}  // namespace kr

@@ -1,0 +1,60 @@
+#include "viewer/accumulator.h"
+
+#include <cmath>
+
+namespace kr::viewer {
+
+namespace {
+
+// Neumaier's variant of Kahan summation: also exact when the addend is the larger term.
+inline void add_compensated(double& sum, double& compensation, double x) {
+    const double t = sum + x;
+    if (std::abs(sum) >= std::abs(x)) compensation += (sum - t) + x;
+    else compensation += (x - t) + sum;
+    sum = t;
+}
+
+}  // namespace
+
+void Accumulator::reset(int width, int height) {
+    totals_.reset(width, height);
+    scratch_.reset(width, height);
+    raw_sum_.assign(totals_.radiance_sum.size(), Color());
+    compensation_.assign(totals_.radiance_sum.size(), Color());
+}
+
+bool Accumulator::render_pass(const RenderScene& scene, const RenderSettings& settings,
+                              const std::atomic<bool>* stop) {
+    const bool complete = kr::render_pass(scene, settings, scratch_, stop);
+    if (complete) add(scratch_);
+    // Clear the per-pass sums; sample_index stays, so the next pass draws the next samples.
+    std::fill(scratch_.radiance_sum.begin(), scratch_.radiance_sum.end(), Color());
+    std::fill(scratch_.depth_sum.begin(), scratch_.depth_sum.end(), 0.0);
+    std::fill(scratch_.luminance_sq_sum.begin(), scratch_.luminance_sq_sum.end(), 0.0);
+    std::fill(scratch_.sample_count.begin(), scratch_.sample_count.end(), 0u);
+    scratch_.rays = 0;
+    scratch_.nonfinite_samples = 0;
+    return complete;
+}
+
+void Accumulator::add(const RenderState& pass) {
+    for (size_t i = 0; i < pass.radiance_sum.size(); ++i) {
+        if (pass.sample_count[i] == 0) continue;
+        Color& sum = raw_sum_[i];
+        Color& c = compensation_[i];
+        add_compensated(sum.x, c.x, pass.radiance_sum[i].x);
+        add_compensated(sum.y, c.y, pass.radiance_sum[i].y);
+        add_compensated(sum.z, c.z, pass.radiance_sum[i].z);
+        totals_.radiance_sum[i] = sum + c;
+        totals_.depth_sum[i] += pass.depth_sum[i];
+        totals_.luminance_sq_sum[i] += pass.luminance_sq_sum[i];
+        totals_.sample_count[i] += pass.sample_count[i];
+    }
+    totals_.rays += pass.rays;
+    totals_.nonfinite_samples += pass.nonfinite_samples;
+    ++totals_.passes;
+}
+
+Image Accumulator::mean() const { return totals_.radiance(); }
+
+}  // namespace kr::viewer

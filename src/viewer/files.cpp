@@ -1,0 +1,70 @@
+#include "viewer/files.h"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+
+#include <unistd.h>
+
+#include <stb/stb_image_write.h>
+
+namespace kr::viewer {
+
+void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
+    namespace fs = std::filesystem;
+    if (image.bytes.size() != static_cast<size_t>(image.width) * image.height * 3)
+        throw std::runtime_error("write_png: image size does not match its pixel data");
+    std::error_code ec;
+    if (!path.parent_path().empty()) fs::create_directories(path.parent_path(), ec);
+    const fs::path tmp = path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
+    if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.bytes.data(), image.width * 3)) {
+        fs::remove(tmp, ec);
+        throw std::runtime_error("cannot write " + tmp.string());
+    }
+    fs::rename(tmp, path, ec);
+    if (ec) {
+        const std::string why = ec.message();
+        fs::remove(tmp, ec);
+        throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + why);
+    }
+}
+
+std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir) {
+    std::vector<std::filesystem::path> found;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
+        if (entry.path().extension() == ".json") found.push_back(entry.path());
+    std::sort(found.begin(), found.end());
+    return found;
+}
+
+FileWatch::Stamp FileWatch::stamp() const {
+    Stamp s;
+    std::error_code ec;
+    s.time = std::filesystem::last_write_time(file_, ec);
+    if (ec) return {};
+    s.size = std::filesystem::file_size(file_, ec);
+    s.exists = !ec;
+    return s;
+}
+
+void FileWatch::watch(const std::filesystem::path& file) {
+    file_ = file;
+    seen_ = stamp();
+    last_poll_ = std::chrono::steady_clock::now();
+}
+
+void FileWatch::acknowledge() { seen_ = stamp(); }
+
+bool FileWatch::changed(std::chrono::steady_clock::time_point now) {
+    if (file_.empty() || now - last_poll_ < interval_) return false;
+    last_poll_ = now;
+    const Stamp s = stamp();
+    // A file being replaced may be missing for a moment: wait for it to come back.
+    if (!s.exists || s == seen_) return false;
+    seen_ = s;
+    return true;
+}
+
+}  // namespace kr::viewer

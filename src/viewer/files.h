@@ -1,0 +1,49 @@
+// File helpers of the viewer that need no window: PNG output, the scene list, and the
+// polling watch on the scene file.
+#pragma once
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "core/image.h"
+
+namespace kr::viewer {
+
+// PNG through stb_image_write (Debian's libstb), written atomically like write_ppm.
+// Throws std::runtime_error.
+void write_png(const std::filesystem::path& path, const Rgb8Image& image);
+
+// The *.json files of `dir`, sorted.
+std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir);
+
+// Polls a file's modification time, at most once per `interval`.
+class FileWatch {
+public:
+    explicit FileWatch(std::chrono::milliseconds interval = std::chrono::milliseconds(250))
+        : interval_(interval) {}
+    // Starts watching `file` from its current state.
+    void watch(const std::filesystem::path& file);
+    // Takes `file`'s current time as seen (after the viewer itself wrote it).
+    void acknowledge();
+    // True once per change of the modification time (or size) since the last call.
+    bool changed(std::chrono::steady_clock::time_point now = std::chrono::steady_clock::now());
+    const std::filesystem::path& file() const { return file_; }
+
+private:
+    struct Stamp {
+        std::filesystem::file_time_type time{};
+        uintmax_t size = 0;
+        bool exists = false;
+        bool operator==(const Stamp&) const = default;
+    };
+    Stamp stamp() const;
+
+    std::chrono::milliseconds interval_;
+    std::filesystem::path file_;
+    Stamp seen_;
+    std::chrono::steady_clock::time_point last_poll_{};
+};
+
+}  // namespace kr::viewer

@@ -1,0 +1,175 @@
+#include "viewer/render_worker.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include "viewer/accumulator.h"
+
+namespace kr::viewer {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// A preview pass: the same renderer on a smaller image of the same view.
+int scaled(int size, int scale) { return std::max(1, (size + scale - 1) / scale); }
+
+}  // namespace
+
+std::vector<int> preview_scales(int width, int height, double seconds_per_pixel, double budget_seconds) {
+    const double pixels = double(width) * double(height);
+    auto cost = [&](int scale) { return pixels / (double(scale) * scale) * seconds_per_pixel; };
+    int first = 8;
+    if (seconds_per_pixel > 0) {
+        first = 16;
+        while (first > 1 && cost(first / 2) <= budget_seconds) first /= 2;
+    }
+    std::vector<int> scales;
+    // Each step costs a quarter of the next; stop refining once a full pass is quick anyway.
+    for (int s = first; s > 1; s /= 2) {
+        scales.push_back(s);
+        if (seconds_per_pixel > 0 && cost(1) < 4 * budget_seconds) break;
+    }
+    return scales;
+}
+
+RenderWorker::RenderWorker(std::function<void()> on_publish)
+    : on_publish_(std::move(on_publish)), thread_([this] { run(); }) {}
+
+RenderWorker::~RenderWorker() {
+    {
+        std::lock_guard lock(mutex_);
+        quit_ = true;
+        stop_.store(true);
+    }
+    changed_.notify_all();
+    thread_.join();
+}
+
+void RenderWorker::submit(RenderJob job) {
+    {
+        std::lock_guard lock(mutex_);
+        pending_ = std::move(job);
+        stop_.store(true);  // the pass in flight ends at its next row
+    }
+    changed_.notify_all();
+}
+
+void RenderWorker::set_paused(bool paused) {
+    {
+        std::lock_guard lock(mutex_);
+        paused_ = paused;
+    }
+    changed_.notify_all();
+}
+
+void RenderWorker::set_unlimited(bool unlimited) {
+    {
+        std::lock_guard lock(mutex_);
+        unlimited_ = unlimited;
+    }
+    changed_.notify_all();
+}
+
+std::shared_ptr<const Snapshot> RenderWorker::latest() const {
+    std::lock_guard lock(mutex_);
+    return latest_;
+}
+
+std::shared_ptr<const Snapshot> RenderWorker::wait_newer(uint64_t serial, std::chrono::milliseconds timeout) const {
+    std::unique_lock lock(mutex_);
+    published_.wait_for(lock, timeout, [&] { return latest_ && latest_->serial > serial; });
+    return latest_;
+}
+
+void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
+    {
+        std::lock_guard lock(mutex_);
+        frame->serial = ++serial_;
+        latest_ = std::move(frame);
+    }
+    published_.notify_all();
+    if (on_publish_) on_publish_();
+}
+
+void RenderWorker::run() {
+    // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
+    // window. Linux nice values are per thread, and the team's threads, created by this
+    // thread at its first parallel region, inherit it.
+    setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
+    constexpr double kPreviewBudget = 0.010;  // seconds for the first preview pass
+    RenderJob job;
+    bool have_job = false;
+    Accumulator accumulator;
+    std::vector<int> previews;
+    size_t next_preview = 0;
+    double seconds = 0, full_seconds = 0;
+    double seconds_per_pixel = 0;  // measured cost, carried across edits
+
+    for (;;) {
+        bool unlimited = false;
+        {
+            std::unique_lock lock(mutex_);
+            auto finished = [&] {
+                return next_preview >= previews.size() && !unlimited_ &&
+                       accumulator.passes() >= job.settings.target_spp;
+            };
+            changed_.wait(lock, [&] { return quit_ || pending_ || (have_job && !paused_ && !finished()); });
+            if (quit_) return;
+            if (pending_) {
+                job = std::move(*pending_);
+                pending_.reset();
+                stop_.store(false);  // under the lock: a newer submit sets it again after this
+                have_job = true;
+                const int w = job.scene->renderer.width, h = job.scene->renderer.height;
+                accumulator.reset(w, h);
+                previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
+                next_preview = 0;
+                seconds = full_seconds = 0;
+                if (paused_) continue;  // an edit while paused shows nothing new until resumed
+            }
+            unlimited = unlimited_;
+        }
+
+        const int w = job.scene->renderer.width, h = job.scene->renderer.height;
+        const auto start = Clock::now();
+        auto frame = std::make_shared<Snapshot>();
+        if (next_preview < previews.size()) {
+            const int scale = previews[next_preview];
+            RenderState preview(scaled(w, scale), scaled(h, scale));
+            if (!kr::render_pass(*job.scene, job.settings, preview, &stop_)) continue;
+            const double dt = seconds_since(start);
+            seconds += dt;
+            ++next_preview;
+            frame->scale = scale;
+            frame->radiance = preview.radiance();
+        } else {
+            if (!accumulator.render_pass(*job.scene, job.settings, &stop_)) continue;
+            const double dt = seconds_since(start);
+            seconds += dt;
+            full_seconds += dt;
+            // Only full passes: tiny previews are dominated by per-pass overheads.
+            seconds_per_pixel = dt / (double(w) * h);
+            frame->radiance = accumulator.mean();
+        }
+        const RenderState& totals = accumulator.totals();
+        frame->generation = job.generation;
+        frame->spp = accumulator.passes();
+        frame->target_spp = job.settings.target_spp;
+        frame->seconds = seconds;
+        frame->full_seconds = full_seconds;
+        frame->rays = totals.rays;
+        frame->relative_error = frame->spp >= 2 ? totals.relative_error() : INFINITY;
+        frame->nonfinite_samples = totals.nonfinite_samples;
+        frame->finished = !unlimited && frame->spp >= job.settings.target_spp;
+        publish(std::move(frame));
+    }
+}
+
+}  // namespace kr::viewer

@@ -1,0 +1,89 @@
+// The render thread: runs progressive passes of the core renderer and publishes
+// immutable Snapshots for the UI thread. It owns its accumulation buffer outright; the UI
+// only ever sees finished Snapshots, handed over under a mutex, and never touches GL here.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <vector>
+
+#include "core/image.h"
+#include "render/render.h"
+
+namespace kr::viewer {
+
+// What to render: a prepared scene (shared, never modified once built) and the settings.
+struct RenderJob {
+    uint64_t generation = 0;  // the model's edit counter: frames carry it back
+    std::shared_ptr<const RenderScene> scene;
+    RenderSettings settings;
+};
+
+// One published snapshot of the estimate.
+struct Snapshot {
+    uint64_t generation = 0;
+    uint64_t serial = 0;     // increases with every frame published
+    int scale = 1;           // > 1: a preview rendered at 1/scale resolution, shown upscaled
+    Image radiance;          // per-pixel mean radiance
+    int spp = 0;             // full-resolution passes accumulated (0 for a preview)
+    int target_spp = 1;
+    double seconds = 0;      // render time of this generation so far (pauses excluded)
+    double full_seconds = 0; // of which full-resolution passes
+    uint64_t rays = 0;       // rays of the full-resolution passes
+    double relative_error = 0;  // RenderState::relative_error() of the accumulation
+    uint64_t nonfinite_samples = 0;
+    bool finished = false;   // target reached (and not unlimited)
+};
+
+// Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
+// to full resolution. first_scale is the smallest power of two (up to 16) whose pass is
+// predicted to take under `budget_seconds`, from the measured cost of a pixel sample;
+// 8 when nothing has been measured yet. Steps are skipped once a full pass is cheap.
+std::vector<int> preview_scales(int width, int height, double seconds_per_pixel, double budget_seconds);
+
+class RenderWorker {
+public:
+    // `on_publish` runs on the render thread after each snapshot (the window passes
+    // glfwPostEmptyEvent, thread-safe, to wake its event wait): it must not touch GL.
+    explicit RenderWorker(std::function<void()> on_publish = {});
+    ~RenderWorker();  // stops the pass in flight and joins
+    RenderWorker(const RenderWorker&) = delete;
+    RenderWorker& operator=(const RenderWorker&) = delete;
+
+    // Restarts at once: stops the running pass (at its next row) and renders `job` from
+    // scratch, low-resolution previews first.
+    void submit(RenderJob job);
+    // Neither resets the estimate. Pausing takes effect at the end of the running pass,
+    // so the accumulated passes stay whole (and the image deterministic).
+    void set_paused(bool paused);
+    void set_unlimited(bool unlimited);
+
+    // The newest frame (null before the first).
+    std::shared_ptr<const Snapshot> latest() const;
+    // Blocks until a frame newer than `serial` is published or `timeout` passes.
+    std::shared_ptr<const Snapshot> wait_newer(uint64_t serial, std::chrono::milliseconds timeout) const;
+
+private:
+    void run();
+    void publish(std::shared_ptr<Snapshot> frame);
+
+    std::function<void()> on_publish_;
+    mutable std::mutex mutex_;
+    mutable std::condition_variable changed_;   // wakes the render thread
+    mutable std::condition_variable published_; // wakes waiters on frames
+    std::optional<RenderJob> pending_;
+    bool paused_ = false, unlimited_ = false, quit_ = false;
+    std::shared_ptr<const Snapshot> latest_;
+    uint64_t serial_ = 0;
+    std::atomic<bool> stop_{false};
+    std::thread thread_;  // last: starts after every member above exists
+};
+
+}  // namespace kr::viewer

@@ -1,0 +1,340 @@
+// The viewer's GL-free parts: the reset rule and generation counter, navigation,
+// click-to-focus, exact accumulation, the render thread's determinism, the file watch.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "render/camera.h"
+#include "scene/load.h"
+#include "test_util.h"
+#include "viewer/accumulator.h"
+#include "viewer/edit.h"
+#include "viewer/files.h"
+#include "viewer/model.h"
+#include "viewer/navigation.h"
+#include "viewer/render_worker.h"
+
+namespace fs = std::filesystem;
+using namespace kr;
+using namespace kr::viewer;
+
+namespace {
+
+fs::path scene_file(int n) {
+    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
+}
+
+ViewerModel model_of(int n) {
+    ViewerModel m;
+    m.load(scene_file(n));
+    return m;
+}
+
+}  // namespace
+
+TEST(ResetRule, ImageEditsResetDisplayEditsDoNot) {
+    for (Edit e : {Edit::camera, Edit::lens, Edit::light, Edit::material, Edit::renderer, Edit::scene})
+        EXPECT_TRUE(edit_resets(e)) << int(e);
+    EXPECT_FALSE(edit_resets(Edit::tone_map));
+    EXPECT_FALSE(edit_resets(Edit::run_control));
+}
+
+TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
+    ViewerModel m = model_of(3);
+    const uint64_t g0 = m.generation();
+    auto scene_before = m.prepared();
+
+    // Tone map: same generation, same prepared scene (the render keeps its samples).
+    ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) {
+        s.tone.op = ToneMap::linear;
+        s.tone.exposure = 4;
+    }));
+    EXPECT_EQ(m.generation(), g0);
+    EXPECT_EQ(m.prepared(), scene_before);
+    EXPECT_EQ(m.settings().tone.op, ToneMap::linear);
+    ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));
+    EXPECT_EQ(m.generation(), g0);
+
+    uint64_t g = g0;
+    auto expect_reset = [&](Edit kind, auto change) {
+        ASSERT_TRUE(m.edit(kind, change));
+        EXPECT_EQ(m.generation(), g + 1) << int(kind);
+        EXPECT_NE(m.prepared(), scene_before) << int(kind);  // rebuilt from the authored scene
+        g = m.generation();
+        scene_before = m.prepared();
+    };
+    expect_reset(Edit::camera, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].fov = 50; });
+    EXPECT_NEAR(m.prepared()->camera.tan_half_fov, std::tan(25 * kPi / 180), 1e-15);
+    expect_reset(Edit::lens, [](Scene& s, ViewerSettings&) {
+        s.cameras[size_t(s.camera)].type = CameraType::lens;
+        s.cameras[size_t(s.camera)].alpha = 0.5;
+    });
+    EXPECT_EQ(m.prepared()->camera.lens_radius, 0.5);
+    expect_reset(Edit::light, [](Scene& s, ViewerSettings&) { s.lights[size_t(s.active_lights[0])].power = Color(3); });
+    EXPECT_EQ(m.prepared()->area_lights[0].radiance, Color(3));
+    expect_reset(Edit::material, [](Scene& s, ViewerSettings&) { s.materials[0].rho = Color(0.1); });
+    expect_reset(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; });
+    EXPECT_EQ(m.settings().render.max_depth, 2);
+    // Tone map and pause survived every reset.
+    EXPECT_EQ(m.settings().tone.exposure, 4);
+    EXPECT_TRUE(m.settings().paused);
+}
+
+// Authored and prepared stay apart: an edit the renderer cannot take is undone whole.
+TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
+    ViewerModel m = model_of(3);
+    const uint64_t g = m.generation();
+    const Camera before = m.camera();
+    std::string error;
+    EXPECT_FALSE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) {
+        Camera& c = s.cameras[size_t(s.camera)];
+        c.position = c.target;
+    }, &error));
+    EXPECT_NE(error.find("position equals target"), std::string::npos) << error;
+    EXPECT_EQ(m.generation(), g);
+    EXPECT_EQ(m.camera().position, before.position);
+}
+
+TEST(ResetRule, SavedSceneCarriesRendererSettings) {
+    ViewerModel m = model_of(3);
+    ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) {
+        s.render.integrator = Integrator::wrt;
+        s.render.max_depth = 3;
+        s.render.target_spp = 7;
+    }));
+    const Scene saved = m.scene_for_saving();
+    EXPECT_EQ(saved.renderer.type, RendererType::wrt);
+    EXPECT_EQ(saved.renderer.depth, 3);
+    EXPECT_EQ(saved.renderer.samples, 7);
+}
+
+TEST(Navigation, OrbitKeepsDistanceAndTarget) {
+    Camera c;
+    c.position = {0, 0, -15};
+    c.target = {1, 2, 3};
+    const double r = length(c.position - c.target);
+    orbit(c, 30, 20);
+    EXPECT_NEAR(length(c.position - c.target), r, 1e-12);
+    EXPECT_EQ(c.target, Vec3(1, 2, 3));
+    // Pitch stops short of the pole, so the camera frame stays defined.
+    orbit(c, 0, 500);
+    EXPECT_LT((c.position - c.target).y / r, std::sin(89.5 * kPi / 180));
+    EXPECT_NO_THROW(CameraModel::from(c));
+}
+
+TEST(Navigation, PanMovesBothDollyKeepsDirection) {
+    Camera c;
+    c.position = {0, 0, -10};
+    c.target = {0, 0, 0};
+    pan_drag(c, 10, 0, 100);
+    EXPECT_NEAR(c.position.z, -10, 1e-12);
+    EXPECT_NEAR(c.position.x, c.target.x, 1e-12);
+    EXPECT_NE(c.position.x, 0);
+    dolly(c, 0.5);
+    EXPECT_NEAR(length(c.position - c.target), 5, 1e-12);
+}
+
+// Scene 3: the camera at z = -15 looks down +z; below the area light (which the centre
+// ray grazes), the far wall (a radius-500 sphere whose near side is about the plane z = 5)
+// is about 20 away along the view axis.
+TEST(ClickToFocus, DistanceAlongViewAxis) {
+    const RenderScene scene = prepare_scene(load_scene_file(scene_file(3)).scene);
+    const auto d = focus_distance(scene, 0.5, 0.6);
+    ASSERT_TRUE(d.has_value());
+    EXPECT_NEAR(*d, 20, 0.01);
+    // Along forward (the camera's focal-plane convention), not along the slanted ray.
+    const CameraRay r = scene.camera.generate(0.5, 0.6, 0.5, 0.5);
+    Ray ray;
+    ray.o = r.origin;
+    ray.d = r.direction;
+    Hit hit;
+    ASSERT_TRUE(scene.intersects(ray, hit));
+    EXPECT_NEAR(*d, hit.t * dot(r.direction, scene.camera.forward), 1e-12);
+    EXPECT_LT(*d, hit.t);
+}
+
+TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
+    ViewerModel m = model_of(3);
+    const uint64_t g = m.generation();
+    ASSERT_TRUE(m.focus_at(0.5, 0.6));
+    EXPECT_EQ(m.camera().type, CameraType::lens);
+    EXPECT_NEAR(m.camera().focal_distance, 20, 0.01);
+    EXPECT_EQ(m.generation(), g + 1);
+    // The pixel of the glass ball's centre (2, -3.5, -1), radius 1.5, focuses on its near
+    // surface: (|c - o| - r) along that ray, times the ray's cosine to the axis.
+    const CameraModel& cam = m.prepared()->camera;
+    const double fx = 0.5 + 2.0 / 14.0 / (2 * cam.tan_half_fov), fy = 0.5 + 3.5 / 14.0 / (2 * cam.tan_half_fov);
+    ASSERT_TRUE(m.focus_at(fx, fy));
+    const double to_centre = length(Vec3(2, -3.5, -1) - Vec3(0, 0, -15));
+    EXPECT_NEAR(m.camera().focal_distance, (to_centre - 1.5) * 14.0 / to_centre, 1e-9);
+}
+
+// 10^6 samples of 0.1 (not representable): a naive double sum drifts by 1.3e-11 relative,
+// the viewer's accumulation must not.
+TEST(Accumulation, NoDriftAfterAMillionSamples) {
+    Accumulator acc;
+    acc.reset(1, 1);
+    RenderState pass(1, 1);
+    pass.radiance_sum[0] = Color(0.1, 0.7, 1.0 / 3.0);
+    pass.sample_count[0] = 1;
+    for (int i = 0; i < 1000000; ++i) acc.add(pass);
+    const Color mean = acc.mean().pixels[0];
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], pass.radiance_sum[0][k], 1e-12 * pass.radiance_sum[0][k]);
+    EXPECT_EQ(acc.passes(), 1000000);
+    EXPECT_EQ(acc.totals().sample_count[0], 1000000u);
+}
+
+// The same through render_pass: the camera inside an emitter of radiance 0.1 with depth 0
+// sees exactly 0.1 in every sample.
+TEST(Accumulation, RenderPassPathStaysExact) {
+    test::SceneBuilder b;
+    b.scene.renderer.width = b.scene.renderer.height = 1;
+    b.emitter({0, 0, 0}, 100, Color(0.1, 0.3, 0.7), b.material(MaterialType::diffuse));
+    const RenderScene scene = b.build();
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.max_depth = 0;
+    settings.target_spp = 1;
+    Accumulator acc;
+    acc.reset(1, 1);
+    for (int i = 0; i < 1000000; ++i) ASSERT_TRUE(acc.render_pass(scene, settings));
+    const Color mean = acc.mean().pixels[0];
+    EXPECT_NEAR(mean.x, 0.1, 1e-12 * 0.1);
+    EXPECT_NEAR(mean.y, 0.3, 1e-12 * 0.3);
+    EXPECT_NEAR(mean.z, 0.7, 1e-12 * 0.7);
+}
+
+// The accumulator draws exactly the core renderer's samples: same RNG streams.
+TEST(Accumulation, MatchesPlainRenderPasses) {
+    const RenderScene scene = prepare_scene(load_scene_file(scene_file(4)).scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.target_spp = 4;
+    RenderScene small = scene;
+    small.renderer.width = small.renderer.height = 32;
+    RenderState plain(32, 32);
+    Accumulator acc;
+    acc.reset(32, 32);
+    for (int i = 0; i < 4; ++i) {
+        render_pass(small, settings, plain);
+        acc.render_pass(small, settings);
+    }
+    const Image a = plain.radiance(), b = acc.mean();
+    for (size_t i = 0; i < a.pixels.size(); ++i)
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(a.pixels[i][k], b.pixels[i][k], 1e-12 * (1 + a.pixels[i][k]));
+    EXPECT_EQ(acc.totals().rays, plain.rays);
+    EXPECT_NEAR(acc.totals().relative_error(), plain.relative_error(), 1e-9);
+}
+
+TEST(RenderThread, PreviewScalesFitTheBudget) {
+    EXPECT_EQ(preview_scales(512, 512, 0, 0.02), (std::vector<int>{8, 4, 2}));  // nothing measured yet
+    // 1 us per pixel sample: a full pass is 0.26 s; 1/4 is 16 ms.
+    EXPECT_EQ(preview_scales(512, 512, 1e-6, 0.02).front(), 4);
+    // Cheap scenes skip the preview ladder after its first step.
+    EXPECT_EQ(preview_scales(512, 512, 1e-8, 0.02), std::vector<int>{});
+    EXPECT_EQ(preview_scales(512, 512, 1e-4, 0.02).front(), 16);
+}
+
+// The worker's published frames are the deterministic estimate: at the target spp they
+// equal plain render passes, whatever the thread timing, edits and previews before.
+TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
+    Scene authored = load_scene_file(scene_file(8)).scene;
+    authored.renderer.width = 40;
+    authored.renderer.height = 30;
+    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 3;
+
+    RenderWorker worker;
+    worker.submit({1, scene, settings});
+    RenderSettings other = settings;
+    other.max_depth = 1;
+    worker.submit({2, scene, other});  // an edit at once: generation 1 may never show
+    worker.submit({3, scene, settings});
+    std::shared_ptr<const Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->generation == 3 && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->finished);
+    EXPECT_EQ(f->scale, 1);
+    EXPECT_EQ(f->spp, 3);
+
+    RenderState plain(40, 30);
+    for (int i = 0; i < 3; ++i) render_pass(*scene, settings, plain);
+    const Image expected = plain.radiance();
+    ASSERT_EQ(f->radiance.pixels.size(), expected.pixels.size());
+    for (size_t i = 0; i < expected.pixels.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            ASSERT_NEAR(f->radiance.pixels[i][k], expected.pixels[i][k], 1e-12 * (1 + expected.pixels[i][k]));
+    // It stops at the target: no newer frame comes.
+    const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
+    EXPECT_EQ(more->serial, f->serial);
+}
+
+TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
+    Scene authored = load_scene_file(scene_file(2)).scene;
+    authored.renderer.width = authored.renderer.height = 16;
+    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 2;
+    RenderWorker worker;
+    worker.submit({1, scene, settings});
+    std::shared_ptr<const Snapshot> f;
+    while (!(f && f->finished)) f = worker.wait_newer(f ? f->serial : 0, std::chrono::seconds(10));
+    worker.set_paused(true);
+    worker.set_unlimited(true);
+    // Paused: nothing new (at most the pass that was running when pause came).
+    const auto paused_frame = worker.wait_newer(f->serial, std::chrono::milliseconds(200));
+    const auto still = worker.wait_newer(paused_frame->serial, std::chrono::milliseconds(300));
+    EXPECT_EQ(still->serial, paused_frame->serial);
+    worker.set_paused(false);
+    const auto resumed = worker.wait_newer(still->serial, std::chrono::seconds(10));
+    EXPECT_GT(resumed->spp, 2);  // kept the 2 samples and went on
+    EXPECT_EQ(resumed->generation, 1u);
+}
+
+TEST(SceneWatch, BrokenFileKeepsTheLastGoodScene) {
+    const fs::path dir = fs::temp_directory_path() / ("keithray_watch_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path file = dir / "scene.json";
+    std::stringstream original;
+    original << std::ifstream(scene_file(2)).rdbuf();
+    std::ofstream(file) << original.str();
+
+    ViewerModel m;
+    m.load(file);
+    FileWatch watch(std::chrono::milliseconds(0));
+    watch.watch(file);
+    EXPECT_FALSE(watch.changed());
+    const uint64_t g = m.generation();
+    const Vec3 position = m.camera().position;
+
+    std::ofstream(file) << original.str().substr(0, original.str().size() / 2);  // a half-saved file
+    ASSERT_TRUE(watch.changed());
+    try {
+        m.load(file);
+        FAIL() << "a broken file loaded";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("scene.json"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(m.generation(), g);
+    EXPECT_TRUE(m.has_scene());
+    EXPECT_EQ(m.camera().position, position);
+    EXPECT_FALSE(watch.changed());  // one change, reported once
+
+    // Fixed in the editor, with the camera moved: the new scene replaces the last good one.
+    std::string fixed = original.str();
+    const size_t at = fixed.find("[0, 0, -15]");
+    ASSERT_NE(at, std::string::npos);
+    fixed.replace(at, 11, "[0, 0, -16]");
+    std::ofstream(file) << fixed;
+    ASSERT_TRUE(watch.changed());
+    EXPECT_NO_THROW(m.load(file));
+    EXPECT_EQ(m.generation(), g + 1);
+    EXPECT_EQ(m.camera().position, Vec3(0, 0, -16));
+    fs::remove_all(dir);
+}

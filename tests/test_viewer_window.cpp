@@ -1,0 +1,126 @@
+// The real window under Xvfb: `keithray view` with scripted edits (a lens, a mouse orbit,
+// a click-to-focus) accumulates N full-resolution passes, then reads back what the display
+// shader drew. That must equal the headless render of the same state, which the viewer
+// saves as JSON: deterministic seeding makes them equal up to float-vs-double rounding.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+
+#include "core/image.h"
+#include "scene/load.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ViewRun {
+    int status;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+
+int max_channel_difference(const kr::Rgb8Image& a, const kr::Rgb8Image& b) {
+    int worst = 0;
+    for (size_t i = 0; i < a.bytes.size(); ++i) worst = std::max(worst, std::abs(int(a.bytes[i]) - int(b.bytes[i])));
+    return worst;
+}
+
+class ViewerWindow : public testing::Test {
+protected:
+    fs::path dir;
+    void SetUp() override {
+        if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (scripts/setup.sh installs it)";
+        dir = fs::temp_directory_path() /
+              ("keithray_view_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+               std::to_string(::getpid()));
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    void TearDown() override {
+        if (!dir.empty()) fs::remove_all(dir);
+    }
+    static std::string scene(int n) {
+        return (fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json")).string();
+    }
+    ViewRun keithray(const std::string& args, bool window) {
+        // A screen big enough for the 512x512 image at 1:1 beside the panels.
+        const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24' " : "";
+        const std::string cmd = prefix + "'" + KEITHRAY_EXE + "' " + args + " >'" + (dir / "out").string() +
+                                "' 2>'" + (dir / "err").string() + "'";
+        const int raw = std::system(cmd.c_str());
+        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir / "out"), slurp(dir / "err")};
+    }
+};
+
+}  // namespace
+
+TEST_F(ViewerWindow, ScriptedEditsScreenshotMatchesHeadlessRender) {
+    const fs::path shot = dir / "shot.ppm", saved = dir / "edited.json", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(3) + "' --spp 3 --frames 3 --aperture 0.4 --orbit 60,-30"
+                           " --click-focus 300,400 --screenshot '" + shot.string() + "' --save-scene '" +
+                               saved.string() + "' --timeout 300",
+                           true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    EXPECT_NE(v.err.find("window GL:"), std::string::npos) << v.err;
+
+    // The edits reached the scene: a thin lens, orbited, focused where the script clicked.
+    const kr::Scene edited = kr::load_scene_file(saved).scene;
+    const kr::Camera& cam = edited.cameras[size_t(edited.camera)];
+    EXPECT_EQ(cam.type, kr::CameraType::lens);
+    EXPECT_EQ(cam.alpha, 0.4);
+    EXPECT_NE(cam.position, kr::Vec3(0, 0, -15));
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(v.out, m, std::regex("focal distance: ([0-9.e+-]+)"))) << v.out;
+    EXPECT_EQ(cam.focal_distance, std::stod(m[1]));
+    EXPECT_GT(cam.focal_distance, 1);
+    EXPECT_EQ(edited.renderer.samples, 3);
+
+    const ViewRun r = keithray("render '" + saved.string() + "' --spp 3 -q -o '" + headless.string() + "'", false);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const kr::Rgb8Image a = kr::read_ppm(shot), b = kr::read_ppm(headless);
+    ASSERT_EQ(a.width, b.width);
+    ASSERT_EQ(a.height, b.height);
+    EXPECT_LE(max_channel_difference(a, b), 1);
+    EXPECT_GT(kr::psnr(a, b), 60);
+    // And the edits changed the image: it is not the unedited view.
+    const ViewRun plain = keithray("render '" + scene(3) + "' --spp 3 -q -o '" + (dir / "plain.ppm").string() + "'", false);
+    ASSERT_EQ(plain.status, 0);
+    EXPECT_LT(kr::psnr(a, kr::read_ppm(dir / "plain.ppm")), 30);
+}
+
+// Tone map options go to the display shader only; the screenshot follows kr::tonemap.
+TEST_F(ViewerWindow, LinearToneMapScreenshotMatchesHeadless) {
+    const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(7) + "' --spp 2 --frames 2 --tonemap linear --screenshot '" +
+                               shot.string() + "' --timeout 300",
+                           true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    const ViewRun r = keithray("render '" + scene(7) + "' --spp 2 -q --tonemap linear -o '" + headless.string() + "'", false);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_LE(max_channel_difference(kr::read_ppm(shot), kr::read_ppm(headless)), 1);
+}
+
+TEST_F(ViewerWindow, BrokenSceneFailsScriptedRunWithItsError) {
+    const fs::path bad = dir / "bad.json";
+    std::ofstream(bad) << "{ \"scene\": ";
+    const ViewRun v = keithray("view '" + bad.string() + "' --frames 1 --screenshot '" + (dir / "x.ppm").string() + "'", true);
+    EXPECT_EQ(v.status, 1);
+    EXPECT_NE(v.err.find("bad.json"), std::string::npos) << v.err;
+    EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+}
