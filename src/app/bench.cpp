@@ -102,23 +102,6 @@ nlohmann::json stress_scene_json(int n, uint64_t seed) {
     return j;
 }
 
-std::vector<fs::path> all_scenes() {
-    std::vector<fs::path> dirs{"res/scenes"};
-#ifdef KEITHRAY_SCENES_DIR
-    dirs.emplace_back(KEITHRAY_SCENES_DIR);
-#endif
-    for (const fs::path& dir : dirs) {
-        std::error_code ec;
-        if (!fs::is_directory(dir, ec)) continue;
-        std::vector<fs::path> found;
-        for (const auto& entry : fs::directory_iterator(dir, ec))
-            if (entry.path().extension() == ".json") found.push_back(entry.path());
-        std::sort(found.begin(), found.end());
-        if (!found.empty()) return found;
-    }
-    return {};
-}
-
 struct BenchOptions {
     bool throughput = false, linear = false;
     std::vector<int> stress;
@@ -184,7 +167,7 @@ BenchOptions parse(int argc, char** argv) {
 }
 
 int bench_throughput(const BenchOptions& o) {
-    std::vector<fs::path> scenes = o.scenes.empty() ? all_scenes() : o.scenes;
+    std::vector<fs::path> scenes = o.scenes.empty() ? default_scenes() : o.scenes;
     std::printf("| scene | renderer | spp run | median s | Mrays/s | est. s at file spp | 1-spp pass ms |\n");
     std::printf("|---|---|---|---|---|---|---|\n");
     double total_estimate = 0;

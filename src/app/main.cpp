@@ -146,24 +146,6 @@ Options parse_options(int argc, char** argv) {
     return o;
 }
 
-// Every *.json in res/scenes: looked up from the working directory, then the source tree.
-std::vector<fs::path> default_scenes() {
-    std::vector<fs::path> dirs{"res/scenes"};
-#ifdef KEITHRAY_SCENES_DIR
-    dirs.emplace_back(KEITHRAY_SCENES_DIR);
-#endif
-    for (const fs::path& dir : dirs) {
-        std::error_code ec;
-        if (!fs::is_directory(dir, ec)) continue;
-        std::vector<fs::path> found;
-        for (const auto& entry : fs::directory_iterator(dir, ec))
-            if (entry.path().extension() == ".json") found.push_back(entry.path());
-        std::sort(found.begin(), found.end());
-        if (!found.empty()) return found;
-    }
-    return {};
-}
-
 std::string format_seconds(double s) {
     char buf[32];
     if (s < 60) std::snprintf(buf, sizeof buf, "%.1f s", s);
@@ -277,6 +259,24 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
 }
 
 }  // namespace
+
+// Every *.json in res/scenes: looked up from the working directory, then the source tree.
+std::vector<fs::path> kr::default_scenes() {
+    std::vector<fs::path> dirs{"res/scenes"};
+#ifdef KEITHRAY_SCENES_DIR
+    dirs.emplace_back(KEITHRAY_SCENES_DIR);
+#endif
+    for (const fs::path& dir : dirs) {
+        std::error_code ec;
+        if (!fs::is_directory(dir, ec)) continue;
+        std::vector<fs::path> found;
+        for (const auto& entry : fs::directory_iterator(dir, ec))
+            if (entry.path().extension() == ".json") found.push_back(entry.path());
+        std::sort(found.begin(), found.end());
+        if (!found.empty()) return found;
+    }
+    return {};
+}
 
 int main(int argc, char** argv) {
     const std::string command = argc > 1 ? argv[1] : "";
