@@ -166,3 +166,37 @@ TEST_F(Cli, NeverOverwritesTheSceneFile) {
     EXPECT_NE(r.err.find("overwrite"), std::string::npos) << r.err;
     EXPECT_EQ(slurp(scene), before);
 }
+
+TEST_F(Cli, StopRulesAndTheirErrors) {
+    const fs::path scene = write_scene("scene.json");
+    CliRun r = run("render '" + scene.string() + "' --integrator pt --time 0.2 -o '" + (dir / "t.ppm").string() + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("stopped by --time"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "t.ppm"));
+    r = run("render '" + scene.string() + "' --integrator pt --noise 0.05 --spp 4096 -o '" + (dir / "n.ppm").string() + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("stopped by --noise"), std::string::npos) << r.err;
+    for (const char* bad : {"--noise 0", "--noise -1", "--time abc", "--time"}) {
+        r = run("render '" + scene.string() + "' " + bad + " -o '" + (dir / "bad.ppm").string() + "'");
+        EXPECT_EQ(r.status, 2) << bad;
+        EXPECT_FALSE(fs::exists(dir / "bad.ppm")) << bad;
+    }
+}
+
+TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
+    const fs::path scene = write_scene("scene.json");
+    CliRun r = run("bench --throughput '" + scene.string() + "' --runs 1 --fraction 1");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("| scene |"), std::string::npos);
+    EXPECT_NE(r.out.find("Mrays/s"), std::string::npos);
+    r = run("bench --stress 20 --runs 1 --size 16");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("| 20 |"), std::string::npos) << r.out;
+    EXPECT_EQ(run("bench --bogus").status, 2);
+    EXPECT_EQ(run("bench").status, 2);
+    // --write-stress never overwrites.
+    EXPECT_EQ(run("bench --write-stress 5 '" + scene.string() + "'").status, 1);
+    EXPECT_EQ(run("bench --write-stress 5 '" + (dir / "s.json").string() + "'").status, 0);
+    r = run("render '" + (dir / "s.json").string() + "' --spp 1 -o '" + (dir / "s.ppm").string() + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+}
