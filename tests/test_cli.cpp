@@ -1,33 +1,23 @@
 // The keithray command line: flags, exit codes, outputs, and error messages.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "core/image.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int status;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using CliRun = kr::test::CommandResult;
+using kr::test::read_file;
 
 class Cli : public testing::Test {
 protected:
@@ -43,10 +33,7 @@ protected:
     void TearDown() override { fs::remove_all(dir); }
 
     CliRun run(const std::string& args) {
-        const std::string cmd = std::string("'") + KEITHRAY_EXE + "' " + args + " >'" + (dir / "stdout").string() +
-                                "' 2>'" + (dir / "stderr").string() + "'";
-        const int raw = std::system(cmd.c_str());
-        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir / "stdout"), slurp(dir / "stderr")};
+        return kr::test::run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
     }
 
     // A small valid scene: a diffuse ball under a point light, 16x12 pixels.
@@ -113,8 +100,8 @@ TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
     ASSERT_EQ(run(base + "1 -o '" + (dir / "a.ppm").string() + "'").status, 0);
     ASSERT_EQ(run(base + "2 -o '" + (dir / "b.ppm").string() + "'").status, 0);
     ASSERT_EQ(run(base + "2 --seed 7 -o '" + (dir / "c.ppm").string() + "'").status, 0);
-    EXPECT_EQ(slurp(dir / "a.ppm"), slurp(dir / "b.ppm"));
-    EXPECT_NE(slurp(dir / "a.ppm"), slurp(dir / "c.ppm"));
+    EXPECT_EQ(read_file(dir / "a.ppm"), read_file(dir / "b.ppm"));
+    EXPECT_NE(read_file(dir / "a.ppm"), read_file(dir / "c.ppm"));
     const CliRun linear = run(base + "2 --tonemap linear --blur 1 --estimator uniform -o '" + (dir / "d.ppm").string() + "'");
     EXPECT_EQ(linear.status, 0) << linear.err;
     // Linear tone mapping scales the brightest channel to 255.
@@ -160,11 +147,11 @@ TEST_F(Cli, DepthAbove20IsClampedWithAWarning) {
 
 TEST_F(Cli, NeverOverwritesTheSceneFile) {
     const fs::path scene = write_scene("self.json");
-    const std::string before = slurp(scene);
+    const std::string before = read_file(scene);
     const CliRun r = run("render '" + scene.string() + "' -o '" + scene.string() + "'");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("overwrite"), std::string::npos) << r.err;
-    EXPECT_EQ(slurp(scene), before);
+    EXPECT_EQ(read_file(scene), before);
 }
 
 TEST_F(Cli, StopRulesAndTheirErrors) {

@@ -1,7 +1,13 @@
 // Shared helpers for the test suite.
 #pragma once
 
+#include <sys/wait.h>
+
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -10,6 +16,26 @@
 #include "scene/scene.h"
 
 namespace kr::test {
+
+inline std::string read_file(const std::filesystem::path& p) {
+    std::ifstream f(p);
+    std::stringstream s;
+    s << f.rdbuf();
+    return s.str();
+}
+
+struct CommandResult {
+    int status;  // exit status, -1 if the command did not exit normally
+    std::string out, err;
+};
+
+// Runs a shell command with stdout and stderr captured in files under `dir`.
+inline CommandResult run_command(const std::string& command, const std::filesystem::path& dir) {
+    const std::string cmd =
+        command + " >'" + (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+    const int raw = std::system(cmd.c_str());
+    return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
+}
 
 // Upper critical value of the chi-square distribution with `dof` degrees of freedom at
 // significance `alpha` (Wilson-Hilferty; accurate to a few percent for dof >= 10).

@@ -4,34 +4,23 @@
 // saves as JSON: deterministic seeding makes them equal up to float-vs-double rounding.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 
 #include "core/image.h"
 #include "scene/load.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct ViewRun {
-    int status;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream f(p);
-    std::stringstream s;
-    s << f.rdbuf();
-    return s.str();
-}
+using ViewRun = kr::test::CommandResult;
 
 bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
@@ -61,10 +50,7 @@ protected:
     ViewRun keithray(const std::string& args, bool window) {
         // A screen big enough for the 512x512 image at 1:1 beside the panels.
         const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24' " : "";
-        const std::string cmd = prefix + "'" + KEITHRAY_EXE + "' " + args + " >'" + (dir / "out").string() +
-                                "' 2>'" + (dir / "err").string() + "'";
-        const int raw = std::system(cmd.c_str());
-        return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, slurp(dir / "out"), slurp(dir / "err")};
+        return kr::test::run_command(prefix + "'" + KEITHRAY_EXE + "' " + args, dir);
     }
 };
 

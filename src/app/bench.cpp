@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <omp.h>
 
+#include "core/args.h"
 #include "render/render.h"
 #include "scene/load.h"
 
@@ -112,30 +113,12 @@ struct BenchOptions {
     int runs = 3, threads = 0, size = 256;
 };
 
-struct BadUsage {
-    std::string message;
-};
-
-double parse_number(const std::string& flag, const std::string& text, double lo, double hi) {
-    size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (text.empty() || used != text.size() || !(v >= lo && v <= hi))
-        throw BadUsage{flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                       "], got \"" + text + "\""};
-    return v;
-}
-
 BenchOptions parse(int argc, char** argv) {
     BenchOptions o;
     for (int i = 2; i < argc; ++i) {
         const std::string arg = argv[i];
         auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw BadUsage{arg + " needs a value"};
+            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
             return argv[++i];
         };
         if (arg == "--throughput") o.throughput = true;
@@ -157,12 +140,12 @@ BenchOptions parse(int argc, char** argv) {
         } else if (arg == "--write-stress") {
             o.write_stress = int(parse_number(arg, value(), 1, 1e7));
             o.write_path = value();
-        } else if (arg == "-h" || arg == "--help") throw BadUsage{""};
-        else if (!arg.empty() && arg[0] == '-') throw BadUsage{"unknown option " + arg};
+        } else if (arg == "-h" || arg == "--help") throw UsageError{""};
+        else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
         else o.scenes.emplace_back(arg);
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)
-        throw BadUsage{"choose --throughput, --stress or --write-stress"};
+        throw UsageError{"choose --throughput, --stress or --write-stress"};
     return o;
 }
 
@@ -235,7 +218,7 @@ int run_bench(int argc, char** argv) {
     BenchOptions o;
     try {
         o = parse(argc, argv);
-    } catch (const BadUsage& e) {
+    } catch (const UsageError& e) {
         if (!e.message.empty()) std::fprintf(stderr, "error: %s\n", e.message.c_str());
         std::fprintf(e.message.empty() ? stdout : stderr, "%s", kBenchUsage);
         return e.message.empty() ? 0 : 2;

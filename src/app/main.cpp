@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "app/bench.h"
+#include "core/args.h"
 #include "core/image.h"
 #include "render/render.h"
 #include "scene/load.h"
@@ -80,31 +81,6 @@ struct Options {
     bool gl = false;  // tone map on the viewer's display path (OSMesa)
 };
 
-struct UsageError {
-    std::string message;
-};
-
-long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi) {
-    size_t used = 0;
-    long long value = 0;
-    try {
-        value = std::stoll(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != text.size() || text.empty() || value < lo || value > hi)
-        throw UsageError{flag + " expects an integer in [" + std::to_string(lo) + ", " +
-                         std::to_string(hi) + "], got \"" + text + "\""};
-    return value;
-}
-
-template <typename Names>
-auto parse_name(const std::string& flag, const std::string& text, const Names& names) {
-    const auto value = names.parse(text);
-    if (!value) throw UsageError{flag + " expects " + names.list() + ", got \"" + text + "\""};
-    return *value;
-}
-
 Options parse_options(int argc, char** argv) {
     Options o;
     for (int i = 2; i < argc; ++i) {
@@ -114,19 +90,8 @@ Options parse_options(int argc, char** argv) {
             return argv[++i];
         };
         if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
-        else if (arg == "--time" || arg == "--noise") {
-            const std::string text = value();
-            size_t used = 0;
-            double v = 0;
-            try {
-                v = std::stod(text, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (text.empty() || used != text.size() || !(v > 0 && v < 1e9))
-                throw UsageError{arg + " expects a positive number, got \"" + text + "\""};
-            (arg == "--time" ? o.time_limit : o.noise) = v;
-        }
+        else if (arg == "--time") o.time_limit = parse_positive(arg, value());
+        else if (arg == "--noise") o.noise = parse_positive(arg, value());
         else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, 1000));
         else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, 4096));
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, 4096));

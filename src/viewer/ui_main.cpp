@@ -3,6 +3,7 @@
 #include <exception>
 #include <string>
 
+#include "core/args.h"
 #include "viewer/ui_app.h"
 #include "viewer/viewer.h"
 
@@ -38,31 +39,6 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --measure-latency N   time N orbit edits from the edit to the first frame on screen
   --timeout S           fail a scripted run after S seconds (default 600)
 )";
-
-struct UsageError {
-    std::string message;
-};
-
-template <typename Names>
-auto parse_name(const std::string& flag, const std::string& text, const Names& names) {
-    const auto value = names.parse(text);
-    if (!value) throw UsageError{flag + " expects " + names.list() + ", got \"" + text + "\""};
-    return *value;
-}
-
-double parse_number(const std::string& flag, const std::string& text, double lo, double hi) {
-    size_t used = 0;
-    double v = 0;
-    try {
-        v = std::stod(text, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (text.empty() || used != text.size() || !(v >= lo && v <= hi))
-        throw UsageError{flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                         "], got \"" + text + "\""};
-    return v;
-}
 
 int parse_int(const std::string& flag, const std::string& text, int lo, int hi) {
     const double v = parse_number(flag, text, lo, hi);

@@ -1,0 +1,63 @@
+// Command-line value parsing shared by `keithray render`, `bench` and `view`: the whole
+// text must be the value, and a bad one becomes a UsageError naming the flag.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace kr {
+
+struct UsageError {
+    std::string message;
+};
+
+// True if all of `text` reads as a number (stored in `value`).
+inline bool read_number(const std::string& text, double& value) {
+    size_t used = 0;
+    try {
+        value = std::stod(text, &used);
+    } catch (const std::exception&) {
+        return false;
+    }
+    return !text.empty() && used == text.size();
+}
+
+inline double parse_number(const std::string& flag, const std::string& text, double lo, double hi) {
+    double v = 0;
+    if (!read_number(text, v) || !(v >= lo && v <= hi))
+        throw UsageError{flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], got \"" + text + "\""};
+    return v;
+}
+
+// A number in (0, 1e9): durations and error targets.
+inline double parse_positive(const std::string& flag, const std::string& text) {
+    double v = 0;
+    if (!read_number(text, v) || !(v > 0 && v < 1e9))
+        throw UsageError{flag + " expects a positive number, got \"" + text + "\""};
+    return v;
+}
+
+inline long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi) {
+    size_t used = 0;
+    long long value = 0;
+    try {
+        value = std::stoll(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != text.size() || text.empty() || value < lo || value > hi)
+        throw UsageError{flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], got \"" + text + "\""};
+    return value;
+}
+
+// One of an EnumNames table's names.
+template <typename Names>
+auto parse_name(const std::string& flag, const std::string& text, const Names& names) {
+    const auto value = names.parse(text);
+    if (!value) throw UsageError{flag + " expects " + names.list() + ", got \"" + text + "\""};
+    return *value;
+}
+
+}  // namespace kr
