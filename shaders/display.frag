@@ -12,7 +12,10 @@ out vec4 colour;
 
 void main() {
     vec3 v = texture(radiance, uv).rgb;
-    vec3 mapped = op == 0 ? (v * exposure) / (1.0 + v * exposure) : v * inv_max;
+    vec3 e = v * exposure;
+    // inf / (1 + inf) is NaN in GLSL: radiance beyond float range saturates, as in the core.
+    vec3 sigmoid = mix(e / (1.0 + e), vec3(1.0), isinf(e));
+    vec3 mapped = op == 0 ? sigmoid : v * inv_max;
     // kr::quantize_unit: !(v > 0) -> 0 (NaN included), v >= 1 -> 255, else round(v * 255).
     vec3 unit = clamp(mapped, 0.0, 1.0);
     unit = mix(vec3(0.0), unit, greaterThan(mapped, vec3(0.0)));

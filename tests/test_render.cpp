@@ -21,8 +21,8 @@ Estimate estimate(const RenderScene& scene, const RenderSettings& settings, cons
     Color sum;
     double sum_l = 0, sum_l2 = 0;
     for (int i = 0; i < n; ++i) {
-        Rng rng = Rng::for_sample(settings.seed, 0, uint64_t(i));
-        const SampleResult r = trace_sample(scene, settings, ray, rng);
+        Sampler sampler(Rng::for_sample(settings.seed, 0, uint64_t(i)));
+        const SampleResult r = trace_sample(scene, settings, ray, sampler);
         sum += r.radiance;
         const double l = luminance(r.radiance);
         sum_l += l;

@@ -202,9 +202,8 @@ TEST(Sampling, StratifiedEstimatorCoversEveryStratum) {
     for (int target : {1, 4, 8, 9, 36, 50}) {
         const int e = int(std::sqrt(double(target)));
         std::vector<int> hits(e * e, 0);
-        Rng rng(1, 1);
         for (int i = 0; i < e * e; ++i) {
-            const Vec2 s = pixel_sample(Estimator::stratified, i, target, rng);
+            const Vec2 s = Sampler(Estimator::stratified, 1, 0, i, target).pixel();
             ASSERT_GE(s.x, 0);
             ASSERT_LT(s.x, 1);
             hits[int(s.y * e) * e + int(s.x * e)] += 1;
@@ -212,7 +211,7 @@ TEST(Sampling, StratifiedEstimatorCoversEveryStratum) {
         for (int h : hits) EXPECT_EQ(h, 1) << "target " << target;
         // Samples past e^2 (non-square counts) are uniform over the pixel.
         for (int i = e * e; i < target; ++i) {
-            const Vec2 s = pixel_sample(Estimator::stratified, i, target, rng);
+            const Vec2 s = Sampler(Estimator::stratified, 1, 0, i, target).pixel();
             EXPECT_TRUE(s.x >= 0 && s.x < 1 && s.y >= 0 && s.y < 1);
         }
     }
@@ -230,8 +229,7 @@ TEST(Sampling, EstimatorsAreUnbiasedAndStratifiedIsBetter) {
         for (int t = 0; t < kTrials; ++t) {
             double sum = 0;
             for (int i = 0; i < kSpp; ++i) {
-                Rng rng = Rng::for_sample(3, t, i);
-                sum += f(pixel_sample(est, i, kSpp, rng));
+                sum += f(Sampler(est, 3, t, i, kSpp).pixel());
             }
             const double estimate = sum / kSpp;
             mean[int(est)] += estimate / kTrials;
@@ -279,4 +277,85 @@ TEST(Sampling, SinCosTurnsMatchesLibm) {
         worst = std::max({worst, std::abs(s - std::sin(2 * kPi * t)), std::abs(c - std::cos(2 * kPi * t))});
     }
     EXPECT_LT(worst, 2e-15);
+}
+
+// The brief's light integral, int over the hemisphere facing p of cos_i cos_axis / dist^2 dA,
+// by midpoint quadrature in (theta, phi) about the axis, with rings crowded towards the pole
+// (theta = pi/2 t^2) where the integrand peaks for a close receiver.
+double brief_integral_quadrature(const SphereGeom& light, const Vec3& p, const Vec3& n_receiver) {
+    const Vec3 axis = normalize(p - light.centre);
+    const Frame frame = Frame::from_normal(axis);
+    constexpr int kRings = 3000, kSectors = 360;
+    double sum = 0;
+    for (int i = 0; i < kRings; ++i) {
+        const double t = (i + 0.5) / kRings, theta = 0.5 * kPi * t * t, dtheta = kPi * t / kRings;
+        for (int j = 0; j < kSectors; ++j) {
+            const double phi = 2 * kPi * (j + 0.5) / kSectors;
+            const Vec3 n = frame.to_world({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
+            const Vec3 w = light.centre + light.radius * n - p;
+            const double d2 = dot(w, w);
+            const double cos_i = std::max(0.0, dot(w, n_receiver) / std::sqrt(d2));
+            // dA = r^2 sin(theta) dtheta dphi.
+            sum += cos_i * std::cos(theta) / d2 * std::sin(theta) * dtheta;
+        }
+    }
+    return sum * light.radius * light.radius * (2 * kPi / kSectors);
+}
+
+// One-sample mean and standard deviation of an estimator over n samples.
+struct Moments {
+    double mean, sd;
+};
+template <typename F>
+Moments moments(F sample, int n) {
+    double sum = 0, sum_sq = 0;
+    for (int i = 0; i < n; ++i) {
+        const double v = sample();
+        sum += v;
+        sum_sq += v * v;
+    }
+    const double mean = sum / n;
+    return {mean, std::sqrt(std::max(0.0, sum_sq / n - mean * mean))};
+}
+
+// The brief's light estimator draws its points in proportion to cos_axis / dist^2: the same
+// integral as the brief's uniform hemisphere sampling, from just above the surface to far
+// away, with a weight that varies only with the receiver's cosine.
+TEST(Sampling, BriefLightImportanceSamplingKeepsTheBriefIntegral) {
+    const SphereGeom light{{0, 0, 0}, 1};
+    constexpr int kN = 200000;
+    for (double distance : {1.02, 1.3, 3.0, 10.0}) {
+        for (double tilt : {0.0, 1.2}) {
+            const Vec3 p{0, distance, 0};
+            const Vec3 n_receiver = normalize(Vec3{std::sin(tilt), -std::cos(tilt), 0});
+            const double exact = brief_integral_quadrature(light, p, n_receiver);
+            Rng rng(11, 3);
+            const Moments importance = moments([&] {
+                LightSample ls;
+                const double u1 = rng.next(), u2 = rng.next();
+                if (!sample_sphere_light(light, p, LightSampling::brief, u1, u2, ls)) return 0.0;
+                return std::max(0.0, dot(ls.wi, n_receiver)) / ls.pdf;
+            }, kN);
+            // The brief's own sampling: y uniform on the facing hemisphere, weight
+            // cos_i cos_axis (A/2) / dist^2.
+            const Moments hemisphere = moments([&] {
+                const double u1 = rng.next(), u2 = rng.next();
+                Vec3 n = sample_uniform_sphere(u1, u2);
+                if (n.y < 0) n = -n;
+                const Vec3 w = light.centre + n - p;
+                const double d2 = dot(w, w);
+                return std::max(0.0, dot(w, n_receiver) / std::sqrt(d2)) * n.y * (2 * kPi) / d2;
+            }, kN);
+            EXPECT_NEAR(importance.mean, exact, 4 * importance.sd / std::sqrt(double(kN)) + 2e-3 * exact)
+                << "distance " << distance << " tilt " << tilt;
+            // Close to the light the hemisphere sampling is too heavy-tailed for its sample
+            // mean to be checked (at 1.02 radii its standard deviation is 15x the mean's).
+            if (distance >= 3)
+                EXPECT_NEAR(hemisphere.mean, exact, 4 * hemisphere.sd / std::sqrt(double(kN)) + 2e-3 * exact)
+                    << "distance " << distance << " tilt " << tilt;
+            EXPECT_LT(importance.sd, hemisphere.sd) << "distance " << distance << " tilt " << tilt;
+            // Facing the light straight on, cos_i stays near 1 over the small far cap.
+            if (tilt == 0 && distance >= 3) EXPECT_LT(importance.sd, 0.1 * importance.mean) << "distance " << distance;
+        }
+    }
 }

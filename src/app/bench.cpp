@@ -28,6 +28,7 @@ constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear]
   keithray bench --stress N[,N...] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
+  keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
 --throughput  renders each scene (default: every res/scenes/*.json) at F times its own
               sample count (default F = 1/32, at least 1 spp), --runs times (default 3),
@@ -145,7 +146,7 @@ BenchOptions parse(int argc, char** argv) {
         else o.scenes.emplace_back(arg);
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)
-        throw UsageError{"choose --throughput, --stress or --write-stress"};
+        throw UsageError{"choose --throughput, --stress, --write-stress or --convergence"};
     return o;
 }
 
@@ -215,6 +216,8 @@ int bench_stress(const BenchOptions& o) {
 }  // namespace
 
 int run_bench(int argc, char** argv) {
+    for (int i = 2; i < argc; ++i)
+        if (std::string(argv[i]) == "--convergence") return bench_convergence(argc, argv);
     BenchOptions o;
     try {
         o = parse(argc, argv);

@@ -12,4 +12,8 @@ std::vector<std::filesystem::path> default_scenes();
 // argv[1] is "bench". Returns the process exit status.
 int run_bench(int argc, char** argv);
 
+// `keithray bench --convergence ...` (convergence.cpp): error against a converged reference
+// as samples and seconds grow, per configuration.
+int bench_convergence(int argc, char** argv);
+
 }  // namespace kr

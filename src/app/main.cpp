@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <unistd.h>
 
 #include "app/bench.h"
+#include "app/progress.h"
 #include "core/args.h"
 #include "core/image.h"
 #include "render/render.h"
@@ -45,10 +47,13 @@ Options:
                         below X (e.g. 0.01); adaptive: passes go to the noisiest pixels
   --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
                         pt-naive samples no area light, only point lights)
-  --estimator NAME      primary samples: uniform | stratified (default: stratified)
-  --light-sampling NAME spherical lights: brief | cone | area (default: brief, the
-                        estimator of the brief's reference images; cone and area are
-                        exact, see docs/fidelity.md)
+  --estimator NAME      where samples come from: uniform | stratified | sobol
+                        (default: sobol, Owen-scrambled Sobol in every dimension;
+                        stratified is the brief's sub-pixel strata; docs/accuracy.md)
+  --light-sampling NAME spherical lights: brief | brief-area | cone | area (default:
+                        brief, the integral of the brief's reference images, importance
+                        sampled; brief-area is the brief's own uniform sampling of it;
+                        cone and area are exact: docs/fidelity.md, docs/accuracy.md)
   --depth N             maximum ray depth, 0..20 (default: the file's "depth")
   --tonemap NAME        sigmoid | linear (default: sigmoid)
   --gl                  tone map through the viewer's GLSL display shaders in an
@@ -111,28 +116,19 @@ Options parse_options(int argc, char** argv) {
     return o;
 }
 
-std::string format_seconds(double s) {
-    char buf[32];
-    if (s < 60) std::snprintf(buf, sizeof buf, "%.1f s", s);
-    else std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
-    return buf;
-}
-
-void draw_progress(int done, int total, double elapsed) {
-    constexpr int kWidth = 30;
-    const double fraction = total > 0 ? double(done) / total : 1.0;
-    const int filled = int(fraction * kWidth);
-    std::string bar(filled, '=');
-    if (filled < kWidth) bar += '>' + std::string(kWidth - filled - 1, ' ');
-    const std::string eta = done > 0 ? format_seconds(elapsed * (total - done) / done) : "?";
-    std::fprintf(stderr, "\r  [%s] %3d%%  %d/%d spp  %s  ETA %s   ", bar.c_str(), int(fraction * 100),
-                 done, total, format_seconds(elapsed).c_str(), eta.c_str());
-    std::fflush(stderr);
-}
-
+// Whether writing path `a` would replace the existing file `b`: the same file under another
+// name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
+// through a folder x that does not exist yet (write_ppm would create it).
 bool same_file(const fs::path& a, const fs::path& b) {
     std::error_code ec;
-    return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec);
+    if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
+    auto resolved = [](const fs::path& p) {
+        std::error_code e;
+        const fs::path absolute = fs::absolute(p, e);
+        const fs::path canonical = fs::weakly_canonical(absolute, e);
+        return e ? absolute.lexically_normal() : canonical;
+    };
+    return resolved(a) == resolved(b);
 }
 
 // Loads, renders and writes one scene. Returns false (after printing why) on failure.
@@ -165,13 +161,25 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
     const fs::path depth_output = depth_path_for(output);
-    if (same_file(output, scene_file) || same_file(depth_output, scene_file)) {
-        std::fprintf(stderr, "error: %s: the output would overwrite the scene file itself\n",
-                     output.string().c_str());
+    // No input of this command is ever overwritten: not this scene file, nor another one
+    // still to be rendered (nor one already rendered).
+    for (const fs::path& input : opt.scenes)
+        for (const fs::path& written : {output, depth_output})
+            if (same_file(written, input)) {
+                std::fprintf(stderr, "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
+                             scene_file.string().c_str(), written.string().c_str(), input.string().c_str(),
+                             same_file(input, scene_file) ? " itself" : "");
+                return false;
+            }
+
+    RenderState state;
+    try {
+        state.reset(scene.renderer.width, scene.renderer.height);
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "error: %s: not enough memory for the render state of a %dx%d image\n",
+                     scene_file.string().c_str(), scene.renderer.width, scene.renderer.height);
         return false;
     }
-
-    RenderState state(scene.renderer.width, scene.renderer.height);
     const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -188,7 +196,8 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
                              s.relative_error());
                 std::fflush(stderr);
             } else {
-                draw_progress(s.passes, settings.target_spp, elapsed());
+                draw_progress(double(s.passes) / settings.target_spp,
+                              std::to_string(s.passes) + "/" + std::to_string(settings.target_spp) + " spp", elapsed());
             }
             last_draw = elapsed();
         }
@@ -285,6 +294,13 @@ int main(int argc, char** argv) {
         }
     }
     bool ok = true;
-    for (const fs::path& scene : opt.scenes) ok = render_scene_file(scene, opt) && ok;
+    for (const fs::path& scene : opt.scenes) {
+        try {
+            ok = render_scene_file(scene, opt) && ok;
+        } catch (const std::exception& e) {  // e.g. out of memory tone mapping a huge image
+            std::fprintf(stderr, "error: %s: %s\n", scene.string().c_str(), e.what());
+            ok = false;
+        }
+    }
     return ok ? 0 : 1;
 }

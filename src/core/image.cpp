@@ -70,9 +70,7 @@ Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height)
     return out;
 }
 
-void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
-    if (image.bytes.size() != static_cast<size_t>(image.width) * image.height * 3)
-        throw std::runtime_error("write_ppm: image size does not match its pixel data");
+void write_file_atomic(const std::filesystem::path& path, const std::string& bytes) {
     const std::filesystem::path dir = path.parent_path();
     std::error_code ec;
     if (!dir.empty()) std::filesystem::create_directories(dir, ec);
@@ -82,9 +80,7 @@ void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
     {
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
         if (!f) throw std::runtime_error("cannot write " + tmp.string());
-        f << "P6\n" << image.width << ' ' << image.height << "\n255\n";
-        f.write(reinterpret_cast<const char*>(image.bytes.data()),
-                static_cast<std::streamsize>(image.bytes.size()));
+        f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         f.flush();
         if (!f) {
             f.close();
@@ -97,6 +93,14 @@ void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
         std::filesystem::remove(tmp, ec);
         throw std::runtime_error("cannot rename temporary file onto " + path.string());
     }
+}
+
+void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
+    if (image.bytes.size() != static_cast<size_t>(image.width) * image.height * 3)
+        throw std::runtime_error("write_ppm: image size does not match its pixel data");
+    std::string bytes = "P6\n" + std::to_string(image.width) + ' ' + std::to_string(image.height) + "\n255\n";
+    bytes.append(reinterpret_cast<const char*>(image.bytes.data()), image.bytes.size());
+    write_file_atomic(path, bytes);
 }
 
 Rgb8Image read_ppm(const std::filesystem::path& path) {

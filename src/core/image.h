@@ -38,7 +38,8 @@ Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure = 1.0);
 
 // One channel value of the tone maps above, before quantisation, for callers
 // that tone map themselves (the viewer's shader mirrors this).
-inline double sigmoid_tonemap(double v) { return v / (1.0 + v); }
+// +inf (an overflowed pixel sum) saturates to 1 like any huge value, where inf/inf would be NaN.
+inline double sigmoid_tonemap(double v) { return std::isinf(v) && v > 0 ? 1.0 : v / (1.0 + v); }
 uint8_t quantize_unit(double v);  // clamp to [0,1], x255, round
 
 // Box blur of half-width `radius` pixels (a (2r+1)^2 box, clamped at the borders),
@@ -47,6 +48,11 @@ Image box_blur(const Image& src, int radius);
 
 // The brief's depth map: each pixel shows 1 - d/(1+d) as grey.
 Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height);
+
+// Writes `bytes` to a temporary file beside `path`, then renames it onto `path`: a reader
+// never sees a partial file, and a failed write leaves any old file intact. Throws
+// std::runtime_error.
+void write_file_atomic(const std::filesystem::path& path, const std::string& bytes);
 
 // Binary PPM (P6, maxval 255). Written to a temporary file beside `path` and renamed,
 // so a reader never sees a partial file. Throws std::runtime_error on failure.

@@ -30,6 +30,7 @@ struct Box {
 
 struct BuildItem {
     double lo[3], hi[3], centre[3];
+    double radius;  // kept exactly: (hi - lo) / 2 loses a tiny sphere far from the origin
     int id;
 };
 
@@ -45,7 +46,7 @@ struct Builder {
         // Largest first: big spheres (walls, floors) are candidates for almost every ray, so
         // grouping them leaves blocks of small ones that most rays skip whole.
         std::sort(items.begin() + begin, items.begin() + end, [](const BuildItem& a, const BuildItem& b) {
-            return a.hi[0] - a.lo[0] > b.hi[0] - b.lo[0] || (a.hi[0] - a.lo[0] == b.hi[0] - b.lo[0] && a.id < b.id);
+            return a.radius > b.radius || (a.radius == b.radius && a.id < b.id);
         });
         nodes[node].index = static_cast<uint32_t>(blocks.size());
         nodes[node].blocks = static_cast<uint16_t>(blocks_for(end - begin));
@@ -55,7 +56,7 @@ struct Builder {
                 const int k = first + lane;
                 if (k < end) {
                     const BuildItem& it = items[k];
-                    const double r = 0.5 * (it.hi[0] - it.lo[0]);
+                    const double r = it.radius;
                     b.cx[lane] = it.centre[0];
                     b.cy[lane] = it.centre[1];
                     b.cz[lane] = it.centre[2];
@@ -171,7 +172,9 @@ inline v4d select4(v4l mask, v4d a, v4d b) { return mask ? a : b; }
 
 // Accepted distance of each lane's sphere for `ray` within [ray.tmin, tmax], or +inf.
 // The same root choice as the scalar sphere_roots + accept rules of render_scene.cpp,
-// written without branches so all four lanes go together.
+// written without branches so all four lanes go together. `shadow`: an any-hit query,
+// whose finite segment end gets the tolerance of kSegmentEndTolerance.
+template <bool kShadow>
 inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, const Ray& ray, double tmax) {
     const v4d inf = v4d{} + kInf, zero = v4d{};
     const v4d fx = ray.o.x - load4(b.cx), fy = ray.o.y - load4(b.cy), fz = ray.o.z - load4(b.cz);
@@ -193,9 +196,18 @@ inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, 
     const v4d q = -half_b - select4(half_b >= 0, root, -root);
     const v4d t0 = select4(q != 0, c / q, zero);
     const v4d t_near = select4(t0 < q, t0, q), t_far = select4(t0 < q, q, t0);
-    const v4l near_ok = ~origin & (t_near >= ray.tmin) & (t_near <= tmax);
-    const v4l far_origin_ok = ray.into_from_sphere ? (t_far > 0) : v4l{};
-    const v4l far_ok = (t_far >= ray.tmin) & (t_far <= tmax) & (~origin | far_origin_ok);
+    v4d end = v4d{} + tmax;
+    if constexpr (kShadow) {
+        if (tmax < kInf) {
+            const v4d fx_abs = select4(fx < 0, -fx, fx), fy_abs = select4(fy < 0, -fy, fy),
+                      fz_abs = select4(fz < 0, -fz, fz);
+            end = tmax - kSegmentEndTolerance * (fx_abs + fy_abs + fz_abs + tmax);
+        }
+    }
+    // Only roots ahead of the origin (t > 0); the origin's own sphere only when entering it.
+    const v4l near_ok = ~origin & (t_near >= ray.tmin) & (t_near > 0) & (t_near <= end);
+    const v4l into = ray.into_from_sphere ? ~v4l{} : v4l{};
+    const v4l far_ok = (t_far >= ray.tmin) & (t_far > 0) & (t_far <= end) & (~origin | into);
     const v4d t = select4(near_ok, t_near, select4(far_ok, t_far, inf));
     const v4l rejected = ~candidate | (ids == static_cast<int64_t>(ray.to_sphere));
     return select4(rejected, inf, t);
@@ -242,7 +254,7 @@ inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& n
         const BvhNode& n = nodes[node];
         if (n.blocks > 0) {
             for (uint32_t k = 0; k < n.blocks; ++k) {
-                const v4d t = block_distances(blocks[n.index + k], ray, best);
+                const v4d t = block_distances<kAny>(blocks[n.index + k], ray, best);
                 for (int lane = 0; lane < 4; ++lane) {
                     // Lanes already passed t <= best; ties keep the first found.
                     if (t[lane] < kInf && (t[lane] < best || best_id < 0)) {
@@ -303,6 +315,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres) {
             it.lo[a] = c[a] - s.radius;
             it.hi[a] = c[a] + s.radius;
         }
+        it.radius = s.radius;
         it.id = static_cast<int>(i);
         builder.items.push_back(it);
     }

@@ -6,14 +6,31 @@
 
 namespace kr {
 
+namespace {
+
+// v / |v| without overflow or underflow in |v|^2: scaled by its largest component first, so
+// any finite non-zero vector has a direction (a view of 1e-310 or of 1e308). Returns false
+// for a zero or non-finite vector.
+bool unit_direction(const Vec3& v, Vec3& out) {
+    const double scale = max_abs_component(v);
+    if (!(scale > 0) || !std::isfinite(scale)) return false;
+    const Vec3 w(v.x / scale, v.y / scale, v.z / scale);  // not v * (1 / scale): 1 / 1e-310 overflows
+    out = w / length(w);
+    return true;
+}
+
+}  // namespace
+
 CameraModel CameraModel::from(const Camera& camera) {
     CameraModel m;
-    const Vec3 view = camera.target - camera.position;
-    const double view_length = length(view);
-    if (!(view_length > 0) || !std::isfinite(view_length))
+    if (!is_finite(camera.position) || !is_finite(camera.target))
+        throw std::invalid_argument("camera position and target must be finite");
+    if (camera.position == camera.target)
         throw std::invalid_argument("camera position equals target (no view direction)");
+    // Halves first: target - position overflows for points near +-1.8e308.
+    if (!unit_direction(0.5 * camera.target - 0.5 * camera.position, m.forward))
+        throw std::invalid_argument("camera position and target are too close to give a finite view direction");
     m.position = camera.position;
-    m.forward = view / view_length;
     // Left-handed: right = up x forward with up = +y. Looking straight up or down, that
     // cross product vanishes; then take the up the camera would have after tilting there
     // from a +z view (-z when looking up, +z when looking down).
@@ -38,10 +55,21 @@ CameraRay CameraModel::generate(double fx, double fy, double u1, double u2) cons
     const Vec3 dir = normalize(forward + px * right + py * up);
     if (lens_radius <= 0) return {position, dir};
     // Thin lens: every ray through the lens point meets the pinhole ray on the focal plane.
+    // Both points are taken relative to the camera position (the lens offset, and the focus
+    // point at focal_distance / cos along dir), so neither is lost against a large position;
+    // a focus point too far to be finite (focal distance near the largest double) gives rays
+    // parallel to the pinhole ray, its limit.
     const Vec2 lens = sample_concentric_disk(u1, u2);
-    const Vec3 origin = position + (lens_radius * lens.x) * right + (lens_radius * lens.y) * up;
-    const Vec3 focus = position + dir * (focal_distance / dot(dir, forward));
-    return {origin, normalize(focus - origin)};
+    const Vec3 offset = (lens_radius * lens.x) * right + (lens_radius * lens.y) * up;
+    const Vec3 origin = position + offset;
+    const double to_plane = focal_distance / dot(dir, forward);
+    Vec3 direction = dir;
+    if (std::isfinite(to_plane)) {
+        // Halves again so the difference of two finite vectors cannot overflow.
+        Vec3 towards;
+        if (unit_direction(dir * (0.5 * to_plane) - 0.5 * offset, towards)) direction = towards;
+    }
+    return {origin, direction};
 }
 
 }  // namespace kr

@@ -11,7 +11,7 @@ namespace {
 struct Tracer {
     const RenderScene& scene;
     const RenderSettings& settings;
-    Rng& rng;
+    Sampler& sampler;
     uint64_t rays = 0;
 
     bool intersect(const Ray& ray, Hit& hit) {
@@ -52,18 +52,18 @@ struct Tracer {
 
     // Light sample towards one area light; `mis` weights it against BSDF sampling.
     Color area_light_direct(const AreaLight& light, const Material& m, const Hit& hit,
-                            const SurfacePoint& sp, bool mis, double select_prob) {
+                            const SurfacePoint& sp, bool mis, double select_prob, Vec2 u) {
         if (light.sphere == hit.sphere) return {};  // a convex emitter cannot light itself
         LightSample ls;
         const SphereGeom& geom = scene.spheres[light.sphere];
-        if (!sample_sphere_light(geom, hit.p, settings.light_sampling, rng.next(), rng.next(), ls))
+        if (!sample_sphere_light(geom, hit.p, settings.light_sampling, u.x, u.y, ls))
             return {};
         const Color f_cos = eval_smooth(m, sp, ls.wi);
         if (is_black(f_cos)) return {};
         if (!visible(spawn(hit, ls.wi, ls.distance, light.sphere))) return {};
         double weight = 1;
-        if (mis) {
-            const double p_light = select_prob * ls.pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
+        if (mis && ls.mis_pdf > 0) {
+            const double p_light = select_prob * ls.mis_pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
             weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
         }
         return f_cos * light.radiance * (weight / (select_prob * ls.pdf));
@@ -87,14 +87,15 @@ struct Tracer {
                 for (const PointLight& light : scene.point_lights)
                     L += point_light_direct(light, m, hit, sp);
                 for (const AreaLight& light : scene.area_lights)
-                    L += area_light_direct(light, m, hit, sp, false, 1.0);
+                    L += area_light_direct(light, m, hit, sp, false, 1.0, sampler.next_2d());
                 break;
             case MaterialType::specular:
                 L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
                 break;
             case MaterialType::glossy: {
                 ScatterSample s;
-                if (sample_material(m, sp, ray.d, rng, s))
+                const double u_lobe = sampler.next_1d();
+                if (sample_material(m, sp, ray.d, u_lobe, sampler.next_2d(), s))
                     L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
                 break;
             }
@@ -104,11 +105,12 @@ struct Tracer {
                 const DielectricSplit split = split_dielectric(m, sp, ray.d);
                 const double beta = m.type == MaterialType::translucent ? m.roughness : 0.0;
                 const Vec3 ns = sp.ns();
-                Vec3 dir = perturb_direction(split.reflected, beta, rng.next(), rng.next());
+                const Vec2 u_reflect = sampler.next_2d(), u_transmit = sampler.next_2d();
+                Vec3 dir = perturb_direction(split.reflected, beta, u_reflect.x, u_reflect.y);
                 if (dot(dir, ns) > 0)
                     L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
                 if (split.reflectance < 1) {
-                    dir = perturb_direction(split.transmitted, beta, rng.next(), rng.next());
+                    dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
                     if (dot(dir, ns) < 0)
                         L += ((1 - split.reflectance) * m.rho_t) *
                              whitted(spawn(hit, dir), event + 1, nullptr);
@@ -137,14 +139,15 @@ struct Tracer {
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
                 double weight = 1;
-                if (!full_emission && hit.sphere != last_sphere && !is_exact(settings.light_sampling)) {
-                    weight = 0;  // the brief's estimator already counted this light at the last vertex
+                if (!full_emission && hit.sphere != last_sphere && !combines_with_bsdf(settings.light_sampling)) {
+                    weight = 0;  // the light sample at the last vertex counted all of this light
                 } else if (!full_emission && hit.sphere != last_sphere) {
-                    const double p_light =
-                        light.select_prob * sphere_light_pdf(scene.spheres[hit.sphere], last_p, ray.d,
-                                                             hit.t, hit.n, settings.light_sampling);
-                    weight = last_bsdf_pdf * last_bsdf_pdf /
-                             (last_bsdf_pdf * last_bsdf_pdf + p_light * p_light);
+                    // The light sample at the last vertex could have found this point too.
+                    const SphereGeom& geom = scene.spheres[hit.sphere];
+                    const double p_light = light.select_prob * sphere_light_pdf(geom, last_p, ray.d, hit.t, hit.n,
+                                                                                settings.light_sampling);
+                    weight = light_emission_scale(geom, last_p, ray.d, hit.n, settings.light_sampling) *
+                             last_bsdf_pdf * last_bsdf_pdf / (last_bsdf_pdf * last_bsdf_pdf + p_light * p_light);
                 }
                 L += throughput * light.radiance * weight;
             }
@@ -153,13 +156,21 @@ struct Tracer {
             const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
             const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
 
+            // Every vertex draws the same dimensions whatever its material, so each dimension
+            // of a low-discrepancy sampler keeps one meaning across the pixel's samples.
+            const double u_light_pick = sampler.next_1d();
+            const Vec2 u_light = sampler.next_2d();
+            const double u_lobe = sampler.next_1d();
+            const Vec2 u_bsdf = sampler.next_2d();
+            const double u_roulette = sampler.next_1d();
+
             // Next-event estimation: one light, chosen in proportion to its power.
             // Point lights cannot be hit by chance, so even naive mode samples them.
             if (has_smooth_lobe(m) && scene.light_count() > 0)
-                L += throughput * sample_one_light(m, hit, sp, naive);
+                L += throughput * sample_one_light(m, hit, sp, naive, u_light_pick, u_light);
 
             ScatterSample s;
-            if (!sample_material(m, sp, ray.d, rng, s)) break;
+            if (!sample_material(m, sp, ray.d, u_lobe, u_bsdf, s)) break;
             throughput *= s.weight;
             full_emission = naive || !s.smooth;
             last_bsdf_pdf = s.pdf;
@@ -170,15 +181,15 @@ struct Tracer {
             // Russian roulette with q = max(throughput) (brief), past the threshold depth.
             if (bounce + 1 >= settings.rr_depth) {
                 const double q = std::min(1.0, max_component(throughput));
-                if (!(rng.next() < q)) break;
+                if (!(u_roulette < q)) break;
                 throughput /= q;
             }
         }
         return L;
     }
 
-    Color sample_one_light(const Material& m, const Hit& hit, const SurfacePoint& sp, bool naive) {
-        double u = rng.next();
+    Color sample_one_light(const Material& m, const Hit& hit, const SurfacePoint& sp, bool naive, double u,
+                           Vec2 u_point) {
         for (const PointLight& light : scene.point_lights) {
             if (u < light.select_prob) return point_light_direct(light, m, hit, sp) / light.select_prob;
             u -= light.select_prob;
@@ -189,8 +200,7 @@ struct Tracer {
             const AreaLight& light = scene.area_lights[i];
             if (u < light.select_prob || i + 1 == scene.area_lights.size())
                 return light.select_prob > 0
-                           ? area_light_direct(light, m, hit, sp, is_exact(settings.light_sampling),
-                                               light.select_prob)
+                           ? area_light_direct(light, m, hit, sp, true, light.select_prob, u_point)
                            : Color();
             u -= light.select_prob;
         }
@@ -201,8 +211,8 @@ struct Tracer {
 }  // namespace
 
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
-                          Rng& rng) {
-    Tracer tracer{scene, settings, rng};
+                          Sampler& sampler) {
+    Tracer tracer{scene, settings, sampler};
     SampleResult result;
     result.radiance = settings.integrator == Integrator::wrt ? tracer.whitted(ray, 1, &result.primary_distance)
                                                              : tracer.path(ray, &result.primary_distance);

@@ -1,5 +1,8 @@
 #include "render/light.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/sampling.h"
 
 namespace kr {
@@ -15,6 +18,52 @@ double cone_one_minus_cos(double r2, double d2) {
 
 double sphere_area(const SphereGeom& s) { return 4.0 * kPi * s.radius * s.radius; }
 
+
+// h(v) = v - 1 + exp(-v) for v >= 0, without cancellation for small v.
+double exp_excess(double v) {
+    if (v < 1e-3) return v * v * (0.5 - v * (1.0 / 6 - v * (1.0 / 24 - v / 120)));
+    return v + std::expm1(-v);
+}
+
+// The distribution of the brief estimator's points: on the hemisphere of the light facing p,
+// density proportional to cos_axis / dist^2, where dist^2 = s = a - b cos_axis with
+// a = d^2 + r^2, b = 2 d r. Its CDF in u = cos_axis is (a / b^2) h(v) with v = ln(a / s)
+// (from int_0^u t / (a - b t) dt), so sampling solves h(v) = xi h(v_max) for v.
+struct BriefDistribution {
+    double a, b, r2, v_max, h_max;
+    BriefDistribution(const SphereGeom& light, double d)
+        : a(d * d + light.radius * light.radius),
+          b(2 * d * light.radius),
+          r2(light.radius * light.radius),
+          v_max(-std::log1p(-b / a)),  // ln(a / (d - r)^2)
+          h_max(exp_excess(v_max)) {}
+    // Z = int cos_axis / dist^2 dA over the hemisphere = 2 pi r^2 (a / b^2) h(v_max).
+    double normalisation() const { return 2 * kPi * r2 * a / (b * b) * h_max; }
+    double sample_cos(double xi) const {
+        // Newton steps on k(v) = sqrt(2 h(v)) = sqrt(2c), which is nearly linear (k ~ v for
+        // small v, ~ sqrt(2v) for large) and concave: from a start left of the root
+        // (h(v) <= v^2 / 2 and h(v) < v, so max(sqrt(2c), c) is), the steps stay left of it
+        // and converge monotonically, quadratically: once a step is below 1e-5 v the next
+        // would be below 1e-10 v, so it is the last (usually the second).
+        const double c = xi * h_max, target = std::sqrt(2 * c);
+        double v = std::max(target, c);
+        for (int iteration = 0; iteration < 20; ++iteration) {
+            const double em = std::expm1(-v);  // h(v) = v + em, h'(v) = -em
+            const double k = std::sqrt(2 * (v < 1e-3 ? exp_excess(v) : v + em));
+            if (!(k > 0)) break;
+            const double step = (target - k) * k / -em;  // (target - k) / k'
+            if (!(step > 1e-5 * v) || v + step >= v_max) {
+                // u = (a - s) / b = a (1 - exp(-v - step)) / b, from em without another exp:
+                // 1 - exp(-v - step) = -em + exp(-v) (1 - exp(-step)), the last by its series.
+                if (v + step >= v_max) return 1.0;
+                const double one_minus = -em + (1 + em) * step * (1 - step * (0.5 - step / 6));
+                return std::clamp(a * one_minus / b, 0.0, 1.0);
+            }
+            v += step;
+        }
+        return std::clamp(-a * std::expm1(-std::min(v, v_max)) / b, 0.0, 1.0);
+    }
+};
 }  // namespace
 
 bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling strategy, double u1,
@@ -23,7 +72,7 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
     const double d2 = dot(to_centre, to_centre);
     const double r2 = light.radius * light.radius;
     const bool outside = d2 > r2;
-    if (strategy == LightSampling::brief && outside) {
+    if (strategy == LightSampling::brief_area && outside) {
         // Uniform on the hemisphere facing p (density 2/A), cosine about its axis.
         const Vec3 axis = -to_centre / std::sqrt(d2);
         Vec3 n = sample_uniform_sphere(u1, u2);
@@ -35,6 +84,34 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
         out.wi = w / dist;
         out.distance = dist;
         out.pdf = dist * dist / (0.5 * sphere_area(light) * cos_axis);
+        out.mis_pdf = 0;
+        return true;
+    }
+    if (strategy == LightSampling::brief && outside) {
+        // The brief's integral over the hemisphere facing p, with the light-side cosine about
+        // that hemisphere's axis: E = int f L cos_i cos_axis / dist^2 dA(y). The brief draws y
+        // uniformly on the hemisphere, whose weight A cos_axis / (2 dist^2) explodes for
+        // shading points close to the light. Here y is drawn with density proportional to
+        // cos_axis / dist^2 itself, so the weight is the constant Z = int cos_axis / dist^2 dA:
+        // the same integral, with only cos_i and visibility left to vary.
+        const BriefDistribution dist_u(light, std::sqrt(d2));
+        const double cos_axis = dist_u.sample_cos(u1);
+        const double sin_axis = std::sqrt(std::max(0.0, 1.0 - cos_axis * cos_axis));
+        double sin_phi, cos_phi;
+        sin_cos_turns(u2, sin_phi, cos_phi);
+        const Vec3 axis = -to_centre / std::sqrt(d2);
+        const Vec3 n = Frame::from_normal(axis).to_world({sin_axis * cos_phi, sin_axis * sin_phi, cos_axis});
+        const Vec3 w = light.centre + light.radius * n - p;
+        const double dist = length(w);
+        if (!(dist > 0) || !(cos_axis > 0)) return false;
+        out.wi = w / dist;
+        out.distance = dist;
+        out.pdf = 1.0 / dist_u.normalisation();  // f L cos_axis / dist^2 / (density): f L Z
+        // BSDF sampling reaches the visible cap only, so only there are the two combined;
+        // the band behind the silhouette keeps this strategy's full weight (mis_pdf 0).
+        const double cos_light = -dot(n, out.wi);
+        const bool visible_cap = cos_axis * std::sqrt(d2) > light.radius && cos_light > 0;
+        out.mis_pdf = visible_cap ? cos_axis / (dist_u.normalisation() * cos_light) : 0.0;
         return true;
     }
     if (strategy == LightSampling::cone && outside) {
@@ -46,6 +123,7 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
         const double sin2 = local.x * local.x + local.y * local.y;
         out.distance = d * local.z - std::sqrt(std::max(0.0, r2 - d2 * sin2));
         out.pdf = uniform_cone_pdf(one_minus_cos_max);
+        out.mis_pdf = out.pdf;
         return out.distance > 0;
     }
     // Uniform over the area; from inside the sphere every point is visible.
@@ -61,6 +139,7 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
     out.wi = w;
     out.distance = dist;
     out.pdf = dist * dist / (sphere_area(light) * cos_abs);  // area density to solid angle
+    out.mis_pdf = out.pdf;
     return true;
 }
 
@@ -70,11 +149,30 @@ double sphere_light_pdf(const SphereGeom& light, const Vec3& p, const Vec3& wi, 
     const double d2 = dot(to_centre, to_centre);
     const double r2 = light.radius * light.radius;
     const bool outside = d2 > r2;
-    if (strategy == LightSampling::brief && outside) return 0;  // never MIS-weighted
-    if (strategy == LightSampling::cone && outside) return uniform_cone_pdf(cone_one_minus_cos(r2, d2));
     const double cos_abs = std::abs(dot(n_light, wi));
+    if (strategy == LightSampling::brief_area && outside) return 0;  // never combined
+    if (strategy == LightSampling::brief && outside) {
+        // Solid-angle density of the brief strategy's point at the (visible) hit:
+        // (cos_axis / dist^2 / Z) dist^2 / cos_light.
+        const double cos_axis = -dot(n_light, to_centre) / std::sqrt(d2);
+        if (!(cos_abs > 0) || !(cos_axis > 0)) return 0;
+        return cos_axis / (BriefDistribution(light, std::sqrt(d2)).normalisation() * cos_abs);
+    }
+    if (strategy == LightSampling::cone && outside) return uniform_cone_pdf(cone_one_minus_cos(r2, d2));
     if (!(cos_abs > 0)) return 0;
     return distance * distance / (sphere_area(light) * cos_abs);
+}
+
+double light_emission_scale(const SphereGeom& light, const Vec3& p, const Vec3& wi, const Vec3& n_light,
+                            LightSampling strategy) {
+    const Vec3 from_centre = p - light.centre;
+    const double d2 = dot(from_centre, from_centre);
+    if (!is_brief(strategy) || !(d2 > light.radius * light.radius)) return 1.0;
+    // The brief's integrand over the light's area has cos_axis where the exact one has the
+    // light-side cosine: in solid angle, L cos_axis / cos_light instead of L.
+    const double cos_axis = dot(n_light, from_centre) / std::sqrt(d2);
+    const double cos_light = std::abs(dot(n_light, wi));
+    return cos_light > 0 && cos_axis > 0 ? cos_axis / cos_light : 0.0;
 }
 
 }  // namespace kr

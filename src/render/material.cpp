@@ -27,12 +27,12 @@ DielectricSplit split_dielectric(const Material& m, const SurfacePoint& sp, cons
     return split;
 }
 
-bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, Rng& rng,
-                     ScatterSample& out) {
+bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, double u_lobe,
+                     Vec2 u, ScatterSample& out) {
     const Vec3 ns = sp.ns();
     switch (m.type) {
         case MaterialType::diffuse: {
-            const Vec3 local = sample_cosine_hemisphere(rng.next(), rng.next());
+            const Vec3 local = sample_cosine_hemisphere(u.x, u.y);
             out.direction = Frame::from_normal(ns).to_world(local);
             out.pdf = cosine_hemisphere_pdf(local.z);
             out.weight = m.rho;  // (rho/pi) cos / (cos/pi)
@@ -47,8 +47,7 @@ bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, 
         case MaterialType::glossy: {
             // Brief eq. 2: the mirror direction perturbed by roughness; weight rho, as the
             // lobe is sampled exactly by its own distribution.
-            const double u1 = rng.next(), u2 = rng.next();
-            out.direction = perturb_direction(reflect(wi, ns), m.roughness, u1, u2);
+            out.direction = perturb_direction(reflect(wi, ns), m.roughness, u.x, u.y);
             out.weight = m.rho;
             out.smooth = false;
             return dot(out.direction, ns) > 0;
@@ -57,16 +56,15 @@ bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, 
         case MaterialType::translucent: {
             const DielectricSplit split = split_dielectric(m, sp, wi);
             // Choose reflection with probability F: weights F rhoR / F and (1-F) rhoT / (1-F).
-            const bool reflect_branch = rng.next() < split.reflectance;
-            const double u1 = rng.next(), u2 = rng.next();
+            const bool reflect_branch = u_lobe < split.reflectance;
             const double beta = m.type == MaterialType::translucent ? m.roughness : 0.0;
             out.smooth = false;
             if (reflect_branch) {
-                out.direction = perturb_direction(split.reflected, beta, u1, u2);
+                out.direction = perturb_direction(split.reflected, beta, u.x, u.y);
                 out.weight = m.rho_r;
                 return dot(out.direction, ns) > 0;
             }
-            out.direction = perturb_direction(split.transmitted, beta, u1, u2);
+            out.direction = perturb_direction(split.transmitted, beta, u.x, u.y);
             out.weight = m.rho_t;
             return dot(out.direction, ns) < 0;
         }

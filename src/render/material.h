@@ -2,7 +2,7 @@
 #pragma once
 
 #include "core/math.h"
-#include "core/rng.h"
+#include "core/sampling.h"
 #include "scene/scene.h"
 
 namespace kr {
@@ -31,10 +31,11 @@ inline bool has_smooth_lobe(const Material& m) { return m.type == MaterialType::
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
 double pdf_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
 
-// Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface).
+// Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface),
+// from uniform numbers: `u_lobe` picks reflection or transmission, `u` the direction.
 // False when the path is absorbed (a perturbed direction fell on the wrong side).
-bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, Rng& rng,
-                     ScatterSample& out);
+bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, double u_lobe,
+                     Vec2 u, ScatterSample& out);
 
 // Fresnel split of a dielectric for a ray arriving along wi: reflectance and the two directions.
 struct DielectricSplit {

@@ -46,7 +46,9 @@ std::vector<double> RenderState::mean_depth() const {
 
 double RenderState::pixel_standard_error(size_t i) const {
     const double n = sample_count[i];
-    if (n < 2) return kInfinity;
+    // Below two samples there is no variance; a sum of squares that overflowed (radiance
+    // above ~1e154) would give inf - inf: the error is unknown, not zero.
+    if (n < 2 || !std::isfinite(luminance_sq_sum[i])) return kInfinity;
     const double mean = luminance(radiance_sum[i]) / n;
     // Unbiased sample variance of one sample, then of the mean of n.
     const double variance = std::max(0.0, (luminance_sq_sum[i] - n * mean * mean) / (n - 1));
@@ -99,16 +101,6 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
     return count;
 }
 
-Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng) {
-    const double u1 = rng.next(), u2 = rng.next();
-    if (estimator == Estimator::stratified) {
-        // Brief: e = floor(sqrt(s)); x_i = (w/e)(i mod e + xi1), y_i = (h/e)(floor(i/e) + xi2).
-        const int e = static_cast<int>(std::sqrt(static_cast<double>(std::max(target, 1))));
-        if (index < e * e) return {((index % e) + u1) / e, ((index / e) + u2) / e};
-    }
-    return {u1, u2};
-}
-
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop) {
     const int width = state.width, height = state.height;
@@ -124,18 +116,19 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         for (int x = 0; x < width; ++x) {
             const size_t pixel = static_cast<size_t>(y) * width + x;
             if (!state.active.empty() && !state.active[pixel]) continue;
-            const int index = static_cast<int>(state.sample_index[pixel]++);
-            Rng rng = Rng::for_sample(settings.seed, pixel, static_cast<uint64_t>(index));
-            const Vec2 sub = pixel_sample(settings.estimator, index, settings.target_spp, rng);
-            const double lens_u1 = rng.next(), lens_u2 = rng.next();
-            const CameraRay cr = scene.camera.generate((x + sub.x) / width, (y + sub.y) / height, lens_u1, lens_u2);
+            const uint32_t index = state.sample_index[pixel]++;
+            Sampler sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+            const Vec2 sub = sampler.pixel();
+            const Vec2 lens = sampler.next_2d();
+            const CameraRay cr = scene.camera.generate((x + sub.x) / width, (y + sub.y) / height, lens.x, lens.y);
             Ray ray;
             ray.o = cr.origin;
             ray.d = cr.direction;
-            const SampleResult r = trace_sample(scene, settings, ray, rng);
+            const SampleResult r = trace_sample(scene, settings, ray, sampler);
             rays += r.rays;
-            // A NaN or Inf sample is dropped and counted, never accumulated.
-            if (!is_finite(r.radiance)) {
+            // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
+            // would overflow the pixel's sum.
+            if (!is_finite(r.radiance) || !is_finite(state.radiance_sum[pixel] + r.radiance)) {
                 ++nonfinite;
                 continue;
             }

@@ -12,22 +12,19 @@
 #include "core/sampling.h"
 #include "render/light.h"
 #include "render/render_scene.h"
+#include "render/sampler.h"
 
 namespace kr {
 
 enum class Integrator { wrt, pt, pt_naive };
 inline constexpr EnumNames<Integrator, 3> integrator_names{{"wrt", "pt", "pt-naive"}};
 
-// How the sub-pixel position of each primary sample is chosen (brief, "Image Estimator").
-enum class Estimator { uniform, stratified };
-inline constexpr EnumNames<Estimator, 2> estimator_names{{"uniform", "stratified"}};
-
 // Distance recorded in the depth map for a primary ray that hits nothing.
 inline constexpr double kMissDepth = 1e6;
 
 struct RenderSettings {
     Integrator integrator = Integrator::pt;
-    Estimator estimator = Estimator::stratified;
+    Estimator estimator = Estimator::sobol;
     LightSampling light_sampling = LightSampling::brief;
     int max_depth = 6;          // scattering events per path, 0..kMaxDepth
     int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
@@ -103,12 +100,8 @@ struct SampleResult {
     double primary_distance = kMissDepth;
     uint64_t rays = 0;
 };
+// `sampler` has given the sub-pixel and lens numbers already (or none, for a hand-made ray).
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
-                          Rng& rng);
-
-// Sub-pixel position in [0,1)^2 of sample `index` of `target` for the given estimator.
-// Stratified: sample i < e^2 lies in stratum (i mod e, i / e); samples beyond e^2 (when the
-// count is not a square) are uniform.
-Vec2 pixel_sample(Estimator estimator, int index, int target, Rng& rng);
+                          Sampler& sampler);
 
 }  // namespace kr

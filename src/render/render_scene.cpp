@@ -28,15 +28,25 @@ bool sphere_roots(const SphereGeom& s, const Vec3& o, const Vec3& d, double& t_n
     return true;
 }
 
-// Root of sphere i accepted for this ray, or +inf. Applies the from/to sphere rules of Ray.
-static inline double accepted_root(const RenderScene& scene, int i, const Ray& ray) {
+double segment_end_tolerance(const Vec3& f, double tmax) {
+    return kSegmentEndTolerance * (std::abs(f.x) + std::abs(f.y) + std::abs(f.z) + tmax);
+}
+
+// Root of sphere i accepted for this ray, or +inf. Applies the from/to sphere rules of Ray,
+// takes only roots ahead of the origin (t > 0: a root at the origin is the surface a ray
+// starts on, such as a camera placed exactly on a sphere), and for a shadow segment leaves
+// out a crossing at its very end (see kSegmentEndTolerance).
+static inline double accepted_root(const RenderScene& scene, int i, const Ray& ray, bool shadow) {
     if (i == ray.to_sphere) return kInfinity;
     const bool is_origin = i == ray.from_sphere;
     if (is_origin && !ray.into_from_sphere) return kInfinity;
+    const SphereGeom& s = scene.spheres[i];
     double t_near, t_far;
-    if (!sphere_roots(scene.spheres[i], ray.o, ray.d, t_near, t_far)) return kInfinity;
-    if (!is_origin && t_near >= ray.tmin && t_near <= ray.tmax) return t_near;
-    if (t_far >= ray.tmin && t_far <= ray.tmax && (!is_origin || t_far > 0)) return t_far;
+    if (!sphere_roots(s, ray.o, ray.d, t_near, t_far)) return kInfinity;
+    const double tmax = shadow && ray.tmax < kInfinity ? ray.tmax - segment_end_tolerance(ray.o - s.centre, ray.tmax)
+                                                       : ray.tmax;
+    if (!is_origin && t_near >= ray.tmin && t_near > 0 && t_near <= tmax) return t_near;
+    if (t_far >= ray.tmin && t_far > 0 && t_far <= tmax) return t_far;
     return kInfinity;
 }
 
@@ -67,7 +77,7 @@ bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {
     double best = kInfinity;
     int best_sphere = -1;
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i) {
-        const double t = accepted_root(*this, i, ray);
+        const double t = accepted_root(*this, i, ray, false);
         if (t < best) {
             best = t;
             best_sphere = i;
@@ -80,7 +90,7 @@ bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {
 
 bool RenderScene::is_occluded_linear(const Ray& ray) const {
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i)
-        if (accepted_root(*this, i, ray) < kInfinity) return true;
+        if (accepted_root(*this, i, ray, true) < kInfinity) return true;
     return false;
 }
 
@@ -109,6 +119,9 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         return material_slot[m];
     };
 
+    std::vector<bool> active(scene.lights.size(), false);
+    for (int l : scene.active_lights) active[size_t(l)] = true;
+
     // One sphere per distinct shape: a repeated primitive would only hit itself again.
     std::vector<int> shape_sphere(scene.shapes.size(), -1);
     for (size_t i = 0; i < scene.primitives.size(); ++i) {
@@ -131,9 +144,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
             const Light& light = scene.lights[prim.light];
             light_index = static_cast<int>(rs.area_lights.size());
             rs.area_lights.push_back({static_cast<int>(rs.spheres.size()) - 1, light.power, 0});
-            bool active = false;
-            for (int l : scene.active_lights) active = active || l == prim.light;
-            if (!active)
+            if (!active[size_t(prim.light)])
                 warn(path + "/light", "light \"" + light.id +
                                           "\" is not listed in /scene/lights; the primitive emits anyway");
             if (light.shape != prim.shape)
@@ -143,16 +154,18 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         rs.sphere_light.push_back(light_index);
     }
 
+    // Which lights some emissive primitive carries (one pass, not one per light: a file may
+    // have 10^5 of each).
+    std::vector<bool> carried(scene.lights.size(), false);
+    for (const Primitive& prim : scene.primitives)
+        if (prim.type == PrimitiveType::emissive && prim.light >= 0) carried[size_t(prim.light)] = true;
     for (size_t k = 0; k < scene.active_lights.size(); ++k) {
         const Light& light = scene.lights[scene.active_lights[k]];
         if (light.type == LightType::point) {
             rs.point_lights.push_back({light.position, light.power, 0});
             continue;
         }
-        bool carried = false;
-        for (const Primitive& prim : scene.primitives)
-            carried = carried || (prim.type == PrimitiveType::emissive && prim.light == scene.active_lights[k]);
-        if (!carried)
+        if (!carried[size_t(scene.active_lights[k])])
             throw SceneError(file, "/scene/lights/" + std::to_string(k),
                              "area light \"" + light.id +
                                  "\" is not carried by any emissive primitive; add one with \"light\": \"" +
@@ -160,16 +173,25 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
     }
 
     // Light selection probabilities proportional to emitted power (luminance):
-    // 4 pi I for a point light, pi A Le for a sphere emitting from its outside.
-    double total = 0;
-    std::vector<double> power;
-    for (const PointLight& l : rs.point_lights) power.push_back(4.0 * kPi * luminance(l.intensity));
+    // 4 pi I for a point light, pi A Le for a sphere emitting from its outside. Powers are
+    // compared as logarithms: a file may hold an intensity of 1e308 or a radius of 1e200,
+    // whose power overflows a double (and inf / inf would make every share NaN).
+    auto log_luminance = [](const Color& c) {
+        const double scale = max_component(c);  // luminance(c / scale) is in (0.07, 1]
+        return scale > 0 ? std::log(scale) + std::log(luminance(c / scale)) : -kInfinity;
+    };
+    std::vector<double> log_power;
+    for (const PointLight& l : rs.point_lights) log_power.push_back(std::log(4.0 * kPi) + log_luminance(l.intensity));
     for (const AreaLight& l : rs.area_lights) {
         const double r = rs.spheres[l.sphere].radius;
-        power.push_back(kPi * 4.0 * kPi * r * r * luminance(l.radiance));
+        log_power.push_back(std::log(4.0 * kPi * kPi) + 2.0 * std::log(r) + log_luminance(l.radiance));
     }
-    for (double p : power) total += p;
-    const size_t n = power.size();
+    const size_t n = log_power.size();
+    double log_max = -kInfinity, total = 0;
+    for (double p : log_power) log_max = std::max(log_max, p);
+    std::vector<double> power(n, 0.0);  // relative to the brightest light
+    if (log_max > -kInfinity)
+        for (size_t i = 0; i < n; ++i) total += power[i] = std::exp(log_power[i] - log_max);
     for (size_t i = 0; i < n; ++i) {
         // Equal shares when every light is black (keeps pdfs defined).
         const double prob = total > 0 ? power[i] / total : 1.0 / double(n);

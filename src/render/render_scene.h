@@ -16,7 +16,7 @@ namespace kr {
 
 inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// A ray segment <O, D, tmin, tmax>. D is unit length.
+// A ray segment <O, D, tmin, tmax>. D is unit length. Only roots with t > 0 count.
 // A ray that leaves a sphere's surface names it in `from_sphere`: spheres are convex, so a
 // ray heading out of it can never hit it again and one heading into it can only hit its far
 // side. Skipping that sphere (or its near root) replaces epsilon offsets, which fail across
@@ -78,6 +78,15 @@ struct RenderScene {
     void build_accel() { bvh.build(spheres); }
     size_t light_count() const { return point_lights.size() + area_lights.size(); }
 };
+
+// A shadow segment towards a point light ends on that point, and the point may lie on a
+// surface (a light placed on a floor or wall). Rounding then puts the surface's crossing a
+// hair before or after the end, so shadows would speckle at random. is_occluded therefore
+// ends a finite segment short of tmax by this fraction of the magnitudes the root is computed
+// from (|o - centre| in the 1-norm, plus tmax): a crossing that close to the end is the end
+// point itself. Scale-free, like the rest of the ray rules; closest-hit queries are exact.
+inline constexpr double kSegmentEndTolerance = 64 * std::numeric_limits<double>::epsilon();
+double segment_end_tolerance(const Vec3& origin_minus_centre, double tmax);
 
 // Ray-sphere roots of |o + t d - c|^2 = r^2 for unit d, in a cancellation-free form
 // (Haines et al., Ray Tracing Gems ch. 7). Returns false when the line misses.

@@ -704,13 +704,15 @@ void Loader::read_scene(const Json& j, const std::string& pointer) {
          {"lights", "an array of light ids",
           [&](const Json& v, const std::string& p) {
               if (!v.is_array()) fail(p, "expected an array of light ids, got " + describe(v));
+              // Where each light is listed: one lookup per entry, not a scan (10^5 lights).
+              std::vector<size_t> listed_at(scene.lights.size(), v.size());
               for (size_t i = 0; i < v.size(); ++i) {
                   const int l = static_cast<int>(resolve(lights_, v[i], child(p, i)));
-                  for (size_t k = 0; k < scene.active_lights.size(); ++k)
-                      if (scene.active_lights[k] == l)
-                          fail(child(p, i), "light " + in_quotes(scene.lights[size_t(l)].id) +
-                                                " is already listed at " + child(p, k) +
-                                                "; expected each active light once");
+                  if (listed_at[size_t(l)] < v.size())
+                      fail(child(p, i), "light " + in_quotes(scene.lights[size_t(l)].id) +
+                                            " is already listed at " + child(p, listed_at[size_t(l)]) +
+                                            "; expected each active light once");
+                  listed_at[size_t(l)] = i;
                   scene.active_lights.push_back(l);
               }
           }},

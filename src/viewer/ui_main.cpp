@@ -25,7 +25,8 @@ Options:
   --spp N               target samples per pixel (default: the file's "samples")
   --unlimited           keep refining past the target
   --integrator NAME     wrt | pt | pt-naive      --depth N         0..20
-  --estimator NAME      uniform | stratified     --light-sampling NAME  brief | cone | area
+  --estimator NAME      uniform | stratified | sobol
+  --light-sampling NAME brief | brief-area | cone | area
   --seed N              random seed (default 0)
   --tonemap NAME        sigmoid | linear         --exposure E      sigmoid exposure
 Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run):

@@ -1,0 +1,178 @@
+// The estimators' samplers: the Owen-scrambled Sobol sampler's net property, uniformity
+// (chi-square), unbiasedness on analytic integrands, and independence between dimensions.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+#include <vector>
+
+#include "render/sampler.h"
+
+using namespace kr;
+
+namespace {
+
+// The first `count` 2-D points of dimension pair `pair` of one pixel.
+std::vector<Vec2> sobol_points(uint64_t pixel, int pair, uint32_t first, uint32_t count) {
+    std::vector<Vec2> points;
+    for (uint32_t i = first; i < first + count; ++i) {
+        Sampler sampler(Estimator::sobol, 7, pixel, i, 1);
+        Vec2 p = sampler.pixel();
+        for (int d = 0; d < pair; ++d) p = sampler.next_2d();
+        points.push_back(p);
+    }
+    return points;
+}
+
+// Upper chi-square quantile at p = 0.001 for `dof` degrees of freedom (Wilson-Hilferty).
+double chi_square_limit(int dof) {
+    const double z = 3.09, k = dof;
+    const double t = 1 - 2 / (9 * k) + z * std::sqrt(2 / (9 * k));
+    return k * t * t * t;
+}
+
+}  // namespace
+
+TEST(Sobol, FirstDimensionsAreTheSobolSequence) {
+    const uint32_t x[] = {0, 1u << 31, 1u << 30, 3u << 30};
+    const uint32_t y[] = {0, 1u << 31, 3u << 30, 1u << 30};
+    for (uint32_t i = 0; i < 4; ++i) {
+        EXPECT_EQ(sobol_dimension0(i), x[i]);
+        EXPECT_EQ(sobol_dimension1(i), y[i]);
+    }
+    EXPECT_EQ(reverse_bits(1u), 1u << 31);
+    EXPECT_EQ(reverse_bits(0x12345678u), 0x1e6a2c48u);
+}
+
+// An Owen scramble is a bijection that maps each dyadic interval onto a dyadic interval of
+// the same size: two fractions sharing their top k bits still share them after scrambling.
+TEST(Sobol, OwenScrambleKeepsDyadicIntervalsTogether) {
+    Rng rng(3, 4);
+    for (int trial = 0; trial < 2000; ++trial) {
+        const uint32_t seed = rng.next_u32(), a = rng.next_u32();
+        const int k = trial % 32;
+        const uint32_t high_mask = k == 0 ? 0u : ~0u << (32 - k);
+        const uint32_t b = (a & high_mask) | (rng.next_u32() & ~high_mask);
+        EXPECT_EQ(owen_scramble(a, seed) & high_mask, owen_scramble(b, seed) & high_mask);
+    }
+    std::set<uint32_t> images;
+    for (uint32_t v = 0; v < 4096; ++v) images.insert(owen_scramble(v << 20, 99) >> 20);
+    EXPECT_EQ(images.size(), 4096u);  // bijective on the top 12 bits
+}
+
+// Every prefix of 2^m samples (and every aligned block after it) of every dimension pair
+// puts exactly one point in each elementary interval of area 2^-m: 2^a by 2^(m-a) cells.
+TEST(Sobol, EveryPowerOfTwoPrefixIsANet) {
+    for (uint64_t pixel : {0ull, 1ull, 12345ull}) {
+        for (int pair : {0, 1, 4, 11}) {
+            for (int m = 0; m <= 8; ++m) {
+                const uint32_t n = 1u << m;
+                for (uint32_t first : {0u, n, 5 * n}) {
+                    const std::vector<Vec2> points = sobol_points(pixel, pair, first, n);
+                    for (int a = 0; a <= m; ++a) {
+                        const int nx = 1 << a, ny = 1 << (m - a);
+                        std::vector<int> cells(n, 0);
+                        for (const Vec2& p : points) {
+                            ASSERT_TRUE(p.x > 0 && p.x < 1 && p.y > 0 && p.y < 1);
+                            cells[int(p.y * ny) * nx + int(p.x * nx)] += 1;
+                        }
+                        for (int c : cells)
+                            ASSERT_EQ(c, 1) << "pixel " << pixel << " pair " << pair << " m " << m
+                                            << " first " << first << " cells " << nx << "x" << ny;
+                    }
+                }
+            }
+        }
+    }
+}
+
+// Across pixels each sample is uniform: chi-square over a 16 x 16 grid of one sample index
+// of many pixels, for 2-D pairs and for 1-D dimensions.
+TEST(Sobol, SamplesAreUniformAcrossPixels) {
+    constexpr int kGrid = 16, kPixels = 25600;
+    for (uint32_t index : {0u, 1u, 3u, 1000u}) {
+        std::vector<int> cells(kGrid * kGrid, 0), cells_1d(kGrid * kGrid, 0);
+        for (int pixel = 0; pixel < kPixels; ++pixel) {
+            Sampler sampler(Estimator::sobol, 1, pixel, index, 1);
+            sampler.pixel();
+            const Vec2 p = sampler.next_2d();
+            cells[int(p.y * kGrid) * kGrid + int(p.x * kGrid)] += 1;
+            const double u = sampler.next_1d();
+            const double v = sampler.next_1d();
+            cells_1d[int(v * kGrid) * kGrid + int(u * kGrid)] += 1;
+        }
+        for (const std::vector<int>* grid : {&cells, &cells_1d}) {
+            const double expected = double(kPixels) / (kGrid * kGrid);
+            double chi2 = 0;
+            for (int c : *grid) chi2 += (c - expected) * (c - expected) / expected;
+            EXPECT_LT(chi2, chi_square_limit(kGrid * kGrid - 1)) << "index " << index;
+        }
+    }
+}
+
+// Unbiased on a smooth integrand at power-of-two and other counts, with far lower error
+// than independent random samples.
+TEST(Sobol, UnbiasedWithLowerErrorThanUniform) {
+    auto f = [](Vec2 p) { return std::sin(3 * p.x) * std::exp(p.y); };
+    const double exact = (1 - std::cos(3.0)) / 3 * (std::exp(1.0) - 1);
+    constexpr int kTrials = 2000;
+    for (int spp : {1, 16, 37}) {
+        double mean[2] = {0, 0}, mse[2] = {0, 0};
+        for (int e = 0; e < 2; ++e) {
+            const Estimator est = e == 0 ? Estimator::uniform : Estimator::sobol;
+            for (int t = 0; t < kTrials; ++t) {
+                double sum = 0;
+                for (int i = 0; i < spp; ++i) {
+                    Sampler sampler(est, 5, t, i, spp);
+                    sampler.pixel();
+                    sum += f(sampler.next_2d());  // the lens pair: a dimension past the first
+                }
+                const double estimate = sum / spp;
+                mean[e] += estimate / kTrials;
+                mse[e] += (estimate - exact) * (estimate - exact) / kTrials;
+            }
+            EXPECT_NEAR(mean[e], exact, 4 * std::sqrt(mse[e] / kTrials)) << "spp " << spp;
+        }
+        if (spp == 16) EXPECT_LT(mse[1], mse[0] / 20);
+        if (spp == 37) EXPECT_LT(mse[1], mse[0] / 8);
+    }
+}
+
+// Different dimensions of one sample are independent: E[u_i u_j] = 1/4 for every pair of
+// dimensions, including the two axes of one pair and dimensions of different pairs.
+TEST(Sobol, DimensionsAreUncorrelated) {
+    constexpr int kDims = 8, kPixels = 4000, kSpp = 16;
+    double sum[kDims][kDims] = {};
+    for (int pixel = 0; pixel < kPixels; ++pixel)
+        for (int i = 0; i < kSpp; ++i) {
+            Sampler sampler(Estimator::sobol, 2, pixel, i, kSpp);
+            double u[kDims];
+            const Vec2 a = sampler.pixel();
+            u[0] = a.x, u[1] = a.y;
+            const Vec2 b = sampler.next_2d();
+            u[2] = b.x, u[3] = b.y;
+            u[4] = sampler.next_1d();
+            const Vec2 c = sampler.next_2d();
+            u[5] = c.x, u[6] = c.y;
+            u[7] = sampler.next_1d();
+            for (int p = 0; p < kDims; ++p)
+                for (int q = 0; q < p; ++q) sum[p][q] += u[p] * u[q];
+        }
+    // Per pixel the 16 products average to within a few 1e-3 of 1/4; across pixels the
+    // mean's standard error is about 0.07 / sqrt(16 * 4000) = 3e-4.
+    for (int p = 0; p < kDims; ++p)
+        for (int q = 0; q < p; ++q)
+            EXPECT_NEAR(sum[p][q] / (kPixels * kSpp), 0.25, 2e-3) << "dimensions " << p << ", " << q;
+}
+
+// The stratified estimator (the brief's) keeps its strata; its other dimensions are the
+// uniform stream, and an index past e^2 is uniform too.
+TEST(Sobol, UniformAndStratifiedDrawFromTheirStream) {
+    Sampler a(Estimator::uniform, 9, 4, 2, 16), b(Rng::for_sample(9, 4, 2));
+    const Vec2 pa = a.pixel(), pb = b.pixel();
+    EXPECT_EQ(pa.x, pb.x);
+    EXPECT_EQ(pa.y, pb.y);
+    EXPECT_EQ(a.next_1d(), b.next_1d());
+    const Vec2 s = Sampler(Estimator::stratified, 9, 4, 5, 16).pixel();  // stratum (1, 1) of 4x4
+    EXPECT_TRUE(s.x >= 0.25 && s.x < 0.5 && s.y >= 0.25 && s.y < 0.5);
+}
