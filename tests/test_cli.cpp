@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 
 #include "core/image.h"
@@ -186,4 +187,45 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     EXPECT_EQ(run("bench --write-stress 5 '" + (dir / "s.json").string() + "'").status, 0);
     r = run("render '" + (dir / "s.json").string() + "' --spp 1 -o '" + (dir / "s.ppm").string() + "'");
     EXPECT_EQ(r.status, 0) << r.err;
+}
+
+// bench --convergence: CSV rows per configuration and checkpoint, a PNG plot per scene, a
+// markdown table with the speed-up column; and its usage errors.
+TEST_F(Cli, BenchConvergenceWritesCsvPlotAndTable) {
+    const fs::path scene = write_scene("conv.json");
+    const fs::path out = dir / "bench";
+    CliRun r = run("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
+                   "wrt/area/uniform,wrt/area/sobol --out '" + out.string() + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string csv = read_file(out / "convergence.csv");
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 2 * 3) << csv;  // header, 2 configs x spp 1, 2, 4
+    EXPECT_NE(csv.find("conv,wrt/area/sobol,4,"), std::string::npos) << csv;
+    const std::string md = read_file(out / "convergence.md");
+    EXPECT_NE(md.find("| wrt/area/sobol |"), std::string::npos) << md;
+    EXPECT_NE(md.find("speed-up"), std::string::npos);
+    const std::string png = read_file(out / "conv.png");
+    ASSERT_GT(png.size(), 8u);
+    EXPECT_EQ(png.substr(1, 3), "PNG");
+    // The reference is cached: a second run renders none and gives the same errors at 4 spp.
+    EXPECT_FALSE(fs::is_empty(out / "cache"));
+    r = run("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
+            "wrt/area/uniform,wrt/area/sobol --out '" + out.string() + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    auto rows_at_4 = [](const std::string& text) {
+        std::string rows;
+        std::istringstream in(text);
+        for (std::string line; std::getline(in, line);)
+            if (line.find(",4,") != std::string::npos) rows += line.substr(line.find(",4,") + 3) + "\n";
+        // Drop the seconds column, which differs run to run.
+        std::string kept;
+        std::istringstream rows_in(rows);
+        for (std::string line; std::getline(rows_in, line);) kept += line.substr(line.find(',')) + "\n";
+        return kept;
+    };
+    EXPECT_EQ(rows_at_4(read_file(out / "convergence.csv")), rows_at_4(csv));
+
+    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --configs pt/cone").status, 2);
+    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --configs pt/lamp/sobol").status, 2);
+    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --scale 0").status, 2);
+    EXPECT_EQ(run("bench --convergence --help").status, 0);
 }

@@ -1,6 +1,7 @@
 // Sampling routines: chi-square tests of their distributions, moments, and the estimators.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <vector>
@@ -318,9 +319,9 @@ Moments moments(F sample, int n) {
     return {mean, std::sqrt(std::max(0.0, sum_sq / n - mean * mean))};
 }
 
-// The brief's light estimator draws its points in proportion to cos_axis / dist^2: the same
-// integral as the brief's uniform hemisphere sampling, from just above the surface to far
-// away, with a weight that varies only with the receiver's cosine.
+// The brief's light estimator draws its points close to cos_axis / dist^2: the same integral
+// as the brief's uniform hemisphere sampling, from just above the surface to far away, with
+// a far smaller variance.
 TEST(Sampling, BriefLightImportanceSamplingKeepsTheBriefIntegral) {
     const SphereGeom light{{0, 0, 0}, 1};
     constexpr int kN = 200000;
@@ -354,8 +355,46 @@ TEST(Sampling, BriefLightImportanceSamplingKeepsTheBriefIntegral) {
                 EXPECT_NEAR(hemisphere.mean, exact, 4 * hemisphere.sd / std::sqrt(double(kN)) + 2e-3 * exact)
                     << "distance " << distance << " tilt " << tilt;
             EXPECT_LT(importance.sd, hemisphere.sd) << "distance " << distance << " tilt " << tilt;
-            // Facing the light straight on, cos_i stays near 1 over the small far cap.
-            if (tilt == 0 && distance >= 3) EXPECT_LT(importance.sd, 0.1 * importance.mean) << "distance " << distance;
+            // Facing a far light straight on, cos_i stays near 1 over its small cap and the
+            // points follow cos_axis / dist^2 closely.
+            if (tilt == 0 && distance >= 10) EXPECT_LT(importance.sd, 0.1 * importance.mean) << "distance " << distance;
         }
+    }
+}
+
+// The brief strategy's points: chi-square of cos_axis (the cosine between the point's normal and
+// the axis from the light's centre to p) against its density on [0, 1], alpha 2u +
+// (1 - alpha) b / ((a - b u) v) with v = ln(a / (a - b)) and alpha = 1 / (1 + v^3).
+TEST(Sampling, BriefLightPointsFollowTheirDensity) {
+    const SphereGeom light{{0, 0, 0}, 1};
+    for (double distance : {1.01, 1.5, 4.0, 40.0}) {
+        const double a = distance * distance + 1, b = 2 * distance, v = std::log(a / (a - b)),
+                     alpha = 1 / (1 + v * v * v);
+        auto density = [&](double u) { return alpha * 2 * u + (1 - alpha) * b / ((a - b * u) * v); };
+        constexpr int kBins = 40, kN = 200000;
+        // Expected bin probabilities by fine midpoint quadrature of the density.
+        std::vector<double> expected(kBins, 0.0);
+        double total = 0;
+        for (int i = 0; i < kBins * 1000; ++i) {
+            const double u = (i + 0.5) / (kBins * 1000);
+            expected[i / 1000] += density(u);
+            total += density(u);
+        }
+        std::vector<int> observed(kBins, 0);
+        Rng rng(21, 5);
+        const Vec3 p{0, 0, distance};
+        for (int i = 0; i < kN; ++i) {
+            LightSample ls;
+            ASSERT_TRUE(sample_sphere_light(light, p, LightSampling::brief, rng.next(), rng.next(), ls));
+            const Vec3 y = p + ls.distance * ls.wi;
+            const double cos_axis = std::clamp(y.z, 0.0, 1.0 - 1e-12);
+            observed[int(cos_axis * kBins)] += 1;
+        }
+        double chi2 = 0;
+        for (int k = 0; k < kBins; ++k) {
+            const double e = expected[k] / total * kN;
+            chi2 += (observed[k] - e) * (observed[k] - e) / e;
+        }
+        EXPECT_LT(chi2, 73.4) << "distance " << distance;  // p = 0.001 for 39 degrees of freedom
     }
 }

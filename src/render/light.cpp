@@ -19,49 +19,27 @@ double cone_one_minus_cos(double r2, double d2) {
 double sphere_area(const SphereGeom& s) { return 4.0 * kPi * s.radius * s.radius; }
 
 
-// h(v) = v - 1 + exp(-v) for v >= 0, without cancellation for small v.
-double exp_excess(double v) {
-    if (v < 1e-3) return v * v * (0.5 - v * (1.0 / 6 - v * (1.0 / 24 - v / 120)));
-    return v + std::expm1(-v);
-}
-
-// The distribution of the brief estimator's points: on the hemisphere of the light facing p,
-// density proportional to cos_axis / dist^2, where dist^2 = s = a - b cos_axis with
-// a = d^2 + r^2, b = 2 d r. Its CDF in u = cos_axis is (a / b^2) h(v) with v = ln(a / s)
-// (from int_0^u t / (a - b t) dt), so sampling solves h(v) = xi h(v_max) for v.
-struct BriefDistribution {
-    double a, b, r2, v_max, h_max;
-    BriefDistribution(const SphereGeom& light, double d)
+// Where the brief strategy puts its points: on the hemisphere of the light facing p, at
+// u = cos_axis and a uniform azimuth. The brief's integrand has cos_axis / dist^2 with
+// dist^2 = s = a - b u (a = d^2 + r^2, b = 2 d r): density proportional to u for a far light
+// (s nearly constant), to 1/s close to it. A mixture of the two, both sampled in closed form:
+// u = sqrt(xi) with weight alpha, log-uniform s with weight 1 - alpha, alpha = 1 / (1 + v^3)
+// where v = ln(a / (d - r)^2) grows as p nears the light. Each part keeps the other's weight
+// bounded: near, the log-uniform part; far, the u part.
+struct BriefProposal {
+    double a, b, v_max, alpha;
+    BriefProposal(const SphereGeom& light, double d)
         : a(d * d + light.radius * light.radius),
           b(2 * d * light.radius),
-          r2(light.radius * light.radius),
-          v_max(-std::log1p(-b / a)),  // ln(a / (d - r)^2)
-          h_max(exp_excess(v_max)) {}
-    // Z = int cos_axis / dist^2 dA over the hemisphere = 2 pi r^2 (a / b^2) h(v_max).
-    double normalisation() const { return 2 * kPi * r2 * a / (b * b) * h_max; }
-    double sample_cos(double xi) const {
-        // Newton steps on k(v) = sqrt(2 h(v)) = sqrt(2c), which is nearly linear (k ~ v for
-        // small v, ~ sqrt(2v) for large) and concave: from a start left of the root
-        // (h(v) <= v^2 / 2 and h(v) < v, so max(sqrt(2c), c) is), the steps stay left of it
-        // and converge monotonically, quadratically: once a step is below 1e-5 v the next
-        // would be below 1e-10 v, so it is the last (usually the second).
-        const double c = xi * h_max, target = std::sqrt(2 * c);
-        double v = std::max(target, c);
-        for (int iteration = 0; iteration < 20; ++iteration) {
-            const double em = std::expm1(-v);  // h(v) = v + em, h'(v) = -em
-            const double k = std::sqrt(2 * (v < 1e-3 ? exp_excess(v) : v + em));
-            if (!(k > 0)) break;
-            const double step = (target - k) * k / -em;  // (target - k) / k'
-            if (!(step > 1e-5 * v) || v + step >= v_max) {
-                // u = (a - s) / b = a (1 - exp(-v - step)) / b, from em without another exp:
-                // 1 - exp(-v - step) = -em + exp(-v) (1 - exp(-step)), the last by its series.
-                if (v + step >= v_max) return 1.0;
-                const double one_minus = -em + (1 + em) * step * (1 - step * (0.5 - step / 6));
-                return std::clamp(a * one_minus / b, 0.0, 1.0);
-            }
-            v += step;
-        }
-        return std::clamp(-a * std::expm1(-std::min(v, v_max)) / b, 0.0, 1.0);
+          v_max(-std::log1p(-b / a)),
+          alpha(1.0 / (1.0 + v_max * v_max * v_max)) {}
+    // Density of u on [0, 1]: alpha 2u + (1 - alpha) b / (s v_max).
+    double pdf(double u) const { return alpha * 2 * u + (1 - alpha) * b / ((a - b * u) * v_max); }
+    double sample(double xi) const {
+        if (xi < alpha) return std::sqrt(xi / alpha);
+        // s = a exp(-t v_max), t uniform: log-uniform on [(d - r)^2, a]; u = (a - s) / b.
+        const double t = (xi - alpha) / (1 - alpha);
+        return std::clamp(-a * std::expm1(-t * v_max) / b, 0.0, 1.0);
     }
 };
 }  // namespace
@@ -91,27 +69,29 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
         // The brief's integral over the hemisphere facing p, with the light-side cosine about
         // that hemisphere's axis: E = int f L cos_i cos_axis / dist^2 dA(y). The brief draws y
         // uniformly on the hemisphere, whose weight A cos_axis / (2 dist^2) explodes for
-        // shading points close to the light. Here y is drawn with density proportional to
-        // cos_axis / dist^2 itself, so the weight is the constant Z = int cos_axis / dist^2 dA:
-        // the same integral, with only cos_i and visibility left to vary.
-        const BriefDistribution dist_u(light, std::sqrt(d2));
-        const double cos_axis = dist_u.sample_cos(u1);
+        // shading points close to the light; here y comes from BriefProposal, close to
+        // cos_axis / dist^2 near and far, so the weight stays bounded.
+        const double d = std::sqrt(d2);
+        const BriefProposal proposal(light, d);
+        const double cos_axis = proposal.sample(u1);
         const double sin_axis = std::sqrt(std::max(0.0, 1.0 - cos_axis * cos_axis));
         double sin_phi, cos_phi;
         sin_cos_turns(u2, sin_phi, cos_phi);
-        const Vec3 axis = -to_centre / std::sqrt(d2);
+        const Vec3 axis = -to_centre / d;
         const Vec3 n = Frame::from_normal(axis).to_world({sin_axis * cos_phi, sin_axis * sin_phi, cos_axis});
         const Vec3 w = light.centre + light.radius * n - p;
         const double dist = length(w);
         if (!(dist > 0) || !(cos_axis > 0)) return false;
         out.wi = w / dist;
         out.distance = dist;
-        out.pdf = 1.0 / dist_u.normalisation();  // f L cos_axis / dist^2 / (density): f L Z
+        // Area density on the sphere: the density of u over 2 pi r^2 (dA = r^2 du dphi).
+        const double area_density = proposal.pdf(cos_axis) / (2 * kPi * r2);
+        out.pdf = dist * dist * area_density / cos_axis;  // f L cos_axis / dist^2 / area_density
         // BSDF sampling reaches the visible cap only, so only there are the two combined;
         // the band behind the silhouette keeps this strategy's full weight (mis_pdf 0).
         const double cos_light = -dot(n, out.wi);
-        const bool visible_cap = cos_axis * std::sqrt(d2) > light.radius && cos_light > 0;
-        out.mis_pdf = visible_cap ? cos_axis / (dist_u.normalisation() * cos_light) : 0.0;
+        const bool visible_cap = cos_axis * d > light.radius && cos_light > 0;
+        out.mis_pdf = visible_cap ? area_density * dist * dist / cos_light : 0.0;
         return true;
     }
     if (strategy == LightSampling::cone && outside) {
@@ -152,11 +132,11 @@ double sphere_light_pdf(const SphereGeom& light, const Vec3& p, const Vec3& wi, 
     const double cos_abs = std::abs(dot(n_light, wi));
     if (strategy == LightSampling::brief_area && outside) return 0;  // never combined
     if (strategy == LightSampling::brief && outside) {
-        // Solid-angle density of the brief strategy's point at the (visible) hit:
-        // (cos_axis / dist^2 / Z) dist^2 / cos_light.
+        // Solid-angle density of the brief strategy's point at the (visible) hit.
         const double cos_axis = -dot(n_light, to_centre) / std::sqrt(d2);
         if (!(cos_abs > 0) || !(cos_axis > 0)) return 0;
-        return cos_axis / (BriefDistribution(light, std::sqrt(d2)).normalisation() * cos_abs);
+        const double area_density = BriefProposal(light, std::sqrt(d2)).pdf(cos_axis) / (2 * kPi * r2);
+        return area_density * distance * distance / cos_abs;
     }
     if (strategy == LightSampling::cone && outside) return uniform_cone_pdf(cone_one_minus_cos(r2, d2));
     if (!(cos_abs > 0)) return 0;

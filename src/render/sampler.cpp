@@ -97,14 +97,14 @@ Vec2 Sampler::pixel() {
 }
 
 double Sampler::next_1d() {
-    if (estimator_ != Estimator::sobol) return rng_.next();
+    if (estimator_ != Estimator::sobol || dimension_ >= kSobolDimensions) return rng_.next();
     const Shuffle s = shuffle(dimension_++);
     // owen_scramble(sobol_dimension0(i)): the two bit reversals in between cancel.
     return to_unit(reverse_bits(laine_karras(s.index, s.seed)));
 }
 
 Vec2 Sampler::next_2d() {
-    if (estimator_ != Estimator::sobol) {
+    if (estimator_ != Estimator::sobol || dimension_ >= kSobolDimensions) {
         const double u1 = rng_.next();
         return {u1, rng_.next()};
     }

@@ -34,6 +34,12 @@ uint32_t owen_scramble(uint32_t fraction, uint32_t seed);
 // BSDF lobe choice, the BSDF direction and Russian roulette.
 class Sampler {
 public:
+    // The Sobol estimator scrambles this many dimensions (1-D or 2-D each): the sub-pixel
+    // position, the lens and the first two path vertices (five each). Later ones come from
+    // the pixel's PCG32 stream: little of the image depends on them, and scrambling costs
+    // time (measured in docs/accuracy.md).
+    static constexpr uint32_t kSobolDimensions = 12;
+
     // `target` is the sample count the stratified estimator divides the pixel for.
     Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target);
     // For tools and tests that trace rays by hand: the uniform estimator on one RNG stream.
