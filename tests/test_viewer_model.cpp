@@ -297,6 +297,48 @@ TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
     EXPECT_EQ(resumed->generation, 1u);
 }
 
+// The viewer's stop rules: with no spp cap, the noise rule stops the estimate once its
+// estimated relative error is below the target (adaptively), and the time rule after its
+// seconds; both like render --noise / --time.
+TEST(RenderThread, NoiseAndTimeRulesStopTheEstimate) {
+    Scene authored = load_scene_file(scene_file(3)).scene;
+    authored.renderer.width = authored.renderer.height = 24;
+    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    auto run_until_finished = [&](RenderWorker& worker) {
+        std::shared_ptr<const Snapshot> f;
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+        return f;
+    };
+    {
+        RenderWorker worker;
+        worker.set_unlimited(true);
+        worker.set_stop_rule(0, 0.05);
+        worker.submit({1, scene, settings});
+        const auto f = run_until_finished(worker);
+        ASSERT_TRUE(f && f->finished);
+        EXPECT_STREQ(f->stopped_by, "noise");
+        EXPECT_GT(f->spp, 16);  // past the (ignored) target: the rule decided
+        // The whole image is within the target (every pixel within its share implies it).
+        EXPECT_LE(f->relative_error, 0.05);
+    }
+    {
+        RenderWorker worker;
+        worker.set_unlimited(true);
+        worker.set_stop_rule(0.3, 0);
+        worker.submit({1, scene, settings});
+        const auto f = run_until_finished(worker);
+        ASSERT_TRUE(f && f->finished);
+        EXPECT_STREQ(f->stopped_by, "time");
+        EXPECT_GE(f->full_seconds, 0.3);
+        const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
+        EXPECT_EQ(more->serial, f->serial);  // and stays stopped
+    }
+}
+
 TEST(SceneWatch, BrokenFileKeepsTheLastGoodScene) {
     const fs::path dir = fs::temp_directory_path() / ("keithray_watch_" + std::to_string(::getpid()));
     fs::create_directories(dir);

@@ -57,4 +57,10 @@ void Accumulator::add(const RenderState& pass) {
 
 Image Accumulator::mean() const { return totals_.radiance(); }
 
+size_t Accumulator::update_adaptive(double target) {
+    const size_t active = totals_.update_adaptive(target);
+    scratch_.active = totals_.active;
+    return active;
+}
+
 }  // namespace kr::viewer

@@ -21,6 +21,12 @@ public:
     bool render_pass(const RenderScene& scene, const RenderSettings& settings,
                      const std::atomic<bool>* stop = nullptr);
 
+    // Adaptive sampling towards relative error `target` (RenderState::update_adaptive on the
+    // totals): later passes sample only the pixels still above their share. Returns their
+    // count; 0 means the image meets the target. clear_adaptive() samples every pixel again.
+    size_t update_adaptive(double target);
+    void clear_adaptive() { scratch_.active.clear(); }
+
     // Adds a one-pass state: per pixel at most one sample, in `pass.radiance_sum` etc.
     void add(const RenderState& pass);
 

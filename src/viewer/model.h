@@ -23,6 +23,8 @@ namespace kr::viewer {
 struct ViewerSettings {
     RenderSettings render;    // integrator, estimator, light sampling, depth, target spp, seed
     bool unlimited = false;   // keep refining past target_spp
+    double stop_seconds = 0;  // stop after this much render time (0: no limit)
+    double stop_noise = 0;    // stop at this estimated relative error, adaptively (0: off)
     bool paused = false;
     ToneSettings tone;
 };

@@ -69,6 +69,15 @@ void RenderWorker::set_paused(bool paused) {
     changed_.notify_all();
 }
 
+void RenderWorker::set_stop_rule(double seconds, double noise) {
+    {
+        std::lock_guard lock(mutex_);
+        stop_seconds_ = seconds;
+        stop_noise_ = noise;
+    }
+    changed_.notify_all();
+}
+
 void RenderWorker::set_unlimited(bool unlimited) {
     {
         std::lock_guard lock(mutex_);
@@ -112,14 +121,22 @@ void RenderWorker::run() {
     double seconds = 0, full_seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
 
+    bool noise_met = false;  // the noise rule's target was reached by this estimate
+    double noise_checked = 0;  // the target noise_met was checked against
+
     for (;;) {
-        bool unlimited = false;
+        double stop_noise = 0;
+        // Which rule ends the refinement, if any (called under the lock).
+        auto stop_reason = [&]() -> const char* {
+            if (next_preview < previews.size()) return nullptr;
+            if (stop_noise_ > 0 && noise_met && noise_checked == stop_noise_) return "noise";
+            if (stop_seconds_ > 0 && full_seconds >= stop_seconds_) return "time";
+            if (!unlimited_ && accumulator.passes() >= job.settings.target_spp) return "spp";
+            return nullptr;
+        };
         {
             std::unique_lock lock(mutex_);
-            auto finished = [&] {
-                return next_preview >= previews.size() && !unlimited_ &&
-                       accumulator.passes() >= job.settings.target_spp;
-            };
+            auto finished = [&] { return stop_reason() != nullptr; };
             changed_.wait(lock, [&] { return quit_ || pending_ || (have_job && !paused_ && !finished()); });
             if (quit_) return;
             if (pending_) {
@@ -132,9 +149,16 @@ void RenderWorker::run() {
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
                 seconds = full_seconds = 0;
+                noise_met = false;
                 if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
-            unlimited = unlimited_;
+            stop_noise = stop_noise_;
+        }
+        if (stop_noise != noise_checked) {
+            // A new (or no) noise target: sample every pixel until it is checked again.
+            accumulator.clear_adaptive();
+            noise_met = false;
+            noise_checked = stop_noise;
         }
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
@@ -157,6 +181,11 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = accumulator.mean();
+            // The noise rule as render_until applies it: every 4 passes from 16 on.
+            const int passes = accumulator.passes();
+            if (stop_noise > 0 && passes >= 16 && passes % 4 == 0)
+                noise_met = accumulator.totals().relative_error() <= stop_noise ||
+                            accumulator.update_adaptive(stop_noise) == 0;
         }
         const RenderState& totals = accumulator.totals();
         frame->generation = job.generation;
@@ -167,7 +196,12 @@ void RenderWorker::run() {
         frame->rays = totals.rays;
         frame->relative_error = frame->spp >= 2 ? totals.relative_error() : INFINITY;
         frame->nonfinite_samples = totals.nonfinite_samples;
-        frame->finished = !unlimited && frame->spp >= job.settings.target_spp;
+        {
+            std::lock_guard lock(mutex_);
+            const char* reason = stop_reason();
+            frame->finished = reason != nullptr;
+            frame->stopped_by = reason ? reason : "";
+        }
         publish(std::move(frame));
     }
 }

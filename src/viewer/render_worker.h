@@ -39,7 +39,8 @@ struct Snapshot {
     uint64_t rays = 0;       // rays of the full-resolution passes
     double relative_error = 0;  // RenderState::relative_error() of the accumulation
     uint64_t nonfinite_samples = 0;
-    bool finished = false;   // target reached (and not unlimited)
+    bool finished = false;   // a stop rule ended the refinement
+    const char* stopped_by = "";  // "spp", "time" or "noise" once finished
 };
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
@@ -64,6 +65,11 @@ public:
     // so the accumulated passes stay whole (and the image deterministic).
     void set_paused(bool paused);
     void set_unlimited(bool unlimited);
+    // The stop rules of `keithray render --time / --noise` (0 disables each): the estimate
+    // stops refining after `seconds` of full-resolution rendering, or once its estimated
+    // relative error is below `noise`, passes going only to pixels above their share of it.
+    // Like unlimited, they apply to the running estimate without resetting it.
+    void set_stop_rule(double seconds, double noise);
 
     // The newest frame (null before the first).
     std::shared_ptr<const Snapshot> latest() const;
@@ -80,6 +86,7 @@ private:
     mutable std::condition_variable published_; // wakes waiters on frames
     std::optional<RenderJob> pending_;
     bool paused_ = false, unlimited_ = false, quit_ = false;
+    double stop_seconds_ = 0, stop_noise_ = 0;
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};

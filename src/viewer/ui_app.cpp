@@ -37,6 +37,8 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)) {
     model_.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) {
         s.tone = options_.tone;
         s.unlimited = options_.unlimited;
+        s.stop_seconds = options_.stop_seconds;
+        s.stop_noise = options_.stop_noise;
     });
     try {
         model_.load(options_.scene);
@@ -122,6 +124,8 @@ void ViewerApp::sync_worker() {
     const ViewerSettings& s = model_.settings();
     if (s.paused != submitted_paused_) worker_->set_paused(submitted_paused_ = s.paused);
     if (s.unlimited != submitted_unlimited_) worker_->set_unlimited(submitted_unlimited_ = s.unlimited);
+    if (s.stop_seconds != submitted_stop_seconds_ || s.stop_noise != submitted_stop_noise_)
+        worker_->set_stop_rule(submitted_stop_seconds_ = s.stop_seconds, submitted_stop_noise_ = s.stop_noise);
     if (model_.generation() != submitted_generation_) {
         submitted_generation_ = model_.generation();
         worker_->submit({submitted_generation_, model_.prepared(), s.render});

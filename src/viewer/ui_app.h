@@ -26,6 +26,7 @@ struct ViewOptions {
     ViewerModel::Overrides overrides;
     ToneSettings tone;
     bool unlimited = false;
+    double stop_seconds = 0, stop_noise = 0;  // --time, --noise
     // Scripted mode: edits applied at start, then the run ends by itself.
     int frames = 0;  // full-resolution passes to accumulate before the screenshot
     std::optional<std::pair<double, double>> orbit;        // a left drag of (dx, dy) pixels
@@ -92,6 +93,7 @@ private:
 
     uint64_t submitted_generation_ = 0;
     bool submitted_paused_ = false, submitted_unlimited_ = false;
+    double submitted_stop_seconds_ = 0, submitted_stop_noise_ = 0;
     std::shared_ptr<const Snapshot> shown_;  // the frame in the texture
     uint64_t shown_serial_ = 0;
     Clock::time_point generation_edited_{};  // when the image last changed by an edit

@@ -24,6 +24,8 @@ low-resolution preview. The scene file is watched and reloaded when it changes.
 Options:
   --spp N               target samples per pixel (default: the file's "samples")
   --unlimited           keep refining past the target
+  --time SECONDS        stop refining after SECONDS of full-resolution rendering
+  --noise X             stop at estimated relative error X (adaptive sampling)
   --integrator NAME     wrt | pt | pt-naive      --depth N         0..20
   --estimator NAME      uniform | stratified | sobol
   --light-sampling NAME brief | brief-area | cone | area
@@ -72,6 +74,8 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--tonemap") o.tone.op = parse_name(arg, value(), tonemap_names);
         else if (arg == "--exposure") o.tone.exposure = parse_number(arg, value(), 1e-6, 1e6);
         else if (arg == "--unlimited") o.unlimited = true;
+        else if (arg == "--time") o.stop_seconds = parse_number(arg, value(), 1e-3, 1e9);
+        else if (arg == "--noise") o.stop_noise = parse_number(arg, value(), 1e-6, 1.0);
         else if (arg == "--aperture") o.aperture = parse_number(arg, value(), 0, 1e9);
         else if (arg == "--orbit") o.orbit = parse_pair(arg, value());
         else if (arg == "--click-focus") o.click_focus = parse_pair(arg, value());

@@ -267,6 +267,16 @@ void ViewerApp::panel_renderer() {
     ImGui::SameLine();
     if (ImGui::Checkbox("pause (Space)", &paused))
         edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.paused = paused; });
+    // The stop rules of render --time / --noise; 0 turns each off.
+    double stop_seconds = settings.stop_seconds, stop_noise_percent = 100 * settings.stop_noise;
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::InputDouble("stop after s (0: off)", &stop_seconds, 1, 10, "%.1f", ImGuiInputTextFlags_EnterReturnsTrue))
+        edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.stop_seconds = std::max(0.0, stop_seconds); });
+    ImGui::SetNextItemWidth(120);
+    if (ImGui::InputDouble("stop at noise % (0: off, adaptive)", &stop_noise_percent, 0.1, 1, "%.2f",
+                           ImGuiInputTextFlags_EnterReturnsTrue))
+        edit(Edit::run_control,
+             [&](Scene&, ViewerSettings& s) { s.stop_noise = std::clamp(stop_noise_percent, 0.0, 100.0) / 100; });
 }
 
 void ViewerApp::panel_stats() {
@@ -287,6 +297,7 @@ void ViewerApp::panel_stats() {
     const bool unlimited = model_.settings().unlimited;
     if (unlimited) ImGui::Text("spp %d (unlimited)%s", f.spp, model_.settings().paused ? ", paused" : "");
     else ImGui::Text("spp %d / %d%s", f.spp, f.target_spp, f.finished ? ", done" : (model_.settings().paused ? ", paused" : ""));
+    if (f.finished && f.stopped_by[0]) ImGui::Text("stopped by the %s rule", f.stopped_by);
     ImGui::Text("elapsed %s, %.2f passes/s, %.2f Mrays/s", format_duration(f.seconds).c_str(),
                 f.full_seconds > 0 ? f.spp / f.full_seconds : 0.0, f.full_seconds > 0 ? f.rays / f.full_seconds * 1e-6 : 0.0);
     if (std::isfinite(f.relative_error)) ImGui::Text("noise estimate %.3g%% (relative RMS)", 100 * f.relative_error);
