@@ -3,6 +3,7 @@
 // Writes a CSV, one log-log plot per scene and a markdown table of time to given errors.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -32,6 +33,13 @@ namespace fs = std::filesystem;
 namespace kr {
 
 namespace {
+
+// CPU time of the whole process (every thread), in seconds.
+double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 double now_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -129,8 +137,10 @@ with Sobol samples at K times N spp (default K = 4) and cached under DIR/cache. 
 reference's own remaining variance is subtracted from the squared error. --reference uses
 a given image instead (an 8-bit PPM or PNG such as res/references/*: PSNR only).
 
-Writes DIR/convergence.csv (scene, config, spp, seconds, RMSE, relative RMSE, PSNR),
-DIR/SCENE.png (relative RMSE, or 8-bit RMSE, against seconds, log-log) and
+Times are CPU seconds of all threads together, each configuration rendering one pass in
+turn: other processes on shared cores neither inflate them nor favour one configuration.
+Writes DIR/convergence.csv (scene, config, spp, CPU seconds, RMSE, relative RMSE, PSNR),
+DIR/SCENE.png (relative RMSE, or 8-bit RMSE, against CPU seconds, log-log) and
 DIR/convergence.md (time to reach given errors, and the speed-up over the baseline).
 )";
 
@@ -393,27 +403,27 @@ struct Bench {
             }
         }
 
-        // Side by side: every configuration reaches checkpoint k before any goes on to k+1, so
-        // load from other processes falls on all of them alike.
+        // Side by side, pass by pass: each configuration renders one pass in turn, so load
+        // from other processes falls on all of them alike; and their time is the CPU time of
+        // this process (all threads), which other processes on shared cores do not inflate.
         std::vector<int> checkpoints;
         for (int k = 1; k < spp; k *= 2) checkpoints.push_back(k);
         checkpoints.push_back(spp);
-        const double total_passes = double(spp) * series.size();
-        double passes_done = 0;
-        for (int checkpoint : checkpoints)
+        size_t next_checkpoint = 0;
+        for (int pass = 1; pass <= spp; ++pass) {
             for (Series& s : series) {
-                while (s.state.passes < checkpoint) {
-                    const double t0 = now_seconds();
-                    render_pass(scene, s.settings, s.state);
-                    s.seconds += now_seconds() - t0;
-                    passes_done += 1;
-                    progress(passes_done / total_passes, label + " " + s.config.name() + " " +
-                                                             std::to_string(s.state.passes) + "/" + std::to_string(spp) +
-                                                             " spp");
+                const double t0 = cpu_seconds();
+                render_pass(scene, s.settings, s.state);
+                s.seconds += cpu_seconds() - t0;
+                if (pass == checkpoints[next_checkpoint]) {
+                    const std::string key = o.reference_file.empty() ? s.config.expectation() : "given";
+                    s.points.push_back(measure(s, references.at(key)));
                 }
-                const std::string key = o.reference_file.empty() ? s.config.expectation() : "given";
-                s.points.push_back(measure(s, references.at(key)));
             }
+            if (pass == checkpoints[next_checkpoint]) ++next_checkpoint;
+            progress(double(pass) / spp, label + " " + std::to_string(pass) + "/" + std::to_string(spp) + " spp, " +
+                                             std::to_string(series.size()) + " configurations");
+        }
         return report(file, series, spp, width, height);
     }
 
@@ -428,7 +438,7 @@ struct Bench {
 
         PlotSpec plot;
         plot.title = stem + " (" + std::to_string(width) + "x" + std::to_string(height) + ")";
-        plot.x_label = "seconds (" + std::to_string(omp_get_max_threads()) + " threads)";
+        plot.x_label = "CPU seconds (" + std::to_string(omp_get_max_threads()) + " threads together)";
         plot.y_label = radiance ? "relative RMSE of luminance" : "RMSE of the 8-bit image (levels)";
         for (const Series& s : series) {
             PlotSeries line;
@@ -455,7 +465,8 @@ struct Bench {
                                                                                                 : Integrator::pt);
         std::string& md = r.markdown;
         md += "### " + stem + "\n\n" + std::to_string(width) + "x" + std::to_string(height) + ", up to " +
-              std::to_string(spp) + " spp, " + std::to_string(omp_get_max_threads()) + " threads; error: " +
+              std::to_string(spp) + " spp, " + std::to_string(omp_get_max_threads()) +
+              " threads, seconds of CPU time (all threads); error: " +
               (radiance ? "relative RMSE of luminance against the converged image of each configuration"
                         : "RMSE (8-bit levels) against " + o.reference_file.filename().string()) +
               ". Speed-up: the baseline's seconds at " + std::to_string(spp) +
@@ -503,7 +514,7 @@ int bench_convergence(int argc, char** argv) {
     if (o.threads > 0) omp_set_num_threads(o.threads);
     const std::vector<fs::path> scenes = o.scenes.empty() ? default_scenes() : o.scenes;
     Bench bench{o};
-    std::string csv = "scene,config,spp,seconds,rmse,relative_rmse,psnr\n";
+    std::string csv = "scene,config,spp,cpu_seconds,rmse,relative_rmse,psnr\n";
     std::string md = "# Convergence (keithray bench --convergence)\n\n";
     for (size_t i = 0; i < scenes.size(); ++i) {
         SceneResult r;
