@@ -168,16 +168,7 @@ test::SceneBuilder room(double R) {
     return b;
 }
 
-// A sphere of material `m` inside a black emitting sphere of radiance Le (the brief's furnace).
-test::SceneBuilder furnace(MaterialType type, Color rho, double le) {
-    test::SceneBuilder b;
-    const int m = b.material(type, rho);
-    b.scene.materials[m].rho_r = rho;
-    b.scene.materials[m].rho_t = rho;
-    b.sphere({0, 0, 0}, 1, m);
-    b.emitter({0, 0, 0}, 20, Color(le), b.material(MaterialType::diffuse, Color(0)));
-    return b;
-}
+using test::furnace;
 
 // A scratch folder per test.
 class TempDir : public ::testing::Test {

@@ -123,4 +123,16 @@ struct SceneBuilder {
     RenderScene build() const { return prepare_scene(scene); }
 };
 
+// The brief's furnace: a unit sphere of material `type` (rho, or rhoR = rhoT = rho) inside a
+// black emitting sphere of radius 20 and radiance Le.
+inline SceneBuilder furnace(MaterialType type, Color rho, double le) {
+    SceneBuilder b;
+    const int m = b.material(type, rho);
+    b.scene.materials[m].rho_r = rho;
+    b.scene.materials[m].rho_t = rho;
+    b.sphere({0, 0, 0}, 1, m);
+    b.emitter({0, 0, 0}, 20, Color(le), b.material(MaterialType::diffuse, Color(0)));
+    return b;
+}
+
 }  // namespace kr::test

@@ -116,12 +116,9 @@ struct BenchOptions {
 
 BenchOptions parse(int argc, char** argv) {
     BenchOptions o;
-    for (int i = 2; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
-            return argv[++i];
-        };
+    for (ArgCursor args(argc, argv); args.next();) {
+        const std::string& arg = args.arg();
+        auto value = [&] { return args.value(); };
         if (arg == "--throughput") o.throughput = true;
         else if (arg == "--linear") o.linear = true;
         else if (arg == "--fraction") o.fraction = parse_number(arg, value(), 1e-6, 1.0);
@@ -222,9 +219,7 @@ int run_bench(int argc, char** argv) {
     try {
         o = parse(argc, argv);
     } catch (const UsageError& e) {
-        if (!e.message.empty()) std::fprintf(stderr, "error: %s\n", e.message.c_str());
-        std::fprintf(e.message.empty() ? stdout : stderr, "%s", kBenchUsage);
-        return e.message.empty() ? 0 : 2;
+        return report_usage(e, kBenchUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
     if (o.write_stress > 0) {

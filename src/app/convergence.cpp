@@ -146,12 +146,9 @@ DIR/convergence.md (time to reach given errors, and the speed-up over the baseli
 
 Options parse(int argc, char** argv) {
     Options o;
-    for (int i = 2; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
-            return argv[++i];
-        };
+    for (ArgCursor args(argc, argv); args.next();) {
+        const std::string& arg = args.arg();
+        auto value = [&] { return args.value(); };
         if (arg == "--convergence") continue;
         else if (arg == "--configs") {
             std::stringstream ss(value());
@@ -507,9 +504,7 @@ int bench_convergence(int argc, char** argv) {
     try {
         o = parse(argc, argv);
     } catch (const UsageError& e) {
-        if (!e.message.empty()) std::fprintf(stderr, "error: %s\n", e.message.c_str());
-        std::fprintf(e.message.empty() ? stdout : stderr, "%s", kUsage);
-        return e.message.empty() ? 0 : 2;
+        return report_usage(e, kUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
     const std::vector<fs::path> scenes = o.scenes.empty() ? default_scenes() : o.scenes;

@@ -88,12 +88,9 @@ struct Options {
 
 Options parse_options(int argc, char** argv) {
     Options o;
-    for (int i = 2; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
-            return argv[++i];
-        };
+    for (ArgCursor args(argc, argv); args.next();) {
+        const std::string& arg = args.arg();
+        auto value = [&] { return args.value(); };
         if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
         else if (arg == "--time") o.time_limit = parse_positive(arg, value());
         else if (arg == "--noise") o.noise = parse_positive(arg, value());

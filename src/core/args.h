@@ -2,14 +2,47 @@
 // text must be the value, and a bad one becomes a UsageError naming the flag.
 #pragma once
 
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
 namespace kr {
 
 struct UsageError {
-    std::string message;
+    std::string message;  // empty: --help was asked for
 };
+
+// Walks the arguments after the subcommand:
+//   for (ArgCursor args(argc, argv); args.next();) { ... args.arg() ... args.value() ... }
+// value() takes the next argument as the current flag's value.
+class ArgCursor {
+public:
+    ArgCursor(int argc, char** argv, int first = 2) : argc_(argc), argv_(argv), index_(first - 1) {}
+    bool next() {
+        if (++index_ >= argc_) return false;
+        arg_ = argv_[index_];
+        return true;
+    }
+    const std::string& arg() const { return arg_; }
+    std::string value() {
+        if (index_ + 1 >= argc_) throw UsageError{arg_ + " needs a value"};
+        return argv_[++index_];
+    }
+
+private:
+    int argc_;
+    char** argv_;
+    int index_;
+    std::string arg_;
+};
+
+// The exit status for a UsageError of a subcommand with `usage` text: --help prints the usage
+// on stdout (0); an error prints itself and the usage on stderr (2).
+inline int report_usage(const UsageError& e, const char* usage) {
+    if (!e.message.empty()) std::fprintf(stderr, "error: %s\n", e.message.c_str());
+    std::fprintf(e.message.empty() ? stdout : stderr, "%s", usage);
+    return e.message.empty() ? 0 : 2;
+}
 
 // True if all of `text` reads as a number (stored in `value`).
 inline bool read_number(const std::string& text, double& value) {

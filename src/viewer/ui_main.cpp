@@ -58,12 +58,9 @@ std::pair<double, double> parse_pair(const std::string& flag, const std::string&
 ViewOptions parse(int argc, char** argv, bool& help) {
     ViewOptions o;
     bool have_scene = false;
-    for (int i = 2; i < argc; ++i) {
-        const std::string arg = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw UsageError{arg + " needs a value"};
-            return argv[++i];
-        };
+    for (ArgCursor args(argc, argv); args.next();) {
+        const std::string& arg = args.arg();
+        auto value = [&] { return args.value(); };
         if (arg == "-h" || arg == "--help") help = true;
         else if (arg == "--spp") o.overrides.spp = parse_int(arg, value(), 1, 1 << 24);
         else if (arg == "--depth") o.overrides.depth = parse_int(arg, value(), 0, kMaxDepth);
