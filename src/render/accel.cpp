@@ -325,8 +325,11 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres) {
 }
 
 // Two versions of each entry point: the default x86-64 one and an AVX2/FMA one, chosen by
-// the dynamic loader from the CPU's features (GCC function multi-versioning).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__)
+// the dynamic loader from the CPU's features (GCC function multi-versioning). Not under a
+// sanitizer: the loader runs the IFUNC resolver while relocating, before the sanitizer's
+// runtime is up, and GCC instruments the resolver too (its __tsan_func_entry segfaults).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__)
 #define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
 #else
 #define KR_CLONES
