@@ -435,7 +435,7 @@ struct Bench {
 
         PlotSpec plot;
         plot.title = stem + " (" + std::to_string(width) + "x" + std::to_string(height) + ")";
-        plot.x_label = "CPU seconds (" + std::to_string(omp_get_max_threads()) + " threads together)";
+        plot.x_label = "CPU seconds (" + std::to_string(omp_get_max_threads()) + (omp_get_max_threads() > 1 ? " threads together)" : " thread)");
         plot.y_label = radiance ? "relative RMSE of luminance" : "RMSE of the 8-bit image (levels)";
         for (const Series& s : series) {
             PlotSeries line;

@@ -86,7 +86,7 @@ Rgb8Image plot_loglog(const PlotSpec& spec, int width, int height) {
     x_lo = std::floor(x_lo), x_hi = std::max(std::ceil(x_hi), x_lo + 1);
     y_lo = std::floor(y_lo), y_hi = std::max(std::ceil(y_hi), y_lo + 1);
 
-    const int left = 90, right = width - 250, top = 50, bottom = height - 70;
+    const int left = 90, right = width - 310, top = 70, bottom = height - 70;
     auto px = [&](double lx) { return left + (lx - x_lo) / (x_hi - x_lo) * (right - left); };
     auto py = [&](double ly) { return bottom - (ly - y_lo) / (y_hi - y_lo) * (bottom - top); };
 
@@ -124,9 +124,9 @@ Rgb8Image plot_loglog(const PlotSpec& spec, int width, int height) {
         c.rect(right + 20, ly + 4, right + 50, ly + 10, colour);
         c.text(right + 58, ly, series.name, ink);
     }
-    c.text((left + right) / 2.0 - Canvas::text_width(spec.title, 3) / 2.0, 12, spec.title, ink, 3);
+    c.text((left + right) / 2.0 - Canvas::text_width(spec.title, 3) / 2.0, 8, spec.title, ink, 3);
     c.text((left + right) / 2.0 - Canvas::text_width(spec.x_label) / 2.0, bottom + 36, spec.x_label, ink);
-    c.text(8, top - 30, spec.y_label, ink);
+    c.text(left - 60, top - 28, spec.y_label, ink);
     return c.image;
 }
 
