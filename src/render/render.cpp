@@ -119,7 +119,9 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             const uint32_t index = state.sample_index[pixel]++;
             Sampler sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
             const Vec2 sub = sampler.pixel();
-            const Vec2 lens = scene.camera.lens_radius > 0 ? sampler.next_2d() : Vec2{};
+            Vec2 lens;
+            if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
+            else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
             const CameraRay cr = scene.camera.generate((x + sub.x) / width, (y + sub.y) / height, lens.x, lens.y);
             Ray ray;
             ray.o = cr.origin;

@@ -108,6 +108,16 @@ public:
                 to_unit(owen_scramble(sobol_dimension1(s.index), s.seed ^ 0xb5297a4du))};
     }
 
+    // Skips a 2-D dimension (the lens of a pinhole camera) without computing it, so every
+    // later dimension is the same as when it is drawn.
+    void skip_2d() {
+        if (scrambling()) {
+            ++dimension_;
+        } else {
+            rng_.next_u32(), rng_.next_u32(), rng_.next_u32(), rng_.next_u32();  // next() uses two each
+        }
+    }
+
 private:
     struct Shuffle {
         uint32_t index;  // this dimension's shuffled sample index
