@@ -122,7 +122,8 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             Vec2 lens;
             if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
             else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
-            const CameraRay cr = scene.camera.generate((x + sub.x) / width, (y + sub.y) / height, lens.x, lens.y);
+            const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+            const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
             Ray ray;
             ray.o = cr.origin;
             ray.d = cr.direction;

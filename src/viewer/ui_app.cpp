@@ -184,7 +184,9 @@ void ViewerApp::handle_input() {
             mx >= rect.x && my >= rect.y && mx < rect.x + rect.width && my < rect.y + rect.height;
         const double dx = io.MouseDelta.x * to_fb / image_scale, dy = io.MouseDelta.y * to_fb / image_scale;
         if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && over_image && (io.KeyCtrl || pick_focus_)) {
-            if (!model_.focus_at((mx - rect.x) / rect.width, (my - rect.y) / rect.height))
+            const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
+            const Vec2 film = raster_to_camera((mx - rect.x) / rect.width * w, (my - rect.y) / rect.height * h, w, h);
+            if (!model_.focus_at(film.x, film.y))
                 error_ = "click-to-focus: nothing there to focus on";
             else
                 generation_edited_ = Clock::now();
@@ -315,9 +317,9 @@ int ViewerApp::run() {
                 orbit_drag(s.cameras[size_t(s.camera)], options_.orbit->first, options_.orbit->second);
             });
         if (options_.click_focus) {
-            const double fx = (options_.click_focus->first + 0.5) / model_.scene().renderer.width;
-            const double fy = (options_.click_focus->second + 0.5) / model_.scene().renderer.height;
-            if (!model_.focus_at(fx, fy)) {
+            const Vec2 film = raster_to_camera(options_.click_focus->first + 0.5, options_.click_focus->second + 0.5,
+                                               model_.scene().renderer.width, model_.scene().renderer.height);
+            if (!model_.focus_at(film.x, film.y)) {
                 std::fprintf(stderr, "error: --click-focus: the ray through that pixel hits nothing\n");
                 return 1;
             }
