@@ -7,7 +7,11 @@ cd "$(dirname "$0")/.."
 packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           # the viewer (keithray view) and its offscreen display (render --gl), and
           # the X server its window test runs under
-          libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xauth)
+          libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xauth
+          # the sanitizer and fuzzing builds (scripts/check_sanitizers.sh): clang, its
+          # sanitizer and libFuzzer runtimes, its OpenMP runtime (whose archer tool makes
+          # OpenMP visible to ThreadSanitizer) and llvm-symbolizer for the reports' stacks
+          clang libclang-rt-14-dev libomp-14-dev llvm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
