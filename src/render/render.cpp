@@ -107,10 +107,10 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     uint64_t rays = 0, nonfinite = 0;
     bool stopped = false;
     // Rows handed out one at a time: rows through glass cost far more than rows of wall.
-#pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, nonfinite)
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, nonfinite) reduction(|| : stopped)
     for (int y = 0; y < height; ++y) {
         if (stop && stop->load(std::memory_order_relaxed)) {
-            stopped = true;  // benign race: every writer stores true
+            stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
             continue;
         }
         for (int x = 0; x < width; ++x) {
