@@ -49,7 +49,9 @@ protected:
     }
     ViewRun keithray(const std::string& args, bool window) {
         // A screen big enough for the 512x512 image at 1:1 beside the panels.
-        const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24' " : "";
+        // -noreset: a resetting Xvfb signals xvfb-run again after the last client leaves, and
+        // if that lands during xvfb-run's clean-up it exits 5 instead of keithray's status.
+        const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' " : "";
         return kr::test::run_command(prefix + "'" + KEITHRAY_EXE + "' " + args, dir);
     }
 };
