@@ -50,10 +50,13 @@ struct Config {
     Integrator integrator = Integrator::pt;
     LightSampling light = LightSampling::area;
     Estimator estimator = Estimator::uniform;
+    Allocation allocation = Allocation::uniform;
 
+    // INTEGRATOR/LIGHT/ESTIMATOR, with /adaptive appended for adaptive allocation.
     std::string name() const {
         return std::string(integrator_names.name(integrator)) + "/" + std::string(light_sampling_names.name(light)) +
-               "/" + std::string(estimator_names.name(estimator));
+               "/" + std::string(estimator_names.name(estimator)) +
+               (allocation == Allocation::uniform ? "" : "/" + std::string(allocation_names.name(allocation)));
     }
     // Configurations with the same key converge to the same image: WRT and PT differ, and
     // the brief's light estimator is brighter near lights than the exact ones (docs/fidelity.md).
@@ -68,19 +71,21 @@ Config parse_config(const std::string& text) {
     std::vector<std::string> parts;
     std::stringstream ss(text);
     for (std::string part; std::getline(ss, part, '/');) parts.push_back(part);
-    if (parts.size() != 3)
-        throw UsageError{"--configs expects INTEGRATOR/LIGHT/ESTIMATOR items (e.g. pt/cone/sobol), got \"" + text + "\""};
+    if (parts.size() != 3 && parts.size() != 4)
+        throw UsageError{"--configs expects INTEGRATOR/LIGHT/ESTIMATOR[/ALLOCATION] items (e.g. pt/cone/sobol or "
+                         "pt/brief/sobol/adaptive), got \"" + text + "\""};
     Config c;
     c.integrator = parse_name("--configs integrator", parts[0], integrator_names);
     c.light = parse_name("--configs light sampling", parts[1], light_sampling_names);
     c.estimator = parse_name("--configs estimator", parts[2], estimator_names);
+    if (parts.size() == 4) c.allocation = parse_name("--configs allocation", parts[3], allocation_names);
     return c;
 }
 
 // The defaults of `keithray render`, named as a configuration.
 Config default_config(Integrator integrator) {
     const RenderSettings d;
-    return {integrator, d.light_sampling, d.estimator};
+    return {integrator, d.light_sampling, d.estimator, d.allocation};
 }
 
 // The baselines first: for the exact image the brief's stated one (uniform area light
@@ -92,6 +97,7 @@ std::vector<Config> default_configs(Integrator file_integrator) {
     if (file_integrator == Integrator::wrt) {
         for (Estimator e : {Estimator::uniform, Estimator::stratified, Estimator::sobol})
             list.push_back({Integrator::wrt, LightSampling::area, e});
+        list.push_back({Integrator::wrt, LightSampling::area, Estimator::sobol, Allocation::adaptive});
         return list;
     }
     list = {{Integrator::pt, LightSampling::area, Estimator::uniform},
@@ -99,8 +105,10 @@ std::vector<Config> default_configs(Integrator file_integrator) {
             {Integrator::pt, LightSampling::area, Estimator::stratified},
             {Integrator::pt, LightSampling::cone, Estimator::uniform},
             {Integrator::pt, LightSampling::cone, Estimator::sobol},
+            {Integrator::pt, LightSampling::cone, Estimator::sobol, Allocation::adaptive},
             {Integrator::pt, LightSampling::brief, Estimator::stratified},
             {Integrator::pt, LightSampling::brief, Estimator::sobol},
+            {Integrator::pt, LightSampling::brief, Estimator::sobol, Allocation::adaptive},
             {Integrator::pt_naive, LightSampling::cone, Estimator::sobol},
             {Integrator::wrt, LightSampling::cone, Estimator::sobol}};
     return list;
@@ -325,6 +333,7 @@ struct Bench {
         settings.integrator = c.integrator == Integrator::wrt ? Integrator::wrt : Integrator::pt;
         settings.light_sampling = c.expectation().ends_with("-brief") ? LightSampling::brief : LightSampling::cone;
         settings.estimator = Estimator::sobol;
+        settings.allocation = Allocation::uniform;  // unbiased: the sample counts never depend on the samples
         const std::string key = file.stem().string() + "-" + c.expectation() + "-" + std::to_string(width) + "x" +
                                 std::to_string(height) + "-" + std::to_string(spp) + "spp-" + hex(fnv1a(read_text(file)));
         const fs::path cache = o.out_dir / "cache" / (key + ".ref");
@@ -376,6 +385,7 @@ struct Bench {
             s.settings.integrator = c.integrator;
             s.settings.light_sampling = c.light;
             s.settings.estimator = c.estimator;
+            s.settings.allocation = c.allocation;
             s.settings.target_spp = spp;
             s.state.reset(width, height);
             series.push_back(std::move(s));
@@ -410,6 +420,7 @@ struct Bench {
         for (int pass = 1; pass <= spp; ++pass) {
             for (Series& s : series) {
                 const double t0 = cpu_seconds();
+                s.state.plan_pass(s.settings);
                 render_pass(scene, s.settings, s.state);
                 s.seconds += cpu_seconds() - t0;
                 if (pass == checkpoints[next_checkpoint]) {

@@ -50,6 +50,10 @@ Options:
   --estimator NAME      where samples come from: uniform | stratified | sobol
                         (default: sobol, Owen-scrambled Sobol in every dimension;
                         stratified is the brief's sub-pixel strata; docs/accuracy.md)
+  --allocation NAME     how a pass spreads its samples: adaptive | uniform (default:
+                        adaptive, each pixel's share in proportion to its estimated
+                        noise after 8 passes, the same total; --spp N is then the
+                        mean per pixel; stratified always gets uniform)
   --light-sampling NAME spherical lights: brief | brief-area | cone | area (default:
                         brief, the integral of the brief's reference images, importance
                         sampled; brief-area is the brief's own uniform sampling of it;
@@ -77,6 +81,7 @@ struct Options {
     double time_limit = 0, noise = 0;  // 0: rule off
     std::optional<Integrator> integrator;
     std::optional<Estimator> estimator;
+    std::optional<Allocation> allocation;
     std::optional<LightSampling> light_sampling;
     ToneMap tonemap = ToneMap::sigmoid;
     int blur = 0;
@@ -100,6 +105,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, (1ll << 62)));
         else if (arg == "--integrator") o.integrator = parse_name(arg, value(), integrator_names);
         else if (arg == "--estimator") o.estimator = parse_name(arg, value(), estimator_names);
+        else if (arg == "--allocation") o.allocation = parse_name(arg, value(), allocation_names);
         else if (arg == "--light-sampling") o.light_sampling = parse_name(arg, value(), light_sampling_names);
         else if (arg == "--tonemap") o.tonemap = parse_name(arg, value(), tonemap_names);
         else if (arg == "-o" || arg == "--output") o.output = value();
@@ -148,6 +154,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     if (opt.spp) settings.target_spp = *opt.spp;
     if (opt.integrator) settings.integrator = *opt.integrator;
     if (opt.estimator) settings.estimator = *opt.estimator;
+    if (opt.allocation) settings.allocation = *opt.allocation;
     if (opt.light_sampling) settings.light_sampling = *opt.light_sampling;
     if (opt.depth) {
         if (*opt.depth > kMaxDepth)

@@ -28,6 +28,8 @@ void RenderState::reset(int w, int h) {
     rays = 0;
     nonfinite_samples = 0;
     active.clear();
+    pass_samples.clear();
+    sample_credit.clear();
 }
 
 Image RenderState::radiance() const {
@@ -68,6 +70,31 @@ double RenderState::relative_error() const {
     return std::sqrt(error_sq / signal_sq);
 }
 
+namespace {
+
+// Each value replaced by the larger of itself and the mean over its 3x3 neighbourhood.
+// A few samples can miss a rare bright path and show almost no variance; variance varies
+// smoothly over the image, so the neighbours guard against that.
+std::vector<double> guard_3x3(const std::vector<double>& v, int width, int height) {
+    std::vector<double> out(v.size());
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            double sum = 0;
+            int cells = 0;
+            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
+                    sum += v[size_t(yy) * width + xx];
+                    ++cells;
+                }
+            const size_t i = size_t(y) * width + x;
+            out[i] = std::max(v[i], sum / cells);
+        }
+    return out;
+}
+
+}  // namespace
+
 size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
     const size_t n = sample_count.size();
     double signal_sq = 0;
@@ -79,26 +106,62 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
         error_sq[i] = se * se;
     }
     const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
+    const std::vector<double> local = guard_3x3(error_sq, width, height);
     active.assign(n, 0);
     size_t count = 0;
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) {
-            // A few samples can miss a rare bright path and show almost no variance; the
-            // mean over the 3x3 neighbourhood (variance varies smoothly) guards against that.
-            double sum = 0;
-            int cells = 0;
-            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
-                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
-                    sum += error_sq[size_t(yy) * width + xx];
-                    ++cells;
-                }
-            const size_t i = size_t(y) * width + x;
-            const double local = std::max(error_sq[i], sum / cells);
-            const bool needs_more = sample_count[i] < min_samples || !(local <= share);
-            active[i] = needs_more;
-            count += needs_more;
-        }
+    for (size_t i = 0; i < n; ++i) {
+        const bool needs_more = sample_count[i] < min_samples || !(local[i] <= share);
+        active[i] = needs_more;
+        count += needs_more;
+    }
     return count;
+}
+
+std::vector<double> RenderState::guarded_sample_variance() const {
+    std::vector<double> variance(sample_count.size());
+    for (size_t i = 0; i < variance.size(); ++i) {
+        const double se = pixel_standard_error(i);
+        variance[i] = se * se * sample_count[i];  // of the mean, times n: of one sample
+    }
+    return guard_3x3(variance, width, height);
+}
+
+void RenderState::plan_pass(const RenderSettings& settings) {
+    if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
+        passes < kAllocationWarmup) {
+        pass_samples.clear();
+        return;
+    }
+    const size_t n = sample_count.size();
+    // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
+    // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
+    // estimate may be too low, and bounds the bias of deciding from the samples themselves.
+    std::vector<double> weight = guarded_sample_variance();
+    double sum = 0;
+    size_t active_count = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const bool on = active.empty() || active[i];
+        weight[i] = on && std::isfinite(weight[i]) ? std::sqrt(weight[i]) : 0.0;
+        sum += weight[i];
+        active_count += on;
+    }
+    const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
+    sum = sum * (1 + kAllocationFloor);
+    if (!(sum > 0) || !std::isfinite(sum)) {
+        pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
+        return;
+    }
+    sample_credit.resize(n, 0.0f);
+    pass_samples.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+        if (!(active.empty() || active[i])) continue;
+        // Quotas sum to the active pixel count: the pass costs what a uniform one does.
+        const double quota = (weight[i] + floor) * double(active_count) / sum;
+        const double credit = std::min<double>(sample_credit[i] + quota, 4 * kMaxPassSamples);
+        const int take = std::min(int(credit), kMaxPassSamples);
+        pass_samples[i] = static_cast<uint8_t>(take);
+        sample_credit[i] = static_cast<float>(credit - take);
+    }
 }
 
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
@@ -116,30 +179,33 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         for (int x = 0; x < width; ++x) {
             const size_t pixel = static_cast<size_t>(y) * width + x;
             if (!state.active.empty() && !state.active[pixel]) continue;
-            const uint32_t index = state.sample_index[pixel]++;
-            Sampler sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
-            const Vec2 sub = sampler.pixel();
-            Vec2 lens;
-            if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
-            else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
-            const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
-            const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
-            Ray ray;
-            ray.o = cr.origin;
-            ray.d = cr.direction;
-            const SampleResult r = trace_sample(scene, settings, ray, sampler);
-            rays += r.rays;
-            // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
-            // would overflow the pixel's sum.
-            if (!is_finite(r.radiance) || !is_finite(state.radiance_sum[pixel] + r.radiance)) {
-                ++nonfinite;
-                continue;
+            const int samples = state.pass_samples.empty() ? 1 : state.pass_samples[pixel];
+            for (int k = 0; k < samples; ++k) {
+                const uint32_t index = state.sample_index[pixel]++;
+                Sampler sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+                const Vec2 sub = sampler.pixel();
+                Vec2 lens;
+                if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
+                else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
+                const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+                Ray ray;
+                ray.o = cr.origin;
+                ray.d = cr.direction;
+                const SampleResult r = trace_sample(scene, settings, ray, sampler);
+                rays += r.rays;
+                // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
+                // would overflow the pixel's sum.
+                if (!is_finite(r.radiance) || !is_finite(state.radiance_sum[pixel] + r.radiance)) {
+                    ++nonfinite;
+                    continue;
+                }
+                state.radiance_sum[pixel] += r.radiance;
+                state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
+                const double lum = luminance(r.radiance);
+                state.luminance_sq_sum[pixel] += lum * lum;
+                state.sample_count[pixel] += 1;
             }
-            state.radiance_sum[pixel] += r.radiance;
-            state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
-            const double lum = luminance(r.radiance);
-            state.luminance_sq_sum[pixel] += lum * lum;
-            state.sample_count[pixel] += 1;
         }
     }
     state.rays += rays;
@@ -153,6 +219,7 @@ StopReason render_until(const RenderScene& scene, const RenderSettings& settings
                         const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass) {
     const auto start = std::chrono::steady_clock::now();
     for (int pass = 0; pass < rule.max_passes; ++pass) {
+        state.plan_pass(settings);
         render_pass(scene, settings, state);
         if (on_pass && !on_pass(state)) return StopReason::cancelled;
         if (rule.noise > 0 && pass + 1 >= int(rule.min_samples) && (pass + 1) % rule.adapt_every == 0) {

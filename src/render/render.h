@@ -22,9 +22,17 @@ inline constexpr EnumNames<Integrator, 3> integrator_names{{"wrt", "pt", "pt-nai
 // Distance recorded in the depth map for a primary ray that hits nothing.
 inline constexpr double kMissDepth = 1e6;
 
+// How a pass spreads its samples over the pixels: one each, or (adaptive) as many in total,
+// each pixel's share in proportion to its estimated noise, once every pixel has a few
+// samples. The brief's stratified estimator needs exactly its s samples per pixel, so it
+// always gets one each.
+enum class Allocation { uniform, adaptive };
+inline constexpr EnumNames<Allocation, 2> allocation_names{{"uniform", "adaptive"}};
+
 struct RenderSettings {
     Integrator integrator = Integrator::pt;
     Estimator estimator = Estimator::sobol;
+    Allocation allocation = Allocation::adaptive;
     LightSampling light_sampling = LightSampling::brief;
     int max_depth = 6;          // scattering events per path, 0..kMaxDepth
     int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
@@ -45,8 +53,12 @@ struct RenderState {
     int passes = 0;                       // completed passes
     uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
     uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
-    // Adaptive sampling: render_pass samples only pixels whose entry is 1 (empty: all of them).
+    // The noise rule (update_adaptive): render_pass samples only pixels whose entry is 1
+    // (empty: all of them).
     std::vector<uint8_t> active;
+    // Samples per pixel in the next pass, set by plan_pass (empty: one each).
+    std::vector<uint8_t> pass_samples;
+    std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
@@ -66,9 +78,26 @@ struct RenderState {
     // total, target^2 * sum(mean^2) / pixels, or it has fewer than `min_samples` samples.
     // When no pixel is active the image meets the target. Returns the active count.
     size_t update_adaptive(double target, uint32_t min_samples = 16);
+
+    // Plans the next pass for `settings.allocation` (fills pass_samples). Adaptive: after
+    // kAllocationWarmup passes, each active pixel's share of the pass (as many samples as
+    // active pixels) is proportional to its estimated standard deviation (3x3 guarded, as
+    // update_adaptive) plus a floor, which minimises the summed variance of the pixel means
+    // for the budget; fractions carry over between passes. Serial sums: the plan does not
+    // depend on threads.
+    void plan_pass(const RenderSettings& settings);
+    // Variance of one sample's luminance in pixel i, guarded against the few-sample case by
+    // the mean over its 3x3 neighbourhood (variance varies smoothly; a rare bright path may
+    // not have shown up yet). Infinite below two samples.
+    std::vector<double> guarded_sample_variance() const;
 };
 
-// Adds one sample to every pixel of `state` (sample index = the pixel's own count of samples drawn).
+inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
+inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean
+inline constexpr int kMaxPassSamples = 64;         // per pixel and pass
+
+// Adds one sample to every pixel of `state`, or the number state.pass_samples gives (sample
+// index = the pixel's own count of samples drawn).
 // Parallel over rows with OpenMP; each sample has its own RNG stream seeded by
 // (seed, pixel, sample index), so the image does not depend on threads or scheduling.
 // If `stop` becomes true the pass ends early and returns false; pixels it reached keep their

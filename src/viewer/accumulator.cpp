@@ -25,6 +25,9 @@ void Accumulator::reset(int width, int height) {
 
 bool Accumulator::render_pass(const RenderScene& scene, const RenderSettings& settings,
                               const std::atomic<bool>* stop) {
+    // The plan comes from the totals' statistics (the scratch state holds one pass).
+    totals_.plan_pass(settings);
+    scratch_.pass_samples = totals_.pass_samples;
     const bool complete = kr::render_pass(scene, settings, scratch_, stop);
     if (complete) add(scratch_);
     // Clear the per-pass sums; sample_index stays, so the next pass draws the next samples.

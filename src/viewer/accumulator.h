@@ -16,7 +16,8 @@ class Accumulator {
 public:
     void reset(int width, int height);
 
-    // Renders one pass with kr::render_pass and adds it. If `stop` ends the pass early it
+    // Renders one pass with kr::render_pass (planned by RenderState::plan_pass on the totals
+    // for adaptive allocation) and adds it. If `stop` ends the pass early it
     // returns false and adds nothing (the caller restarts anyway).
     bool render_pass(const RenderScene& scene, const RenderSettings& settings,
                      const std::atomic<bool>* stop = nullptr);
@@ -25,9 +26,12 @@ public:
     // totals): later passes sample only the pixels still above their share. Returns their
     // count; 0 means the image meets the target. clear_adaptive() samples every pixel again.
     size_t update_adaptive(double target);
-    void clear_adaptive() { scratch_.active.clear(); }
+    void clear_adaptive() {
+        scratch_.active.clear();
+        totals_.active.clear();
+    }
 
-    // Adds a one-pass state: per pixel at most one sample, in `pass.radiance_sum` etc.
+    // Adds a one-pass state: its samples per pixel in `pass.radiance_sum` etc.
     void add(const RenderState& pass);
 
     // The running totals as a RenderState (radiance_sum holds the compensated sums), for

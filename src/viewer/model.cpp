@@ -35,6 +35,7 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     if (overrides_.depth) settings.render.max_depth = std::min(*overrides_.depth, kMaxDepth);
     if (overrides_.integrator) settings.render.integrator = *overrides_.integrator;
     if (overrides_.estimator) settings.render.estimator = *overrides_.estimator;
+    if (overrides_.allocation) settings.render.allocation = *overrides_.allocation;
     if (overrides_.light_sampling) settings.render.light_sampling = *overrides_.light_sampling;
     if (overrides_.seed) settings.render.seed = *overrides_.seed;
     settings.tone = tone;

@@ -71,6 +71,7 @@ public:
         std::optional<int> spp, depth;
         std::optional<Integrator> integrator;
         std::optional<Estimator> estimator;
+        std::optional<Allocation> allocation;
         std::optional<LightSampling> light_sampling;
         std::optional<uint64_t> seed;
     };

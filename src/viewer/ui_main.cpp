@@ -28,6 +28,7 @@ Options:
   --noise X             stop at estimated relative error X (adaptive sampling)
   --integrator NAME     wrt | pt | pt-naive      --depth N         0..20
   --estimator NAME      uniform | stratified | sobol
+  --allocation NAME     adaptive | uniform (samples per pixel and pass)
   --light-sampling NAME brief | brief-area | cone | area
   --seed N              random seed (default 0)
   --tonemap NAME        sigmoid | linear         --exposure E      sigmoid exposure
@@ -67,6 +68,7 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--seed") o.overrides.seed = uint64_t(parse_number(arg, value(), 0, 9e15));
         else if (arg == "--integrator") o.overrides.integrator = parse_name(arg, value(), integrator_names);
         else if (arg == "--estimator") o.overrides.estimator = parse_name(arg, value(), estimator_names);
+        else if (arg == "--allocation") o.overrides.allocation = parse_name(arg, value(), allocation_names);
         else if (arg == "--light-sampling") o.overrides.light_sampling = parse_name(arg, value(), light_sampling_names);
         else if (arg == "--tonemap") o.tone.op = parse_name(arg, value(), tonemap_names);
         else if (arg == "--exposure") o.tone.exposure = parse_number(arg, value(), 1e-6, 1e6);

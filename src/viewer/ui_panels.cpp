@@ -244,6 +244,7 @@ void ViewerApp::panel_renderer() {
     bool changed = combo("integrator", r.integrator, integrator_names);
     changed |= ImGui::SliderInt("depth", &r.max_depth, 0, kMaxDepth);
     changed |= combo("estimator", r.estimator, estimator_names);
+    changed |= combo("allocation", r.allocation, allocation_names);
     if (r.integrator != Integrator::wrt) changed |= combo("light sampling", r.light_sampling, light_sampling_names);
     int spp = r.target_spp;
     if (ImGui::InputInt("target spp", &spp, 1, 16, ImGuiInputTextFlags_EnterReturnsTrue)) {
