@@ -132,10 +132,11 @@ constexpr const char* kUsage = R"(Usage:
 Renders each scene (default: every res/scenes/*.json) with each configuration, side by
 side, at F times the file's resolution (default 0.25), checking the error after 1, 2, 4,
 ... samples per pixel up to N (default: the file's sample count). Configurations are
-INTEGRATOR/LIGHT/ESTIMATOR items separated by commas, e.g. pt/area/uniform,pt/cone/sobol
-(integrators wrt, pt, pt-naive; light sampling brief, brief-area, cone, area; estimators
-uniform, stratified, sobol). Each configuration's speed-up is measured against the first
-one listed that converges to the same image: by default pt/area/uniform for the exact
+INTEGRATOR/LIGHT/ESTIMATOR[/ALLOCATION] items separated by commas, e.g.
+pt/area/uniform,pt/cone/sobol/adaptive (integrators wrt, pt, pt-naive; light sampling
+brief, brief-area, cone, area; estimators uniform, stratified, sobol; allocation uniform,
+the default when left out, or adaptive). Each configuration's speed-up is measured
+against the first one listed that converges to the same image: by default pt/area/uniform for the exact
 image (the brief's stated baseline) and pt/brief-area/uniform for the brief's (the brief's
 own estimator).
 
