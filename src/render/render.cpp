@@ -46,15 +46,17 @@ std::vector<double> RenderState::mean_depth() const {
     return d;
 }
 
-double RenderState::pixel_standard_error(size_t i) const {
+double RenderState::sample_variance(size_t i) const {
     const double n = sample_count[i];
     // Below two samples there is no variance; a sum of squares that overflowed (radiance
-    // above ~1e154) would give inf - inf: the error is unknown, not zero.
+    // above ~1e154) would give inf - inf: the variance is unknown, not zero.
     if (n < 2 || !std::isfinite(luminance_sq_sum[i])) return kInfinity;
     const double mean = luminance(radiance_sum[i]) / n;
-    // Unbiased sample variance of one sample, then of the mean of n.
-    const double variance = std::max(0.0, (luminance_sq_sum[i] - n * mean * mean) / (n - 1));
-    return std::sqrt(variance / n);
+    return std::max(0.0, (luminance_sq_sum[i] - n * mean * mean) / (n - 1));  // unbiased
+}
+
+double RenderState::pixel_standard_error(size_t i) const {
+    return std::sqrt(sample_variance(i) / sample_count[i]);  // of the mean of n samples
 }
 
 double RenderState::relative_error() const {
@@ -117,15 +119,6 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
     return count;
 }
 
-std::vector<double> RenderState::guarded_sample_variance() const {
-    std::vector<double> variance(sample_count.size());
-    for (size_t i = 0; i < variance.size(); ++i) {
-        const double se = pixel_standard_error(i);
-        variance[i] = se * se * sample_count[i];  // of the mean, times n: of one sample
-    }
-    return guard_3x3(variance, width, height);
-}
-
 void RenderState::plan_pass(const RenderSettings& settings) {
     if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
         passes < kAllocationWarmup) {
@@ -136,7 +129,9 @@ void RenderState::plan_pass(const RenderSettings& settings) {
     // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
     // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
     // estimate may be too low, and bounds the bias of deciding from the samples themselves.
-    std::vector<double> weight = guarded_sample_variance();
+    std::vector<double> variance(n);
+    for (size_t i = 0; i < n; ++i) variance[i] = sample_variance(i);
+    std::vector<double> weight = guard_3x3(variance, width, height);
     double sum = 0;
     size_t active_count = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -146,8 +141,8 @@ void RenderState::plan_pass(const RenderSettings& settings) {
         active_count += on;
     }
     const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
-    sum = sum * (1 + kAllocationFloor);
-    if (!(sum > 0) || !std::isfinite(sum)) {
+    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
+    if (!(total > 0) || !std::isfinite(total)) {
         pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
         return;
     }
@@ -156,7 +151,7 @@ void RenderState::plan_pass(const RenderSettings& settings) {
     for (size_t i = 0; i < n; ++i) {
         if (!(active.empty() || active[i])) continue;
         // Quotas sum to the active pixel count: the pass costs what a uniform one does.
-        const double quota = (weight[i] + floor) * double(active_count) / sum;
+        const double quota = (weight[i] + floor) * double(active_count) / total;
         const double credit = std::min<double>(sample_credit[i] + quota, 4 * kMaxPassSamples);
         const int take = std::min(int(credit), kMaxPassSamples);
         pass_samples[i] = static_cast<uint8_t>(take);

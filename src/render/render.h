@@ -66,6 +66,8 @@ struct RenderState {
     Image radiance() const;                  // per-pixel mean radiance
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
 
+    // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
+    double sample_variance(size_t i) const;
     // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
     // two samples).
     double pixel_standard_error(size_t i) const;
@@ -86,10 +88,6 @@ struct RenderState {
     // for the budget; fractions carry over between passes. Serial sums: the plan does not
     // depend on threads.
     void plan_pass(const RenderSettings& settings);
-    // Variance of one sample's luminance in pixel i, guarded against the few-sample case by
-    // the mean over its 3x3 neighbourhood (variance varies smoothly; a rare bright path may
-    // not have shown up yet). Infinite below two samples.
-    std::vector<double> guarded_sample_variance() const;
 };
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
