@@ -1,5 +1,6 @@
 // The BVH with four-wide sphere blocks against the plain linear scan: same hits at every
-// scale and size, for every kind of ray the integrators cast, and the same images.
+// scale and size, for every kind of ray the integrators cast (shadow segments ending short
+// of, on and past a surface included), and the same images.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -70,6 +71,15 @@ Agreement compare(const RenderScene& scene, double scale, uint64_t seed, int cou
             shadow.to_sphere = b_lin.sphere;
             ++a.rays;
             if (scene.is_occluded_linear(shadow) != scene.is_occluded(shadow)) ++a.mismatches;
+            // Segments ending at a random point, and a hair before and after the next
+            // surface, with no target sphere: the any-hit query culls spheres that start
+            // beyond a segment's end before taking a square root.
+            for (double end : {rng.next(), 1 - 1e-9, 1 + 1e-9}) {
+                Ray partial = bounce;
+                partial.tmax = end * b_lin.t;
+                ++a.rays;
+                if (scene.is_occluded_linear(partial) != scene.is_occluded(partial)) ++a.mismatches;
+            }
         }
     }
     return a;

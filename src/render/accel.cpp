@@ -187,9 +187,23 @@ inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, 
     v4l ids;
     __builtin_memcpy(&ids, b.id, sizeof ids);
     const v4l origin = ids == static_cast<int64_t>(ray.from_sphere);
-    // Most lanes miss: the line passes the sphere by, or the sphere lies behind an origin
-    // outside it. Skip the square root and division when all four do.
-    const v4l candidate = (disc >= 0) & ~((c > 0) & (half_b > 0) & ~origin);
+    const v4l into = ray.into_from_sphere ? ~v4l{} : v4l{};
+    // Most lanes miss: the line passes the sphere by, the sphere lies behind an origin
+    // outside it, the ray leaves its own sphere or ends on this one. Skip the square root and
+    // division when all four do.
+    v4l candidate = (disc >= 0) & ~((c > 0) & (half_b > 0) & ~origin) & (~origin | into) &
+                    (ids != static_cast<int64_t>(ray.to_sphere));
+    if (tmax < kInf) {
+        // A finite segment (shadow rays; closest hits once one is found): from outside, the
+        // near root c / (-half_b + sqrt(disc)) is at least c / (2 |half_b|), so a sphere with
+        // c > 2 |half_b| tmax starts beyond the end. Walls behind a lamp go here. The factor
+        // covers the rounding of the three terms (c itself is cancellation-prone, hence the
+        // margin on its own magnitude).
+        constexpr double kMargin = 16 * std::numeric_limits<double>::epsilon();
+        const v4d f2 = fx * fx + fy * fy + fz * fz;
+        const v4l beyond = ~origin & (c > kMargin * (f2 + r2)) & (c > (-2.0 * (1.0 + kMargin)) * half_b * tmax);
+        candidate &= ~beyond;
+    }
     if (!(candidate[0] | candidate[1] | candidate[2] | candidate[3])) return inf;
     const v4d root = sqrt4(select4(disc > 0, disc, zero));
     // Vieta: q = -b - sign(b) sqrt(disc); roots q and c / q (both 0 when q is).
@@ -206,11 +220,9 @@ inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, 
     }
     // Only roots ahead of the origin (t > 0); the origin's own sphere only when entering it.
     const v4l near_ok = ~origin & (t_near >= ray.tmin) & (t_near > 0) & (t_near <= end);
-    const v4l into = ray.into_from_sphere ? ~v4l{} : v4l{};
     const v4l far_ok = (t_far >= ray.tmin) & (t_far > 0) & (t_far <= end) & (~origin | into);
     const v4d t = select4(near_ok, t_near, select4(far_ok, t_far, inf));
-    const v4l rejected = ~candidate | (ids == static_cast<int64_t>(ray.to_sphere));
-    return select4(rejected, inf, t);
+    return select4(candidate, t, inf);
 }
 
 struct SlabRay {
@@ -242,10 +254,25 @@ template <bool kAny>
 inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& nodes,
                                                    const std::vector<SphereBlock>& blocks, const Ray& ray,
                                                    double& t_best) {
-    const SlabRay slab(ray);
-    const bool dir_negative[3] = {ray.d.x < 0, ray.d.y < 0, ray.d.z < 0};
     double best = ray.tmax;
     int best_id = -1;
+    if (nodes[0].blocks > 0) {
+        // One leaf (scenes of a few spheres): no box to test, and no reciprocals to compute.
+        for (uint32_t k = 0; k < nodes[0].blocks; ++k) {
+            const v4d t = block_distances<kAny>(blocks[k], ray, best);
+            for (int lane = 0; lane < 4; ++lane)
+                if (t[lane] < kInf && (t[lane] < best || best_id < 0)) {
+                    best = t[lane];
+                    best_id = blocks[k].id[lane];
+                    if constexpr (kAny) break;
+                }
+            if (kAny && best_id >= 0) break;
+        }
+        t_best = best;
+        return best_id;
+    }
+    const SlabRay slab(ray);
+    const bool dir_negative[3] = {ray.d.x < 0, ray.d.y < 0, ray.d.z < 0};
     uint32_t stack[kMaxTreeDepth + 1];
     int top = 0;
     uint32_t node = 0;

@@ -27,11 +27,16 @@ double sphere_area(const SphereGeom& s) { return 4.0 * kPi * s.radius * s.radius
 // where v = ln(a / (d - r)^2) grows as p nears the light. Each part keeps the other's weight
 // bounded: near, the log-uniform part; far, the u part.
 struct BriefProposal {
+    // ln(a / (d - r)^2) = -ln(1 - b / a): one log of a ratio, cheaper than log1p. For a far
+    // light the ratio is near 1 and loses relative precision, but v_max is then tiny and the
+    // log-uniform part's weight 1 - alpha ~ v_max^3 negligible.
+    static double log_ratio(double a, double gap) { return std::log(a / (gap * gap)); }
+
     double a, b, v_max, alpha;
     BriefProposal(const SphereGeom& light, double d)
         : a(d * d + light.radius * light.radius),
           b(2 * d * light.radius),
-          v_max(-std::log1p(-b / a)),
+          v_max(log_ratio(a, d - light.radius)),
           alpha(1.0 / (1.0 + v_max * v_max * v_max)) {}
     // Density of u on [0, 1]: alpha 2u + (1 - alpha) b / (s v_max).
     double pdf(double u) const { return alpha * 2 * u + (1 - alpha) * b / ((a - b * u) * v_max); }
