@@ -163,20 +163,22 @@ struct Tracer {
             const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
 
             // Every vertex draws the same dimensions whatever its material, so each dimension
-            // of a low-discrepancy sampler keeps one meaning across the pixel's samples.
-            const double u_light_pick = sampler.next_1d();
-            const Vec2 u_light = sampler.next_2d();
-            const double u_lobe = sampler.next_1d();
-            const Vec2 u_bsdf = sampler.next_2d();
-            const double u_roulette = sampler.next_1d();
+            // of a low-discrepancy sampler keeps one meaning across the pixel's samples; only
+            // those this vertex reads are computed.
+            const bool next_event = has_smooth_lobe(m) && scene.light_count() > 0;
+            const bool roulette = bounce + 1 >= settings.rr_depth;
+            const Sampler::VertexNumbers u = sampler.next_vertex(
+                (next_event && scene.light_count() > 1 ? Sampler::use_light_pick : 0u) |
+                (next_event && !scene.area_lights.empty() ? Sampler::use_light : 0u) |
+                (uses_lobe_choice(m) ? Sampler::use_lobe : 0u) | (uses_direction_sample(m) ? Sampler::use_bsdf : 0u) |
+                (roulette ? Sampler::use_roulette : 0u));
 
             // Next-event estimation: one light, chosen in proportion to its power.
             // Point lights cannot be hit by chance, so even naive mode samples them.
-            if (has_smooth_lobe(m) && scene.light_count() > 0)
-                L += throughput * sample_one_light(m, hit, sp, naive, u_light_pick, u_light);
+            if (next_event) L += throughput * sample_one_light(m, hit, sp, naive, u.light_pick, u.light);
 
             ScatterSample s;
-            if (!sample_material(m, sp, ray.d, u_lobe, u_bsdf, s)) break;
+            if (!sample_material(m, sp, ray.d, u.lobe, u.bsdf, s)) break;
             throughput *= s.weight;
             full_emission = naive || !s.smooth;
             last_bsdf_pdf = s.pdf;
@@ -185,9 +187,9 @@ struct Tracer {
             respawn(ray, hit, s.direction);
 
             // Russian roulette with q = max(throughput) (brief), past the threshold depth.
-            if (bounce + 1 >= settings.rr_depth) {
+            if (roulette) {
                 const double q = std::min(1.0, max_component(throughput));
-                if (!(u_roulette < q)) break;
+                if (!(u.roulette < q)) break;
                 throughput /= q;
             }
         }

@@ -108,6 +108,28 @@ public:
                 to_unit(owen_scramble(sobol_dimension1(s.index), s.seed ^ 0xb5297a4du))};
     }
 
+    // One path vertex's five dimensions, in the fixed order below. Those `use` leaves out
+    // are not computed where they would be scrambled (they cost two or three hashes each)
+    // and are 0; each dimension keeps its meaning and the uniform stream its order, so the
+    // image is the same as when all five are drawn.
+    struct VertexNumbers {
+        double light_pick = 0;
+        Vec2 light;
+        double lobe = 0;
+        Vec2 bsdf;
+        double roulette = 0;
+    };
+    enum VertexUse : unsigned { use_light_pick = 1, use_light = 2, use_lobe = 4, use_bsdf = 8, use_roulette = 16 };
+    VertexNumbers next_vertex(unsigned use) {
+        VertexNumbers v;
+        v.light_pick = draw_1d(use & use_light_pick);
+        v.light = draw_2d(use & use_light);
+        v.lobe = draw_1d(use & use_lobe);
+        v.bsdf = draw_2d(use & use_bsdf);
+        v.roulette = draw_1d(use & use_roulette);
+        return v;
+    }
+
     // Skips a 2-D dimension (the lens of a pinhole camera) without computing it, so every
     // later dimension is the same as when it is drawn.
     void skip_2d() {
@@ -119,6 +141,16 @@ public:
     }
 
 private:
+    double draw_1d(bool used) {
+        if (used || !scrambling()) return next_1d();
+        ++dimension_;
+        return 0;
+    }
+    Vec2 draw_2d(bool used) {
+        if (used || !scrambling()) return next_2d();
+        ++dimension_;
+        return {};
+    }
     struct Shuffle {
         uint32_t index;  // this dimension's shuffled sample index
         uint32_t seed;   // and the seed of its point scramble
