@@ -176,3 +176,32 @@ TEST(Sobol, UniformAndStratifiedDrawFromTheirStream) {
     const Vec2 s = Sampler(Estimator::stratified, 9, 4, 5, 16).pixel();  // stratum (1, 1) of 4x4
     EXPECT_TRUE(s.x >= 0.25 && s.x < 0.5 && s.y >= 0.25 && s.y < 0.5);
 }
+
+// A path vertex may leave out the numbers it does not read: those it reads, and every later
+// dimension, are the same as when all five are drawn, for the scrambled dimensions and for
+// the uniform stream behind them.
+TEST(Sobol, VertexNumbersLeftOutDoNotShiftOthers) {
+    const unsigned all = Sampler::use_light_pick | Sampler::use_light | Sampler::use_lobe | Sampler::use_bsdf |
+                         Sampler::use_roulette;
+    for (Estimator estimator : {Estimator::sobol, Estimator::uniform})
+        for (unsigned use : {0u, unsigned(Sampler::use_light | Sampler::use_bsdf), unsigned(Sampler::use_lobe)}) {
+            Sampler full(estimator, 3, 41, 9, 1), partial(estimator, 3, 41, 9, 1);
+            full.pixel();
+            partial.pixel();
+            full.skip_2d();
+            partial.skip_2d();
+            for (int vertex = 0; vertex < 4; ++vertex) {  // past the scrambled dimensions
+                const Sampler::VertexNumbers a = full.next_vertex(all), b = partial.next_vertex(use);
+                if (use & Sampler::use_light) {
+                    EXPECT_EQ(a.light.x, b.light.x);
+                    EXPECT_EQ(a.light.y, b.light.y);
+                }
+                if (use & Sampler::use_bsdf) EXPECT_EQ(a.bsdf.x, b.bsdf.x);
+                if (use & Sampler::use_lobe) EXPECT_EQ(a.lobe, b.lobe);
+                EXPECT_GT(a.bsdf.x, 0.0);
+            }
+            const Vec2 a = full.next_2d(), b = partial.next_2d();
+            EXPECT_EQ(a.x, b.x) << estimator_names.name(estimator);
+            EXPECT_EQ(a.y, b.y);
+        }
+}
