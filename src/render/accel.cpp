@@ -225,6 +225,19 @@ inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, 
     return select4(candidate, t, inf);
 }
 
+// Takes the nearest of a block's lane distances if it improves on `best` (the lanes were
+// computed with `best` as their end, so they are <= best; ties keep the first found: an
+// earlier block, then the lower lane). Shared by the one-leaf loop and the tree's leaves.
+inline __attribute__((always_inline)) bool take_nearest(const SphereBlock& b, v4d t, double& best, int& best_id) {
+    const double nearest = std::min(std::min(t[0], t[1]), std::min(t[2], t[3]));
+    if (!(nearest < best || (best_id < 0 && nearest < kInf))) return false;
+    const v4l is_nearest = t == nearest;
+    const int lane = is_nearest[0] ? 0 : is_nearest[1] ? 1 : is_nearest[2] ? 2 : 3;
+    best = nearest;
+    best_id = static_cast<int>(b.id[lane]);
+    return true;
+}
+
 struct SlabRay {
     double o[3], inv[3];
     explicit SlabRay(const Ray& ray) {
@@ -258,16 +271,8 @@ inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& n
     int best_id = -1;
     if (nodes[0].blocks > 0) {
         // One leaf (scenes of a few spheres): no box to test, and no reciprocals to compute.
-        for (uint32_t k = 0; k < nodes[0].blocks; ++k) {
-            const v4d t = block_distances<kAny>(blocks[k], ray, best);
-            for (int lane = 0; lane < 4; ++lane)
-                if (t[lane] < kInf && (t[lane] < best || best_id < 0)) {
-                    best = t[lane];
-                    best_id = blocks[k].id[lane];
-                    if constexpr (kAny) break;
-                }
-            if (kAny && best_id >= 0) break;
-        }
+        for (uint32_t k = 0; k < nodes[0].blocks; ++k)
+            if (take_nearest(blocks[k], block_distances<kAny>(blocks[k], ray, best), best, best_id) && kAny) break;
         t_best = best;
         return best_id;
     }
@@ -280,20 +285,13 @@ inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& n
     for (;;) {
         const BvhNode& n = nodes[node];
         if (n.blocks > 0) {
-            for (uint32_t k = 0; k < n.blocks; ++k) {
-                const v4d t = block_distances<kAny>(blocks[n.index + k], ray, best);
-                for (int lane = 0; lane < 4; ++lane) {
-                    // Lanes already passed t <= best; ties keep the first found.
-                    if (t[lane] < kInf && (t[lane] < best || best_id < 0)) {
-                        best = t[lane];
-                        best_id = blocks[n.index + k].id[lane];
-                        if constexpr (kAny) {
-                            t_best = best;
-                            return best_id;
-                        }
-                    }
+            for (uint32_t k = 0; k < n.blocks; ++k)
+                if (take_nearest(blocks[n.index + k], block_distances<kAny>(blocks[n.index + k], ray, best), best,
+                                 best_id) &&
+                    kAny) {
+                    t_best = best;
+                    return best_id;
                 }
-            }
         } else {
             // Visit the child on the ray's side of the split first; skip boxes beyond `best`.
             uint32_t first = node + 1, second = n.index;
