@@ -27,13 +27,14 @@ struct ScatterSample {
 // reached through sampling. True if the material has such a lobe.
 inline bool has_smooth_lobe(const Material& m) { return m.type == MaterialType::diffuse; }
 // Which random numbers sample_material reads: the reflect-or-transmit choice, and the 2-D
-// direction sample (a perfect mirror or sharp dielectric needs none).
+// direction sample (a diffuse bounce, or a direction perturbed by roughness; a perfect
+// mirror or sharp dielectric needs none).
 inline bool uses_lobe_choice(const Material& m) {
     return m.type == MaterialType::dielectric || m.type == MaterialType::translucent;
 }
 inline bool uses_direction_sample(const Material& m) {
-    return m.type == MaterialType::diffuse || m.type == MaterialType::glossy ||
-           (m.type == MaterialType::translucent && m.roughness > 0);
+    return m.type == MaterialType::diffuse ||
+           ((m.type == MaterialType::glossy || m.type == MaterialType::translucent) && m.roughness > 0);
 }
 
 // f(wi, wo) * |cos(wo)| of the smooth lobe, for wo a unit direction away from the surface.

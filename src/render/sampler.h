@@ -109,9 +109,9 @@ public:
     }
 
     // One path vertex's five dimensions, in the fixed order below. Those `use` leaves out
-    // are not computed where they would be scrambled (they cost two or three hashes each)
-    // and are 0; each dimension keeps its meaning and the uniform stream its order, so the
-    // image is the same as when all five are drawn.
+    // are skipped, not computed (a scrambled one costs two or three hashes), and are 0; each
+    // dimension keeps its meaning and the uniform stream its order, so the image is the same
+    // as when all five are drawn.
     struct VertexNumbers {
         double light_pick = 0;
         Vec2 light;
@@ -130,25 +130,32 @@ public:
         return v;
     }
 
-    // Skips a 2-D dimension (the lens of a pinhole camera) without computing it, so every
-    // later dimension is the same as when it is drawn.
+    // Skip a dimension (the lens of a pinhole camera, numbers a vertex does not read) without
+    // computing it, so every later dimension is the same as when it is drawn.
+    void skip_1d() {
+        if (scrambling()) {
+            ++dimension_;
+        } else {
+            rng_.next_u32(), rng_.next_u32();  // next() uses two
+        }
+    }
     void skip_2d() {
         if (scrambling()) {
             ++dimension_;
         } else {
-            rng_.next_u32(), rng_.next_u32(), rng_.next_u32(), rng_.next_u32();  // next() uses two each
+            rng_.next_u32(), rng_.next_u32(), rng_.next_u32(), rng_.next_u32();
         }
     }
 
 private:
     double draw_1d(bool used) {
-        if (used || !scrambling()) return next_1d();
-        ++dimension_;
+        if (used) return next_1d();
+        skip_1d();
         return 0;
     }
     Vec2 draw_2d(bool used) {
-        if (used || !scrambling()) return next_2d();
-        ++dimension_;
+        if (used) return next_2d();
+        skip_2d();
         return {};
     }
     struct Shuffle {
