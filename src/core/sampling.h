@@ -13,7 +13,6 @@ struct Vec2 {
     double x = 0, y = 0;
 };
 
-// Cosine-weighted direction about +z (Malley: concentric disk lifted to the hemisphere).
 // sin and cos of 2 pi t (t in turns), to about 1e-15: reduced to an eighth of a turn and
 // evaluated by Taylor polynomials. The samplers call it for every direction; libm's general
 // sincos was a tenth of the render time.
@@ -21,7 +20,10 @@ struct Vec2 {
 // mispredicts three times in four.
 inline void sin_cos_turns(double t, double& sin_out, double& cos_out) {
     // t = k/4 + r with |r| <= 1/8 turn, so the angle x = 2 pi r lies in [-pi/4, pi/4].
-    const double quarter = std::nearbyint(4.0 * t);
+    // Nearest integer by adding and removing 1.5 * 2^52, exact for |4t| < 2^51 (ties to even):
+    // std::nearbyint is a libm call on baseline x86-64, which has no rounding instruction.
+    constexpr double kRoundingShift = 0x1.8p52;
+    const double quarter = (4.0 * t + kRoundingShift) - kRoundingShift;
     const double x = 2.0 * kPi * (t - 0.25 * quarter);
     const double x2 = x * x;
     // Taylor series to x^15 / x^16: the first omitted term is below 3e-16 at pi/4.
@@ -38,6 +40,7 @@ inline void sin_cos_turns(double t, double& sin_out, double& cos_out) {
     cos_out = ((k + 1) & 2) ? -cos_mag : cos_mag;
 }
 
+// Cosine-weighted direction about +z (Malley: concentric disk lifted to the hemisphere).
 Vec3 sample_cosine_hemisphere(double u1, double u2);
 inline double cosine_hemisphere_pdf(double cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0; }
 

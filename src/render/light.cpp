@@ -32,18 +32,23 @@ struct BriefProposal {
     // log-uniform part's weight 1 - alpha ~ v_max^3 negligible.
     static double log_ratio(double a, double gap) { return std::log(a / (gap * gap)); }
 
-    double a, b, v_max, alpha;
+    // mix = 1 / alpha = 1 + v_max^3, so that sampling needs no division.
+    double a, b, v_max, mix, alpha;
     BriefProposal(const SphereGeom& light, double d)
         : a(d * d + light.radius * light.radius),
           b(2 * d * light.radius),
           v_max(log_ratio(a, d - light.radius)),
-          alpha(1.0 / (1.0 + v_max * v_max * v_max)) {}
-    // Density of u on [0, 1]: alpha 2u + (1 - alpha) b / (s v_max).
-    double pdf(double u) const { return alpha * 2 * u + (1 - alpha) * b / ((a - b * u) * v_max); }
+          mix(1.0 + v_max * v_max * v_max),
+          alpha(1.0 / mix) {}
+    // Density of u on [0, 1] times s = a - b u: alpha 2u s + (1 - alpha) b / v_max. The
+    // callers want it times the squared distance, which is s, so s cancels its division.
+    double pdf_times_s(double u, double s) const { return alpha * (2 * u * s + v_max * v_max * b); }
+    double pdf(double u) const { const double s = a - b * u; return pdf_times_s(u, s) / s; }
     double sample(double xi) const {
-        if (xi < alpha) return std::sqrt(xi / alpha);
+        const double x = xi * mix;  // below 1: the u part, with xi / alpha = x
+        if (x < 1) return std::sqrt(x);
         // s = a exp(-t v_max), t uniform: log-uniform on [(d - r)^2, a]; u = (a - s) / b.
-        const double t = (xi - alpha) / (1 - alpha);
+        const double t = (x - 1) / (v_max * v_max * v_max);
         return std::clamp(-a * std::expm1(-t * v_max) / b, 0.0, 1.0);
     }
 };
@@ -85,18 +90,20 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
         const Vec3 axis = -to_centre / d;
         const Vec3 n = Frame::from_normal(axis).to_world({sin_axis * cos_phi, sin_axis * sin_phi, cos_axis});
         const Vec3 w = light.centre + light.radius * n - p;
-        const double dist = length(w);
+        const double dist2 = dot(w, w);
+        const double dist = std::sqrt(dist2);
         if (!(dist > 0) || !(cos_axis > 0)) return false;
         out.wi = w / dist;
         out.distance = dist;
-        // Area density on the sphere: the density of u over 2 pi r^2 (dA = r^2 du dphi).
-        const double area_density = proposal.pdf(cos_axis) / (2 * kPi * r2);
-        out.pdf = dist * dist * area_density / cos_axis;  // f L cos_axis / dist^2 / area_density
+        // Area density on the sphere is the density of u over 2 pi r^2 (dA = r^2 du dphi);
+        // times dist^2 it converts to solid angle.
+        const double area_density_dist2 = proposal.pdf_times_s(cos_axis, dist2) / (2 * kPi * r2);
+        out.pdf = area_density_dist2 / cos_axis;  // f L cos_axis / dist^2 / area_density
         // BSDF sampling reaches the visible cap only, so only there are the two combined;
         // the band behind the silhouette keeps this strategy's full weight (mis_pdf 0).
         const double cos_light = -dot(n, out.wi);
         const bool visible_cap = cos_axis * d > light.radius && cos_light > 0;
-        out.mis_pdf = visible_cap ? area_density * dist * dist / cos_light : 0.0;
+        out.mis_pdf = visible_cap ? area_density_dist2 / cos_light : 0.0;
         return true;
     }
     if (strategy == LightSampling::cone && outside) {
