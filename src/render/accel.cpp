@@ -10,7 +10,11 @@ namespace kr {
 namespace {
 
 constexpr int kBins = 16;
-constexpr int kMaxLeafSpheres = 16;  // larger sets are always split
+// Sets of up to this many spheres (four blocks) are leaves, larger ones always split. Testing
+// the blocks of a small set is cheaper than the box tests that would cull some of them: walls
+// are spheres with huge boxes that every ray enters (docs/performance.md: scene 6, of ten
+// spheres, as a tree of 7 nodes took 40% more instructions than as one leaf).
+constexpr int kMaxLeafSpheres = 16;
 constexpr int kMaxTreeDepth = 60;    // traversal stack size; deeper sets become leaves
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -87,10 +91,10 @@ struct Builder {
             nodes[node].hi[a] = bounds.hi[a];
         }
         const int n = end - begin;
-        if (n <= 4 || level + 1 >= kMaxTreeDepth) return make_leaf(node, begin, end);
+        if (n <= kMaxLeafSpheres || level + 1 >= kMaxTreeDepth) return make_leaf(node, begin, end);
 
-        // Binned SAH over the centroid extent of each axis; costs in blocks of four spheres
-        // (one traversal step costs about one block test).
+        // Where to split: binned SAH over the centroid extent of each axis, costs in blocks
+        // of four spheres.
         double best_cost = kInf;
         int best_axis = -1, best_bin = 0;
         for (int a = 0; a < 3; ++a) {
@@ -129,11 +133,8 @@ struct Builder {
                 }
             }
         }
-        const double parent_area = bounds.half_area();
-        const double leaf_cost = blocks_for(n);
-        const double split_cost = parent_area > 0 ? 1.0 + best_cost / parent_area : kInf;
         int mid;
-        if (best_axis >= 0 && (split_cost < leaf_cost || n > kMaxLeafSpheres)) {
+        if (best_axis >= 0) {
             const double extent = centres.hi[best_axis] - centres.lo[best_axis];
             auto it = std::partition(items.begin() + begin, items.begin() + end, [&](const BuildItem& s) {
                 const int b = std::min(kBins - 1, int(kBins * (s.centre[best_axis] - centres.lo[best_axis]) / extent));
@@ -141,11 +142,9 @@ struct Builder {
             });
             mid = static_cast<int>(it - items.begin());
             nodes[node].axis = static_cast<uint8_t>(best_axis);
-        } else if (n > kMaxLeafSpheres) {
+        } else {
             // All centres coincide (or SAH found nothing): split the list in half.
             mid = begin + n / 2;
-        } else {
-            return make_leaf(node, begin, end);
         }
         build(begin, mid, level + 1);
         const uint32_t second = build(mid, end, level + 1);
