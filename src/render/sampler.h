@@ -38,11 +38,13 @@ inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits(index); }
 
 // The second Sobol dimension: XOR of its generator matrix's columns for the index's bits,
 // tabulated per index byte at compile time. Column k+1 = column k xor (column k >> 1) builds
-// the upper-triangular Pascal matrix mod 2.
-constexpr std::array<std::array<uint32_t, 256>, 4> sobol_dimension1_table() {
-    std::array<uint32_t, 32> column{};
-    column[0] = 1u << 31;
-    for (int k = 1; k < 32; ++k) column[k] = column[k - 1] ^ (column[k - 1] >> 1);
+// the upper-triangular Pascal matrix mod 2. The table holds the columns bit-reversed, the
+// order the Owen scramble works in, which saves a reversal per sample (and reversal is
+// linear over XOR, so reversing each column reverses the sum).
+constexpr std::array<std::array<uint32_t, 256>, 4> sobol_dimension1_reversed_table() {
+    std::array<uint32_t, 32> column{};  // reversed: the k-th column's top bit is bit 0 here
+    column[0] = 1u;
+    for (int k = 1; k < 32; ++k) column[k] = column[k - 1] ^ (column[k - 1] << 1);
     std::array<std::array<uint32_t, 256>, 4> table{};
     for (int b = 0; b < 4; ++b)
         for (uint32_t v = 0; v < 256; ++v)
@@ -50,11 +52,12 @@ constexpr std::array<std::array<uint32_t, 256>, 4> sobol_dimension1_table() {
                 if (v & (1u << bit)) table[b][v] ^= column[8 * b + bit];
     return table;
 }
-inline constexpr auto kSobolDimension1Bytes = sobol_dimension1_table();
-inline uint32_t sobol_dimension1(uint32_t index) {
-    return kSobolDimension1Bytes[0][index & 0xff] ^ kSobolDimension1Bytes[1][(index >> 8) & 0xff] ^
-           kSobolDimension1Bytes[2][(index >> 16) & 0xff] ^ kSobolDimension1Bytes[3][index >> 24];
+inline constexpr auto kSobolDimension1ReversedBytes = sobol_dimension1_reversed_table();
+inline uint32_t sobol_dimension1_reversed(uint32_t index) {
+    const auto& t = kSobolDimension1ReversedBytes;
+    return t[0][index & 0xff] ^ t[1][(index >> 8) & 0xff] ^ t[2][(index >> 16) & 0xff] ^ t[3][index >> 24];
 }
+inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits(sobol_dimension1_reversed(index)); }
 
 // Laine-Karras style hash with Burley's constants: each step changes bit k only by a function
 // of the bits below k (addition carries and multiplication by even constants only move
@@ -105,7 +108,8 @@ public:
         }
         const Shuffle s = shuffle(dimension_++);
         return {to_unit(reverse_bits(laine_karras(s.index, s.seed))),
-                to_unit(owen_scramble(sobol_dimension1(s.index), s.seed ^ 0xb5297a4du))};
+                // owen_scramble(sobol_dimension1(i)), its inner reversal taken by the table.
+                to_unit(reverse_bits(laine_karras(sobol_dimension1_reversed(s.index), s.seed ^ 0xb5297a4du)))};
     }
 
     // One path vertex's five dimensions, in the fixed order below. Those `use` leaves out
