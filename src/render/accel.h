@@ -28,7 +28,7 @@ struct BvhNode {
 
 class SphereBvh {
 public:
-    // Binned surface-area-heuristic build. Scenes of a few spheres end up as one leaf.
+    // Sets of up to 16 spheres are one leaf; a binned surface-area heuristic splits larger ones.
     void build(const std::vector<SphereGeom>& spheres);
 
     // Closest sphere accepted by the ray's rules within [tmin, tmax]: its index and distance,
