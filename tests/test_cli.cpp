@@ -87,6 +87,28 @@ TEST_F(Cli, RendersImageAndDepthBesideIt) {
     for (const auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().string().find(".tmp"), std::string::npos);
 }
 
+TEST_F(Cli, PngOutputByNameAndPsnrReadsBothFormats) {
+    const fs::path scene = write_scene("png.json");
+    const std::string base = "render '" + scene.string() + "' --spp 2 -q -o '";
+    ASSERT_EQ(run(base + (dir / "x.ppm").string() + "'").status, 0);
+    const CliRun r = run(base + (dir / "x.PNG").string() + "'");
+    ASSERT_EQ(r.status, 0) << r.err;
+    // A PNG by its signature, the depth map beside it too, and the same pixels as the PPM.
+    EXPECT_EQ(read_file(dir / "x.PNG").substr(0, 8), std::string("\x89PNG\r\n\x1a\n"));
+    EXPECT_EQ(read_file(dir / "x-depth.PNG").substr(0, 4), std::string("\x89PNG"));
+    const CliRun same = run("psnr '" + (dir / "x.ppm").string() + "' '" + (dir / "x.PNG").string() + "'");
+    EXPECT_EQ(same.status, 0) << same.err;
+    EXPECT_EQ(same.out, "99.00\n");  // identical images
+    const CliRun depth = run("psnr '" + (dir / "x-depth.PNG").string() + "' '" + (dir / "x.ppm").string() + "'");
+    EXPECT_EQ(depth.status, 0) << depth.err;
+    EXPECT_LT(std::stod(depth.out), 40.0);  // a different image
+    // A file that is not a PNG: one message naming it, exit status 1.
+    std::ofstream(dir / "bad.png") << "not an image";
+    const CliRun bad = run("psnr '" + (dir / "bad.png").string() + "' '" + (dir / "x.ppm").string() + "'");
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_NE(bad.err.find("bad.png"), std::string::npos) << bad.err;
+}
+
 TEST_F(Cli, OutputIsRelativeToTheSceneFolder) {
     const fs::path scene = write_scene("rel.json");
     const CliRun r = run("render '" + scene.string() + "' -q");

@@ -16,10 +16,6 @@
 #include <omp.h>
 #include <unistd.h>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#include <stb/stb_image.h>
-
 #include "app/bench.h"
 #include "app/plot.h"
 #include "app/progress.h"
@@ -236,18 +232,6 @@ void save_cached(const fs::path& file, const Reference& ref) {
     write_file_atomic(file, bytes);
 }
 
-Rgb8Image read_image(const fs::path& file) {
-    if (file.extension() == ".ppm") return read_ppm(file);
-    int w = 0, h = 0, channels = 0;
-    unsigned char* pixels = stbi_load(file.string().c_str(), &w, &h, &channels, 3);
-    if (!pixels) throw std::runtime_error("cannot read " + file.string() + " (a PPM or PNG image)");
-    Rgb8Image img;
-    img.width = w, img.height = h;
-    img.bytes.assign(pixels, pixels + size_t(w) * h * 3);
-    stbi_image_free(pixels);
-    return img;
-}
-
 // What one configuration has measured so far.
 struct Series {
     Config config;
@@ -403,7 +387,7 @@ struct Bench {
             if (references.count(key)) continue;
             if (!o.reference_file.empty()) {
                 Reference ref;
-                ref.display = read_image(o.reference_file);
+                ref.display = viewer::read_image(o.reference_file);
                 if (ref.display.width != width || ref.display.height != height)
                     throw std::runtime_error(o.reference_file.string() + " is " + std::to_string(ref.display.width) +
                                              "x" + std::to_string(ref.display.height) + ", the renders " +

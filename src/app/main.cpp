@@ -18,6 +18,7 @@
 #include "core/image.h"
 #include "render/render.h"
 #include "scene/load.h"
+#include "viewer/files.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
 
@@ -30,7 +31,7 @@ constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere 
 
 Usage:
   keithray render [SCENE.json ...] [options]
-  keithray psnr IMAGE.ppm REFERENCE.ppm     PSNR in dB of two 8-bit PPMs
+  keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG)
   keithray bench --throughput|--stress ...  speed figures ('keithray bench --help')
   keithray view [SCENE.json] [options]      interactive viewer (GLFW window; see
                                             'keithray view --help' and README.md)
@@ -66,12 +67,12 @@ Options:
   --seed N              random seed (default: 0); same seed, same image
   --threads N           worker threads (default: all cores)
   -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
-                        (only with a single scene)
+                        (only with a single scene); OUT.png writes PNGs instead
   -q, --quiet           no progress bar
   -h, --help            this text
 
-Output: an 8-bit binary PPM and, beside it, the depth map (1 - d/(1+d)) as NAME-depth.ppm,
-each written atomically. One summary line per scene on stdout: spp, seconds, Mrays/s.
+Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
+(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per scene on stdout: spp, seconds, Mrays/s.
 Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
 )";
 
@@ -217,9 +218,9 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
 
     try {
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        write_ppm(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
-                                 : tonemap(radiance, opt.tonemap));
-        write_ppm(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+        viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
+                                           : tonemap(radiance, opt.tonemap));
+        viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
         return false;
@@ -265,11 +266,11 @@ int main(int argc, char** argv) {
     if (command == "bench") return run_bench(argc, argv);
     if (command == "psnr") {
         if (argc != 4) {
-            std::fprintf(stderr, "error: psnr needs two PPM files\n");
+            std::fprintf(stderr, "error: psnr needs two image files (PPM or PNG)\n");
             return 2;
         }
         try {
-            std::printf("%.2f\n", psnr(read_ppm(argv[2]), read_ppm(argv[3])));
+            std::printf("%.2f\n", psnr(viewer::read_image(argv[2]), viewer::read_image(argv[3])));
             return 0;
         } catch (const std::exception& e) {
             std::fprintf(stderr, "error: %s\n", e.what());

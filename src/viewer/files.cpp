@@ -7,6 +7,9 @@
 
 #include <unistd.h>
 
+#define STB_IMAGE_IMPLEMENTATION
+#define STBI_ONLY_PNG
+#include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 
 namespace kr::viewer {
@@ -28,6 +31,32 @@ void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
         fs::remove(tmp, ec);
         throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + why);
     }
+}
+
+namespace {
+bool is_png_path(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".png";
+}
+}  // namespace
+
+Rgb8Image read_image(const std::filesystem::path& path) {
+    if (!is_png_path(path)) return read_ppm(path);
+    int w = 0, h = 0, channels = 0;
+    unsigned char* pixels = stbi_load(path.string().c_str(), &w, &h, &channels, 3);
+    if (!pixels)
+        throw std::runtime_error("cannot read " + path.string() + " as a PNG image: " + stbi_failure_reason());
+    Rgb8Image img;
+    img.width = w, img.height = h;
+    img.bytes.assign(pixels, pixels + size_t(w) * size_t(h) * 3);
+    stbi_image_free(pixels);
+    return img;
+}
+
+void write_image(const std::filesystem::path& path, const Rgb8Image& image) {
+    if (is_png_path(path)) write_png(path, image);
+    else write_ppm(path, image);
 }
 
 std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir) {

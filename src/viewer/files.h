@@ -1,5 +1,5 @@
-// File helpers of the viewer that need no window: PNG output, the scene list, and the
-// polling watch on the scene file.
+// File helpers of the viewer that need no window: PNG input and output, the scene list, and
+// the polling watch on the scene file.
 #pragma once
 
 #include <chrono>
@@ -14,6 +14,12 @@ namespace kr::viewer {
 // PNG through stb_image_write (Debian's libstb), written atomically like write_ppm.
 // Throws std::runtime_error.
 void write_png(const std::filesystem::path& path, const Rgb8Image& image);
+
+// An 8-bit RGB image from a binary PPM (a .ppm path) or a PNG (stb_image). Throws
+// std::runtime_error with the file's name.
+Rgb8Image read_image(const std::filesystem::path& path);
+// PNG when the path ends in .png (any case), otherwise binary PPM; written atomically.
+void write_image(const std::filesystem::path& path, const Rgb8Image& image);
 
 // The *.json files of `dir`, sorted.
 std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir);

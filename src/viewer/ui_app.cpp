@@ -286,7 +286,7 @@ bool ViewerApp::script_step(const PixelRect& rect) {
     if (!(current && shown_->scale == 1 && shown_->spp >= needed)) return false;
     try {
         if (options_.screenshot) {
-            write_ppm(*options_.screenshot, read_image_region(rect));
+            write_image(*options_.screenshot, read_image_region(rect));
             std::printf("screenshot: %s (%d spp, generation %llu)\n", options_.screenshot->string().c_str(),
                         shown_->spp, static_cast<unsigned long long>(shown_->generation));
         }
@@ -354,8 +354,7 @@ int ViewerApp::run() {
         if (done && options_.window_shot) {
             try {
                 const Rgb8Image window = read_image_region({0, 0, double(fb_w), double(fb_h)});
-                if (options_.window_shot->extension() == ".png") write_png(*options_.window_shot, window);
-                else write_ppm(*options_.window_shot, window);
+                write_image(*options_.window_shot, window);
             } catch (const std::exception& e) {
                 std::fprintf(stderr, "error: %s\n", e.what());
                 script_status_ = 1;

@@ -37,7 +37,7 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
   --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
   --frames N            accumulate N full-resolution passes (at most the target spp)
-  --screenshot OUT.ppm  then write the image region as drawn by the display shader
+  --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
   --save-scene OUT.json then save the edited scene
   --window-shot OUT.ppm and the whole window, panels included (.png: as PNG)
   --measure-latency N   time N orbit edits from the edit to the first frame on screen
