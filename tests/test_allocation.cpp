@@ -221,8 +221,9 @@ TEST(Allocation, AdaptiveBeatsUniformAtTheSameBudget) {
     EXPECT_LT(mse_adaptive, 0.8 * mse_uniform) << mse_adaptive << " vs " << mse_uniform;
 }
 
-// The plan is made serially from the statistics: the same image with 1 or 2 threads, and the
-// viewer's accumulator (plan from its totals) draws the same samples as render_until.
+// The plan sums per row in parallel and adds the rows in order: the same image with 1 or 2
+// threads, and the viewer's accumulator (plan from its totals) draws the same samples as
+// render_until.
 TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     const RenderScene scene = prepare_scene(brief_scene(6, 16));
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);

@@ -56,11 +56,15 @@ struct Timing {
     uint64_t rays = 0;
 };
 
-// Renders `passes` passes into a fresh state; returns wall time and rays.
+// Renders `passes` passes into a fresh state, each planned as `keithray render` plans it
+// (adaptive allocation, by default); returns wall time and rays.
 Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes) {
     RenderState state(width, height);
     const double start = now_seconds();
-    for (int i = 0; i < passes; ++i) render_pass(scene, settings, state);
+    for (int i = 0; i < passes; ++i) {
+        state.plan_pass(settings);
+        render_pass(scene, settings, state);
+    }
     return {now_seconds() - start, state.rays};
 }
 

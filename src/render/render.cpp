@@ -30,6 +30,7 @@ void RenderState::reset(int w, int h) {
     active.clear();
     pass_samples.clear();
     sample_credit.clear();
+    for (auto& scratch : allocation_scratch) scratch.clear();
 }
 
 Image RenderState::radiance() const {
@@ -74,25 +75,35 @@ double RenderState::relative_error() const {
 
 namespace {
 
-// Each value replaced by the larger of itself and the mean over its 3x3 neighbourhood.
-// A few samples can miss a rare bright path and show almost no variance; variance varies
-// smoothly over the image, so the neighbours guard against that.
-std::vector<double> guard_3x3(const std::vector<double>& v, int width, int height) {
-    std::vector<double> out(v.size());
+// Each value replaced by the larger of itself and the mean over its 3x3 neighbourhood (the
+// cells inside the image). A few samples can miss a rare bright path and show almost no
+// variance; variance varies smoothly over the image, so the neighbours guard against that.
+// Separable: sums over each row's three columns into `scratch`, then over three rows.
+void guard_3x3(const std::vector<double>& v, int width, int height, std::vector<double>& scratch,
+               std::vector<double>& out) {
+    const size_t w = size_t(width);
+    scratch.resize(v.size());
+    out.resize(v.size());
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) {
-            double sum = 0;
-            int cells = 0;
-            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
-                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx) {
-                    sum += v[size_t(yy) * width + xx];
-                    ++cells;
-                }
-            const size_t i = size_t(y) * width + x;
-            out[i] = std::max(v[i], sum / cells);
+    for (int y = 0; y < height; ++y) {
+        const double* row = &v[size_t(y) * w];
+        double* sums = &scratch[size_t(y) * w];
+        for (size_t x = 0; x < w; ++x)
+            sums[x] = (x > 0 ? row[x - 1] : 0.0) + row[x] + (x + 1 < w ? row[x + 1] : 0.0);
+    }
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        const double* above = y > 0 ? &scratch[size_t(y - 1) * w] : nullptr;
+        const double* here = &scratch[size_t(y) * w];
+        const double* below = y + 1 < height ? &scratch[size_t(y + 1) * w] : nullptr;
+        const double rows = 1.0 + (above != nullptr) + (below != nullptr);
+        for (size_t x = 0; x < w; ++x) {
+            const double columns = 1.0 + (x > 0) + (x + 1 < w);
+            const double sum = here[x] + (above ? above[x] : 0.0) + (below ? below[x] : 0.0);
+            const size_t i = size_t(y) * w + x;
+            out[i] = std::max(v[i], sum / (rows * columns));
         }
-    return out;
+    }
 }
 
 }  // namespace
@@ -100,7 +111,7 @@ std::vector<double> guard_3x3(const std::vector<double>& v, int width, int heigh
 size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
     const size_t n = sample_count.size();
     double signal_sq = 0;
-    std::vector<double> error_sq(n);
+    std::vector<double> error_sq(n), scratch, local;
     for (size_t i = 0; i < n; ++i) {
         const double mean = sample_count[i] ? luminance(radiance_sum[i]) / sample_count[i] : 0.0;
         signal_sq += mean * mean;
@@ -108,7 +119,7 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
         error_sq[i] = se * se;
     }
     const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
-    const std::vector<double> local = guard_3x3(error_sq, width, height);
+    guard_3x3(error_sq, width, height, scratch, local);
     active.assign(n, 0);
     size_t count = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -125,20 +136,52 @@ void RenderState::plan_pass(const RenderSettings& settings) {
         pass_samples.clear();
         return;
     }
-    const size_t n = sample_count.size();
+    const size_t n = sample_count.size(), w = size_t(width);
     // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
     // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
     // estimate may be too low, and bounds the bias of deciding from the samples themselves.
-    std::vector<double> variance(n);
-    for (size_t i = 0; i < n; ++i) variance[i] = sample_variance(i);
-    std::vector<double> weight = guard_3x3(variance, width, height);
+    // Every loop runs over rows in parallel; sums are taken per row and then over the rows in
+    // order, so the plan is the same for any number of threads. The loops are fused:
+    // at 512x512 the plan is bound by memory traffic.
+    std::vector<double>& variance = allocation_scratch[0];
+    std::vector<double>& row_sums = allocation_scratch[1];  // 3-wide sums along each row
+    std::vector<double>& weight = allocation_scratch[2];
+    variance.resize(n);
+    row_sums.resize(n);
+    weight.resize(n);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        double* v = &variance[size_t(y) * w];
+        for (size_t x = 0; x < w; ++x) v[x] = sample_variance(size_t(y) * w + x);
+        double* h = &row_sums[size_t(y) * w];
+        for (size_t x = 0; x < w; ++x) h[x] = (x > 0 ? v[x - 1] : 0.0) + v[x] + (x + 1 < w ? v[x + 1] : 0.0);
+    }
+    // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
+    // standard deviation, summed per row.
+    std::vector<double> row_weight(size_t(height), 0.0);
+    std::vector<size_t> row_active(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        const double* above = y > 0 ? &row_sums[size_t(y - 1) * w] : nullptr;
+        const double* here = &row_sums[size_t(y) * w];
+        const double* below = y + 1 < height ? &row_sums[size_t(y + 1) * w] : nullptr;
+        const double rows = 1.0 + (above != nullptr) + (below != nullptr);
+        for (size_t x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * w + x;
+            const bool on = active.empty() || active[i];
+            const double columns = 1.0 + (x > 0) + (x + 1 < w);
+            const double mean = (here[x] + (above ? above[x] : 0.0) + (below ? below[x] : 0.0)) / (rows * columns);
+            const double guarded = std::max(variance[i], mean);
+            weight[i] = on && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
+            row_weight[size_t(y)] += weight[i];
+            row_active[size_t(y)] += on;
+        }
+    }
     double sum = 0;
     size_t active_count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const bool on = active.empty() || active[i];
-        weight[i] = on && std::isfinite(weight[i]) ? std::sqrt(weight[i]) : 0.0;
-        sum += weight[i];
-        active_count += on;
+    for (int y = 0; y < height; ++y) {
+        sum += row_weight[size_t(y)];
+        active_count += row_active[size_t(y)];
     }
     const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
     const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
@@ -147,16 +190,22 @@ void RenderState::plan_pass(const RenderSettings& settings) {
         return;
     }
     sample_credit.resize(n, 0.0f);
-    pass_samples.assign(n, 0);
-    for (size_t i = 0; i < n; ++i) {
-        if (!(active.empty() || active[i])) continue;
-        // Quotas sum to the active pixel count: the pass costs what a uniform one does.
-        const double quota = (weight[i] + floor) * double(active_count) / total;
-        const double credit = std::min<double>(sample_credit[i] + quota, 4 * kMaxPassSamples);
-        const int take = std::min(int(credit), kMaxPassSamples);
-        pass_samples[i] = static_cast<uint8_t>(take);
-        sample_credit[i] = static_cast<float>(credit - take);
-    }
+    pass_samples.resize(n);
+    const double quota_scale = double(active_count) / total;
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            if (!(active.empty() || active[i])) {
+                pass_samples[i] = 0;
+                continue;
+            }
+            // Quotas sum to the active pixel count: the pass costs what a uniform one does.
+            const double quota = (weight[i] + floor) * quota_scale;
+            const double credit = std::min<double>(sample_credit[i] + quota, 4 * kMaxPassSamples);
+            const int take = std::min(int(credit), kMaxPassSamples);
+            pass_samples[i] = static_cast<uint8_t>(take);
+            sample_credit[i] = static_cast<float>(credit - take);
+        }
 }
 
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,

@@ -2,6 +2,7 @@
 // every pixel. The CLI loops over it; the viewer calls it from its render thread.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -59,6 +60,7 @@ struct RenderState {
     // Samples per pixel in the next pass, set by plan_pass (empty: one each).
     std::vector<uint8_t> pass_samples;
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
+    std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's per-pixel buffers, kept between passes
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
@@ -85,8 +87,8 @@ struct RenderState {
     // kAllocationWarmup passes, each active pixel's share of the pass (as many samples as
     // active pixels) is proportional to its estimated standard deviation (3x3 guarded, as
     // update_adaptive) plus a floor, which minimises the summed variance of the pixel means
-    // for the budget; fractions carry over between passes. Serial sums: the plan does not
-    // depend on threads.
+    // for the budget; fractions carry over between passes. Parallel over rows, with the rows'
+    // sums added in order: the plan does not depend on threads.
     void plan_pass(const RenderSettings& settings);
 };
 
