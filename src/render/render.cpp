@@ -61,13 +61,28 @@ double RenderState::pixel_standard_error(size_t i) const {
 }
 
 double RenderState::relative_error() const {
+    // Per-row sums in parallel, added in row order: the same estimate for any thread count.
+    // (The viewer shows it after every pass.)
+    const size_t w = size_t(width);
+    std::vector<double> row_error(size_t(height), 0.0), row_signal(size_t(height), 0.0);
+    std::vector<uint8_t> row_unknown(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            const double se = pixel_standard_error(i);
+            if (!std::isfinite(se)) {
+                row_unknown[size_t(y)] = 1;
+                break;
+            }
+            row_error[size_t(y)] += se * se;
+            const double mean = luminance(radiance_sum[i]) / sample_count[i];
+            row_signal[size_t(y)] += mean * mean;
+        }
     double error_sq = 0, signal_sq = 0;
-    for (size_t i = 0; i < sample_count.size(); ++i) {
-        const double se = pixel_standard_error(i);
-        if (!std::isfinite(se)) return kInfinity;
-        error_sq += se * se;
-        const double mean = luminance(radiance_sum[i]) / sample_count[i];
-        signal_sq += mean * mean;
+    for (size_t y = 0; y < size_t(height); ++y) {
+        if (row_unknown[y]) return kInfinity;
+        error_sq += row_error[y];
+        signal_sq += row_signal[y];
     }
     if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
     return std::sqrt(error_sq / signal_sq);

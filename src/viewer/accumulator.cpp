@@ -31,17 +31,26 @@ bool Accumulator::render_pass(const RenderScene& scene, const RenderSettings& se
     const bool complete = kr::render_pass(scene, settings, scratch_, stop);
     if (complete) add(scratch_);
     // Clear the per-pass sums; sample_index stays, so the next pass draws the next samples.
-    std::fill(scratch_.radiance_sum.begin(), scratch_.radiance_sum.end(), Color());
-    std::fill(scratch_.depth_sum.begin(), scratch_.depth_sum.end(), 0.0);
-    std::fill(scratch_.luminance_sq_sum.begin(), scratch_.luminance_sq_sum.end(), 0.0);
-    std::fill(scratch_.sample_count.begin(), scratch_.sample_count.end(), 0u);
+    // In parallel, like add(): at 512x512 these loops took a tenth of a cheap scene's pass.
+    const long n = long(scratch_.radiance_sum.size());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) {
+        scratch_.radiance_sum[size_t(i)] = Color();
+        scratch_.depth_sum[size_t(i)] = 0.0;
+        scratch_.luminance_sq_sum[size_t(i)] = 0.0;
+        scratch_.sample_count[size_t(i)] = 0u;
+    }
     scratch_.rays = 0;
     scratch_.nonfinite_samples = 0;
     return complete;
 }
 
 void Accumulator::add(const RenderState& pass) {
-    for (size_t i = 0; i < pass.radiance_sum.size(); ++i) {
+    // Every pixel on its own: the same sums for any thread count.
+    const long n = long(pass.radiance_sum.size());
+#pragma omp parallel for schedule(static)
+    for (long k = 0; k < n; ++k) {
+        const size_t i = size_t(k);
         if (pass.sample_count[i] == 0) continue;
         Color& sum = raw_sum_[i];
         Color& c = compensation_[i];
