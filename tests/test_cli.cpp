@@ -102,11 +102,17 @@ TEST_F(Cli, PngOutputByNameAndPsnrReadsBothFormats) {
     const CliRun depth = run("psnr '" + (dir / "x-depth.PNG").string() + "' '" + (dir / "x.ppm").string() + "'");
     EXPECT_EQ(depth.status, 0) << depth.err;
     EXPECT_LT(std::stod(depth.out), 40.0);  // a different image
-    // A file that is not a PNG: one message naming it, exit status 1.
+    // Images are told apart by content, not name: a PPM called .png still reads.
+    fs::copy_file(dir / "x.ppm", dir / "ppm-inside.png");
+    const CliRun renamed = run("psnr '" + (dir / "ppm-inside.png").string() + "' '" + (dir / "x.PNG").string() + "'");
+    EXPECT_EQ(renamed.status, 0) << renamed.err;
+    EXPECT_EQ(renamed.out, "99.00\n");
+    // A file that is neither: one message naming it, exit status 1.
     std::ofstream(dir / "bad.png") << "not an image";
     const CliRun bad = run("psnr '" + (dir / "bad.png").string() + "' '" + (dir / "x.ppm").string() + "'");
     EXPECT_EQ(bad.status, 1);
     EXPECT_NE(bad.err.find("bad.png"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("not a binary PPM (P6) or PNG"), std::string::npos) << bad.err;
 }
 
 TEST_F(Cli, OutputIsRelativeToTheSceneFolder) {

@@ -1,6 +1,7 @@
 #include "viewer/files.h"
 
 #include <algorithm>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -42,7 +43,14 @@ bool is_png_path(const std::filesystem::path& path) {
 }  // namespace
 
 Rgb8Image read_image(const std::filesystem::path& path) {
-    if (!is_png_path(path)) return read_ppm(path);
+    // By content, not by name: a binary PPM starts with "P6", a PNG with its signature.
+    char magic[2] = {};
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw std::runtime_error("cannot open " + path.string());
+    file.read(magic, 2);
+    if (magic[0] == 'P' && magic[1] == '6') return read_ppm(path);
+    if (magic[0] != '\x89')
+        throw std::runtime_error("cannot read " + path.string() + ": not a binary PPM (P6) or PNG image");
     int w = 0, h = 0, channels = 0;
     unsigned char* pixels = stbi_load(path.string().c_str(), &w, &h, &channels, 3);
     if (!pixels)

@@ -15,8 +15,8 @@ namespace kr::viewer {
 // Throws std::runtime_error.
 void write_png(const std::filesystem::path& path, const Rgb8Image& image);
 
-// An 8-bit RGB image from a binary PPM (a .ppm path) or a PNG (stb_image). Throws
-// std::runtime_error with the file's name.
+// An 8-bit RGB image from a binary PPM or a PNG (stb_image), told apart by their first
+// bytes, whatever the file's name. Throws std::runtime_error with the file's name.
 Rgb8Image read_image(const std::filesystem::path& path);
 // PNG when the path ends in .png (any case), otherwise binary PPM; written atomically.
 void write_image(const std::filesystem::path& path, const Rgb8Image& image);
