@@ -72,7 +72,8 @@ Options:
   -h, --help            this text
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
-(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per scene on stdout: spp, seconds, Mrays/s.
+(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per
+scene on stdout: spp, seconds, Mrays/s.
 Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
 )";
 

@@ -90,58 +90,62 @@ double RenderState::relative_error() const {
 
 namespace {
 
-// Each value replaced by the larger of itself and the mean over its 3x3 neighbourhood (the
-// cells inside the image). A few samples can miss a rare bright path and show almost no
-// variance; variance varies smoothly over the image, so the neighbours guard against that.
-// Separable: sums over each row's three columns into `scratch`, then over three rows.
-void guard_3x3(const std::vector<double>& v, int width, int height, std::vector<double>& scratch,
-               std::vector<double>& out) {
-    const size_t w = size_t(width);
-    scratch.resize(v.size());
-    out.resize(v.size());
-#pragma omp parallel for schedule(static)
-    for (int y = 0; y < height; ++y) {
-        const double* row = &v[size_t(y) * w];
-        double* sums = &scratch[size_t(y) * w];
-        for (size_t x = 0; x < w; ++x)
-            sums[x] = (x > 0 ? row[x - 1] : 0.0) + row[x] + (x + 1 < w ? row[x + 1] : 0.0);
-    }
-#pragma omp parallel for schedule(static)
-    for (int y = 0; y < height; ++y) {
-        const double* above = y > 0 ? &scratch[size_t(y - 1) * w] : nullptr;
-        const double* here = &scratch[size_t(y) * w];
-        const double* below = y + 1 < height ? &scratch[size_t(y + 1) * w] : nullptr;
-        const double rows = 1.0 + (above != nullptr) + (below != nullptr);
-        for (size_t x = 0; x < w; ++x) {
-            const double columns = 1.0 + (x > 0) + (x + 1 < w);
-            const double sum = here[x] + (above ? above[x] : 0.0) + (below ? below[x] : 0.0);
-            const size_t i = size_t(y) * w + x;
-            out[i] = std::max(v[i], sum / (rows * columns));
-        }
-    }
+// The 3x3 guard on per-pixel values (variances): each value replaced by the larger of itself
+// and the mean over its 3x3 neighbourhood (the cells inside the image). A few samples can
+// miss a rare bright path and show almost no variance; variance varies smoothly over the
+// image, so the neighbours guard against that. Separable, in two loops over rows: first
+// each row's 3-wide sums, then the guarded value from three rows of those sums.
+void sum_three_along_row(const double* values, double* sums, size_t width) {
+    for (size_t x = 0; x < width; ++x)
+        sums[x] = (x > 0 ? values[x - 1] : 0.0) + values[x] + (x + 1 < width ? values[x + 1] : 0.0);
+}
+
+double guarded_3x3(const std::vector<double>& values, const std::vector<double>& row_sums, int width, int height,
+                   int y, size_t x) {
+    const size_t w = size_t(width), i = size_t(y) * w + x;
+    double sum = row_sums[i], cells = 1.0;
+    if (y > 0) sum += row_sums[i - w], cells += 1.0;
+    if (y + 1 < height) sum += row_sums[i + w], cells += 1.0;
+    cells *= 1.0 + (x > 0) + (x + 1 < w);
+    return std::max(values[i], sum / cells);
 }
 
 }  // namespace
 
 size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
-    const size_t n = sample_count.size();
+    const size_t n = sample_count.size(), w = size_t(width);
+    // Rows in parallel, their sums added in order (as plan_pass).
+    std::vector<double>& error_sq = allocation_scratch[0];
+    std::vector<double>& row_sums = allocation_scratch[1];
+    error_sq.resize(n);
+    row_sums.resize(n);
+    std::vector<double> row_signal(size_t(height), 0.0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            const double mean = sample_count[i] ? luminance(radiance_sum[i]) / sample_count[i] : 0.0;
+            row_signal[size_t(y)] += mean * mean;
+            const double se = pixel_standard_error(i);
+            error_sq[i] = se * se;
+        }
+        sum_three_along_row(&error_sq[size_t(y) * w], &row_sums[size_t(y) * w], w);
+    }
     double signal_sq = 0;
-    std::vector<double> error_sq(n), scratch, local;
-    for (size_t i = 0; i < n; ++i) {
-        const double mean = sample_count[i] ? luminance(radiance_sum[i]) / sample_count[i] : 0.0;
-        signal_sq += mean * mean;
-        const double se = pixel_standard_error(i);
-        error_sq[i] = se * se;
-    }
+    for (double s : row_signal) signal_sq += s;
     const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
-    guard_3x3(error_sq, width, height, scratch, local);
-    active.assign(n, 0);
+    active.resize(n);
+    std::vector<size_t> row_count(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * w + x;
+            const bool needs_more =
+                sample_count[i] < min_samples || !(guarded_3x3(error_sq, row_sums, width, height, y, x) <= share);
+            active[i] = needs_more;
+            row_count[size_t(y)] += needs_more;
+        }
     size_t count = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const bool needs_more = sample_count[i] < min_samples || !(local[i] <= share);
-        active[i] = needs_more;
-        count += needs_more;
-    }
+    for (size_t c : row_count) count += c;
     return count;
 }
 
@@ -166,32 +170,23 @@ void RenderState::plan_pass(const RenderSettings& settings) {
     weight.resize(n);
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < height; ++y) {
-        double* v = &variance[size_t(y) * w];
-        for (size_t x = 0; x < w; ++x) v[x] = sample_variance(size_t(y) * w + x);
-        double* h = &row_sums[size_t(y) * w];
-        for (size_t x = 0; x < w; ++x) h[x] = (x > 0 ? v[x - 1] : 0.0) + v[x] + (x + 1 < w ? v[x + 1] : 0.0);
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) variance[i] = sample_variance(i);
+        sum_three_along_row(&variance[size_t(y) * w], &row_sums[size_t(y) * w], w);
     }
     // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
     // standard deviation, summed per row.
     std::vector<double> row_weight(size_t(height), 0.0);
     std::vector<size_t> row_active(size_t(height), 0);
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < height; ++y) {
-        const double* above = y > 0 ? &row_sums[size_t(y - 1) * w] : nullptr;
-        const double* here = &row_sums[size_t(y) * w];
-        const double* below = y + 1 < height ? &row_sums[size_t(y + 1) * w] : nullptr;
-        const double rows = 1.0 + (above != nullptr) + (below != nullptr);
+    for (int y = 0; y < height; ++y)
         for (size_t x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
             const bool on = active.empty() || active[i];
-            const double columns = 1.0 + (x > 0) + (x + 1 < w);
-            const double mean = (here[x] + (above ? above[x] : 0.0) + (below ? below[x] : 0.0)) / (rows * columns);
-            const double guarded = std::max(variance[i], mean);
+            const double guarded = guarded_3x3(variance, row_sums, width, height, y, x);
             weight[i] = on && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
             row_weight[size_t(y)] += weight[i];
             row_active[size_t(y)] += on;
         }
-    }
     double sum = 0;
     size_t active_count = 0;
     for (int y = 0; y < height; ++y) {

@@ -60,7 +60,7 @@ struct RenderState {
     // Samples per pixel in the next pass, set by plan_pass (empty: one each).
     std::vector<uint8_t> pass_samples;
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
-    std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's per-pixel buffers, kept between passes
+    std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's and update_adaptive's buffers
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
