@@ -230,13 +230,16 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     ASSERT_EQ(settings.allocation, Allocation::adaptive);  // the default
     StopRule rule;
     rule.max_passes = 24;
-    RenderState one(16, 16), two(16, 16);
-    const int threads = omp_get_max_threads();
-    omp_set_num_threads(1);
-    render_until(scene, settings, one, rule);
-    omp_set_num_threads(2);
-    render_until(scene, settings, two, rule);
-    omp_set_num_threads(threads);
+    // A render under `rule` with the given OpenMP thread count.
+    auto render_with = [&](int thread_count) {
+        RenderState state(16, 16);
+        const int threads = omp_get_max_threads();
+        omp_set_num_threads(thread_count);
+        render_until(scene, settings, state, rule);
+        omp_set_num_threads(threads);
+        return state;
+    };
+    const RenderState one = render_with(1), two = render_with(2);
     EXPECT_EQ(one.sample_count, two.sample_count);
     for (size_t i = 0; i < one.radiance_sum.size(); ++i) EXPECT_EQ(one.radiance_sum[i].x, two.radiance_sum[i].x);
     EXPECT_NE(*std::min_element(one.sample_count.begin(), one.sample_count.end()),
@@ -244,12 +247,7 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
 
     // With the noise rule too, whose mask (update_adaptive) also sums rows in parallel.
     rule.noise = 0.04;  // not met by pass 24 (about 0.05): the mask is updated at passes 16, 20, 24
-    RenderState noise_one(16, 16), noise_two(16, 16);
-    omp_set_num_threads(1);
-    render_until(scene, settings, noise_one, rule);
-    omp_set_num_threads(2);
-    render_until(scene, settings, noise_two, rule);
-    omp_set_num_threads(threads);
+    const RenderState noise_one = render_with(1), noise_two = render_with(2);
     EXPECT_EQ(noise_one.sample_count, noise_two.sample_count);
     EXPECT_EQ(noise_one.active, noise_two.active);
     EXPECT_EQ(noise_one.relative_error(), noise_two.relative_error());
