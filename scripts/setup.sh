@@ -5,6 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
+          # Embree: ray casting in scenes of more than 32 spheres (optional to CMake)
+          libembree-dev
           # the viewer (keithray view) and its offscreen display (render --gl), and
           # the X server its window test runs under
           libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xauth

@@ -41,6 +41,18 @@ Agreement compare(const RenderScene& scene, double scale, uint64_t seed, int cou
     Agreement a;
     Rng rng(seed, 9);
     for (int i = 0; i < count; ++i) {
+        // A camera far outside the spheres, aimed at one of them (Embree's float ray starts
+        // nearer: accel_embree.cpp), its aim off by up to twice the radius.
+        {
+            const SphereGeom& target = scene.spheres[size_t(rng.next() * double(scene.spheres.size()))];
+            Ray far;
+            far.o = random_direction(rng) * (1e3 * scale);
+            far.d = normalize(target.centre + random_direction(rng) * (2 * target.radius * rng.next()) - far.o);
+            Hit lin, fast;
+            const bool hit_lin = scene.intersects_linear(far, lin), hit_fast = scene.intersects(far, fast);
+            ++a.rays;
+            if (hit_lin != hit_fast || (hit_lin && lin.sphere != fast.sphere)) ++a.mismatches;
+        }
         Ray ray;
         ray.o = Vec3{rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5} * (2 * scale);
         ray.d = random_direction(rng);
@@ -85,23 +97,99 @@ Agreement compare(const RenderScene& scene, double scale, uint64_t seed, int cou
     return a;
 }
 
+// The BVHs this build has: ours, and Embree's where CMake found it.
+std::vector<AccelBackend> backends() {
+    if (embree_available()) return {AccelBackend::own, AccelBackend::embree};
+    return {AccelBackend::own};
+}
+
+RenderScene with_backend(RenderScene scene, AccelBackend backend) {
+    scene.accel_backend = backend;
+    scene.build_accel();
+    return scene;
+}
+
 }  // namespace
 
 TEST(Accel, AgreesWithLinearScanAtAllScalesAndSizes) {
-    for (int n : {1, 3, 4, 5, 8, 17, 200, 3000})
-        for (double scale : {1e-4, 1.0, 1e4})
-            for (bool walls : {false, true}) {
-                const RenderScene scene = random_spheres(n, scale, 11 + n, walls);
-                const Agreement a = compare(scene, scale, 5 + n, 3000);
-                EXPECT_GT(a.hits, 0) << n << " spheres at scale " << scale;
-                if (walls) EXPECT_GE(a.hits, 3000 - a.mismatches);  // inside the wall every ray hits
-                // Rounding may differ in the last bit (FMA in the AVX2 path) on a grazing ray.
-                EXPECT_LE(a.mismatches, a.rays / 2000) << n << " spheres at scale " << scale << " walls " << walls;
-            }
+    for (AccelBackend backend : backends())
+        for (int n : {1, 3, 4, 5, 8, 17, 200, 3000})
+            for (double scale : {1e-4, 1.0, 1e4})
+                for (bool walls : {false, true}) {
+                    const RenderScene scene = with_backend(random_spheres(n, scale, 11 + n, walls), backend);
+                    ASSERT_EQ(scene.bvh.backend(), backend);
+                    const Agreement a = compare(scene, scale, 5 + n, 3000);
+                    const std::string where = std::string(accel_backend_names.name(backend)) + ", " +
+                                              std::to_string(n) + " spheres at scale " + std::to_string(scale) +
+                                              (walls ? " in a wall" : "");
+                    EXPECT_GT(a.hits, 0) << where;
+                    if (walls) EXPECT_GE(a.hits, 3000 - a.mismatches) << where;  // inside the wall every ray hits
+                    // Rounding may differ in the last bit (FMA in the AVX2 path) on a grazing ray.
+                    EXPECT_LE(a.mismatches, a.rays / 2000) << where;
+                }
+}
+
+// Embree's float traversal must never cull a sphere the double test hits: the rays of the
+// test above, and exactly the same answers as the plain path (both run accepted_root).
+TEST(Accel, EmbreeGivesExactlyThePlainPathsHits) {
+    if (!embree_available()) GTEST_SKIP() << "built without Embree";
+    for (double scale : {1e-4, 1.0, 1e4}) {
+        const RenderScene scene = with_backend(random_spheres(500, scale, 21, true), AccelBackend::embree);
+        EXPECT_EQ(compare(scene, scale, 8, 3000).mismatches, 0) << "scale " << scale;
+    }
+    // The hardest rays for a float traversal: from far away, grazing a sphere where it
+    // touches its box (a millionth of the radius inside the extreme point of an axis), so
+    // that the rounding of the float ray alone moves many out of the box.
+    for (double scale : {1e-4, 1.0, 1e4}) {
+        const RenderScene scene = with_backend(random_spheres(200, scale, 23, false), AccelBackend::embree);
+        Rng rng(31, 2);
+        int rays = 0, mismatches = 0, hits = 0;
+        for (size_t i = 0; i < scene.spheres.size(); ++i)
+            for (int axis = 0; axis < 3; ++axis)
+                for (double side : {-1.0, 1.0}) {
+                    const SphereGeom& s = scene.spheres[i];
+                    Vec3 e;
+                    (axis == 0 ? e.x : axis == 1 ? e.y : e.z) = side;
+                    const Vec3 grazed = s.centre + e * (s.radius * (1 - 1e-6));
+                    // A direction across the axis, tilted by up to a millionth, from a
+                    // million times the scene's size away: a naive float slab test misses
+                    // the box for about 40 % of these rays.
+                    Vec3 d = random_direction(rng);
+                    d = normalize(d - dot(d, e) * e + e * (2e-6 * rng.next() - 1e-6));
+                    Ray ray;
+                    ray.o = grazed - d * (1e6 * scale * (1 + rng.next()));
+                    ray.d = d;
+                    Hit lin, fast;
+                    const bool hit_lin = scene.intersects_linear(ray, lin), hit_fast = scene.intersects(ray, fast);
+                    ++rays;
+                    hits += hit_lin;
+                    mismatches += hit_lin != hit_fast || (hit_lin && (lin.sphere != fast.sphere || lin.t != fast.t));
+                }
+        EXPECT_EQ(hits, rays) << "scale " << scale;  // each ray at least grazes its sphere
+        EXPECT_EQ(mismatches, 0) << "of " << rays << " grazing rays at scale " << scale;
+    }
+}
+
+TEST(Accel, AutomaticChoiceBySphereCount) {
+    EXPECT_EQ(random_spheres(16, 1.0, 5, true).bvh.backend(), AccelBackend::own);  // 17 with the wall
+    EXPECT_EQ(random_spheres(31, 1.0, 5, true).bvh.backend(), AccelBackend::own);
+    EXPECT_EQ(random_spheres(32, 1.0, 5, true).bvh.backend(),
+              embree_available() ? AccelBackend::embree : AccelBackend::own);
+    // The brief's scenes are small: always our own one-leaf blocks.
+    for (int n = 1; n <= 8; ++n) {
+        const RenderScene scene = prepare_scene(
+            load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
+        EXPECT_EQ(scene.bvh.backend(), AccelBackend::own) << "scene " << n;
+    }
+    if (!embree_available()) {
+        RenderScene scene = random_spheres(40, 1.0, 5, false);
+        scene.accel_backend = AccelBackend::embree;
+        EXPECT_THROW(scene.build_accel(), std::runtime_error);
+    }
 }
 
 TEST(Accel, LargeSceneBuildsShallowTree) {
-    const RenderScene scene = random_spheres(100000, 1.0, 3, true);
+    const RenderScene scene = with_backend(random_spheres(100000, 1.0, 3, true), AccelBackend::own);
     EXPECT_LE(scene.bvh.depth(), 60);
     EXPECT_GE(scene.bvh.depth(), 10);  // it did split
     EXPECT_EQ(scene.bvh.block_count() * 4 >= scene.spheres.size(), true);
@@ -115,7 +203,7 @@ TEST(Accel, SmallScenesAreOneLeaf) {
     const RenderScene sixteen = random_spheres(15, 1.0, 5, true);
     EXPECT_EQ(sixteen.bvh.node_count(), 1u);
     EXPECT_EQ(sixteen.bvh.block_count(), 4u);
-    const RenderScene seventeen = random_spheres(16, 1.0, 5, true);
+    const RenderScene seventeen = with_backend(random_spheres(16, 1.0, 5, true), AccelBackend::own);
     EXPECT_GT(seventeen.bvh.node_count(), 1u);
     const RenderScene room =
         prepare_scene(load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_06.json").scene);
@@ -127,16 +215,54 @@ TEST(Accel, CoincidentCentresStillSplit) {
     test::SceneBuilder b;
     const int m = b.material(MaterialType::diffuse);
     for (int i = 0; i < 100; ++i) b.sphere({0, 0, 0}, 1.0 + i, m);  // nested shells, one centre
-    const RenderScene scene = b.build();
-    Ray ray;
-    ray.o = {0, 0, -1000};
-    ray.d = {0, 0, 1};
-    Hit hit;
-    ASSERT_TRUE(scene.intersects(ray, hit));
-    EXPECT_EQ(scene.spheres[hit.sphere].radius, 100.0);
-    ray.o = {0, 0, 0};
-    ASSERT_TRUE(scene.intersects(ray, hit));
-    EXPECT_DOUBLE_EQ(hit.t, 1.0);
+    for (AccelBackend backend : backends()) {
+        const RenderScene scene = with_backend(b.build(), backend);
+        Ray ray;
+        ray.o = {0, 0, -1000};
+        ray.d = {0, 0, 1};
+        Hit hit;
+        ASSERT_TRUE(scene.intersects(ray, hit));
+        EXPECT_EQ(scene.spheres[hit.sphere].radius, 100.0);
+        ray.o = {0, 0, 0};
+        ASSERT_TRUE(scene.intersects(ray, hit));
+        EXPECT_DOUBLE_EQ(hit.t, 1.0);
+    }
+}
+
+// Embree's BVH changes no image: 300 spheres under a lamp, path traced with Embree and with
+// the plain path (the same double-precision test decides both), same seeds, bit for bit.
+TEST(Accel, EmbreeImageIsThePlainPaths) {
+    if (!embree_available()) GTEST_SKIP() << "built without Embree";
+    test::SceneBuilder b;
+    const int m = b.material(MaterialType::diffuse), glass = b.material(MaterialType::dielectric);
+    b.scene.materials[glass].rho_r = b.scene.materials[glass].rho_t = Color(0.9);
+    Rng rng(4, 1);
+    for (int i = 0; i < 300; ++i)
+        b.sphere({8 * rng.next() - 4, 8 * rng.next() - 4, 8 * rng.next() - 4}, 0.2 + 0.3 * rng.next(),
+                 i % 4 ? m : glass);
+    b.sphere({0, -1005, 0}, 1000, m);
+    b.emitter({3, 12, -6}, 3, Color(5), m);
+    const RenderScene embree = with_backend(b.build(), AccelBackend::embree);
+    RenderScene plain = b.build();
+    plain.linear_scan = true;
+    RenderSettings settings = RenderSettings::from_scene(plain.renderer);
+    settings.target_spp = 2;
+    RenderState a(64, 64), c(64, 64);
+    for (int i = 0; i < 2; ++i) {
+        render_pass(plain, settings, a);
+        render_pass(embree, settings, c);
+    }
+    EXPECT_EQ(a.rays, c.rays);
+    const Image ia = a.radiance(), ic = c.radiance();
+    size_t differ = 0;
+    double total = 0;
+    for (size_t i = 0; i < ia.pixels.size(); ++i) {
+        differ += !(ia.pixels[i].x == ic.pixels[i].x && ia.pixels[i].y == ic.pixels[i].y &&
+                    ia.pixels[i].z == ic.pixels[i].z);
+        total += luminance(ia.pixels[i]);
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(total, 0.0);  // not a black image
 }
 
 // The fast path changes no image beyond rounding: the same scene rendered with the BVH and

@@ -26,7 +26,7 @@ namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear]
-  keithray bench --stress N[,N...] [--runs N] [--threads N] [--size W]
+  keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
@@ -38,6 +38,9 @@ constexpr const char* kBenchUsage = R"(Usage:
 --linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
 --stress      generated scenes of N random spheres under a sphere light, path traced at
               W x W (default 256) with 4 spp: ns per ray and ns per ray / log2(N).
+--accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
+              own,embree where the build has Embree, else own). With --throughput, one
+              of them (default auto).
 --write-stress writes such a scene as a scene file (for the viewer).
 )";
 
@@ -111,6 +114,7 @@ nlohmann::json stress_scene_json(int n, uint64_t seed) {
 struct BenchOptions {
     bool throughput = false, linear = false;
     std::vector<int> stress;
+    std::vector<AccelBackend> accel;
     int write_stress = 0;
     fs::path write_path;
     std::vector<fs::path> scenes;
@@ -130,14 +134,14 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
         else if (arg == "--size") o.size = int(parse_number(arg, value(), 1, 8192));
         else if (arg == "--stress") {
-            std::string list = value();
-            size_t start = 0;
-            while (start <= list.size()) {
-                const size_t comma = list.find(',', start);
-                const std::string item = list.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+            for (const std::string& item : split_list(value()))
                 o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
-                if (comma == std::string::npos) break;
-                start = comma + 1;
+        } else if (arg == "--accel") {
+            for (const std::string& item : split_list(value())) {
+                const AccelBackend backend = parse_name(arg, item, accel_backend_names);
+                if (backend == AccelBackend::embree && !embree_available())
+                    throw UsageError{"--accel embree: this build has no Embree (install libembree-dev)"};
+                o.accel.push_back(backend);
             }
         } else if (arg == "--write-stress") {
             o.write_stress = int(parse_number(arg, value(), 1, 1e7));
@@ -148,6 +152,12 @@ BenchOptions parse(int argc, char** argv) {
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)
         throw UsageError{"choose --throughput, --stress, --write-stress or --convergence"};
+    if (o.throughput && o.accel.size() > 1) throw UsageError{"--throughput takes one --accel"};
+    if (o.accel.empty()) {
+        if (o.throughput) o.accel = {AccelBackend::automatic};
+        else o.accel = embree_available() ? std::vector{AccelBackend::own, AccelBackend::embree}
+                                          : std::vector{AccelBackend::own};
+    }
     return o;
 }
 
@@ -165,6 +175,8 @@ int bench_throughput(const BenchOptions& o) {
             return 1;
         }
         scene.linear_scan = o.linear;
+        scene.accel_backend = o.accel.front();
+        scene.build_accel();
         const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
         const int spp = std::max(1, int(std::lround(settings.target_spp * o.fraction)));
         const int w = scene.renderer.width, h = scene.renderer.height;
@@ -184,31 +196,49 @@ int bench_throughput(const BenchOptions& o) {
         std::fflush(stdout);
     }
     std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s).\n", total_estimate,
-                omp_get_max_threads(), o.linear ? "linear scan" : "BVH");
+                omp_get_max_threads(),
+                o.linear ? "linear scan" : ("BVH " + std::string(accel_backend_names.name(o.accel.front()))).c_str());
     return 0;
 }
 
 int bench_stress(const BenchOptions& o) {
-    std::printf("| spheres | BVH nodes | depth | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N |\n");
-    std::printf("|---|---|---|---|---|---|---|---|\n");
+    std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
     for (int n : o.stress) {
-        const double build_start = now_seconds();
-        RenderScene scene = prepare_scene(parse_scene(stress_scene_json(n, 1).dump(), "stress.json").scene);
-        const double build_ms = (now_seconds() - build_start) * 1e3;
-        scene.linear_scan = o.linear;
-        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
-        settings.target_spp = 4;
-        std::vector<double> seconds, ns;
-        for (int run = 0; run < o.runs; ++run) {
-            const Timing t = time_render(scene, settings, o.size, o.size, 4);
-            seconds.push_back(t.seconds);
-            // Per-ray cost on all threads together, as a user sees it.
-            ns.push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
+        const double prepare_start = now_seconds();
+        const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1).dump(), "stress.json").scene);
+        const double prepare_ms = (now_seconds() - prepare_start) * 1e3;
+        // One copy of the scene per BVH, timed in turn within each run, so that the ratios
+        // come from the same moments of a shared machine.
+        std::vector<RenderScene> scenes(o.accel.size(), prepared);
+        std::vector<double> build_ms(o.accel.size());
+        std::vector<std::vector<double>> seconds(o.accel.size()), ns(o.accel.size());
+        for (size_t k = 0; k < o.accel.size(); ++k) {
+            scenes[k].linear_scan = o.linear;
+            scenes[k].accel_backend = o.accel[k];
+            const double build_start = now_seconds();
+            scenes[k].build_accel();
+            build_ms[k] = (now_seconds() - build_start) * 1e3;
         }
-        const double ns_ray = median(ns);
-        std::printf("| %d | %zu | %d | %.0f | %.2f | %.1f | %.1f | %.2f |\n", n, scene.bvh.node_count(),
-                    scene.bvh.depth(), build_ms, median(seconds), ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray,
-                    ns_ray / std::log2(double(n) + 1));
+        RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
+        settings.target_spp = 4;
+        for (int run = 0; run < o.runs; ++run)
+            for (size_t k = 0; k < o.accel.size(); ++k) {
+                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4);
+                seconds[k].push_back(t.seconds);
+                // Per-ray cost on all threads together, as a user sees it.
+                ns[k].push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
+            }
+        for (size_t k = 0; k < o.accel.size(); ++k) {
+            const SphereBvh& bvh = scenes[k].bvh;
+            const bool own = bvh.backend() == AccelBackend::own;
+            const double ns_ray = median(ns[k]);
+            std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f |\n", n,
+                        o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())).c_str(),
+                        own ? std::to_string(bvh.node_count()).c_str() : "-",
+                        own ? std::to_string(bvh.depth()).c_str() : "-", prepare_ms, build_ms[k], median(seconds[k]),
+                        ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1));
+        }
         std::fflush(stdout);
     }
     return 0;

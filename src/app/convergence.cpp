@@ -156,8 +156,7 @@ Options parse(int argc, char** argv) {
         auto value = [&] { return args.value(); };
         if (arg == "--convergence") continue;
         else if (arg == "--configs") {
-            std::stringstream ss(value());
-            for (std::string item; std::getline(ss, item, ',');) o.configs.push_back(parse_config(item));
+            for (const std::string& item : split_list(value())) o.configs.push_back(parse_config(item));
         } else if (arg == "--scale") o.scale = parse_number(arg, value(), 1e-3, 4.0);
         else if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
         else if (arg == "--reference-factor") o.reference_factor = int(parse_integer(arg, value(), 1, 1024));

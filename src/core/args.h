@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace kr {
 
@@ -83,6 +84,16 @@ inline long long parse_integer(const std::string& flag, const std::string& text,
         throw UsageError{flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
                          "], got \"" + text + "\""};
     return value;
+}
+
+// The items of a comma-separated list ("a,b,c"); an empty text is one empty item.
+inline std::vector<std::string> split_list(const std::string& text) {
+    std::vector<std::string> items(1);
+    for (char c : text) {
+        if (c == ',') items.emplace_back();
+        else items.back() += c;
+    }
+    return items;
 }
 
 // One of an EnumNames table's names.

@@ -1,17 +1,34 @@
-// Ray casting acceleration: a bounding volume hierarchy over spheres whose leaves hold
-// spheres in blocks of four, tested together (SIMD lanes). Double precision throughout, so
-// the epsilon-free rules of Ray (from/to sphere) hold at every scale.
+// Ray casting acceleration: a bounding volume hierarchy over spheres. Two of them, with the
+// same answers: our own, whose leaves hold spheres in blocks of four tested together (SIMD
+// lanes), and Embree's (libembree3, where the build found it), whose traversal is faster once
+// the scene is a tree. Both decide hits in double precision with the same rules, so the
+// epsilon-free rules of Ray (from/to sphere) hold at every scale (docs/performance.md,
+// "Scaling").
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "core/math.h"
+#include "scene/scene.h"  // EnumNames
 
 namespace kr {
 
 struct Ray;
 struct SphereGeom;
+struct EmbreeSpheres;  // accel_embree.cpp
+
+// own:       our BVH. One leaf, without any box test, for up to 16 spheres: the faster one
+//            for small scenes (the brief's have 5 to 10 spheres).
+// embree:    Embree's BVH over user geometry whose intersection callbacks are our double-
+//            precision sphere tests: the faster one for large scenes (ray casting alone 1.4x
+//            at 1,000 to 100,000 spheres, whole renders 1.25x; docs/performance.md).
+// automatic: embree for more than 32 spheres where the build has Embree, else own.
+enum class AccelBackend { automatic, own, embree };
+inline constexpr EnumNames<AccelBackend, 3> accel_backend_names{{"auto", "own", "embree"}};
+// Whether this build can cast rays with Embree.
+bool embree_available();
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
@@ -28,8 +45,10 @@ struct BvhNode {
 
 class SphereBvh {
 public:
-    // Sets of up to 16 spheres are one leaf; a binned surface-area heuristic splits larger ones.
-    void build(const std::vector<SphereGeom>& spheres);
+    // Our BVH: sets of up to 16 spheres are one leaf; a binned surface-area heuristic splits
+    // larger ones. Or Embree's (see AccelBackend); `embree` without Embree in the build
+    // throws std::runtime_error.
+    void build(const std::vector<SphereGeom>& spheres, AccelBackend backend = AccelBackend::automatic);
 
     // Closest sphere accepted by the ray's rules within [tmin, tmax]: its index and distance,
     // or -1. Picks an AVX2 version at run time where the CPU has it.
@@ -37,6 +56,9 @@ public:
     // Whether any sphere is accepted within [tmin, tmax].
     bool any(const Ray& ray) const;
 
+    // Which BVH the last build made (own or embree); the counts below are of our own BVH
+    // (0 when Embree's was built).
+    AccelBackend backend() const { return embree_ ? AccelBackend::embree : AccelBackend::own; }
     size_t node_count() const { return nodes_.size(); }
     size_t block_count() const { return blocks_.size(); }
     int depth() const { return depth_; }
@@ -45,6 +67,12 @@ private:
     std::vector<BvhNode> nodes_;
     std::vector<SphereBlock> blocks_;
     int depth_ = 0;
+    std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
 };
+
+// Embree's side (accel_embree.cpp, only in builds with Embree).
+std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<SphereGeom>& spheres);
+int embree_closest(const EmbreeSpheres& accel, const Ray& ray, double& t);
+bool embree_any(const EmbreeSpheres& accel, const Ray& ray);
 
 }  // namespace kr

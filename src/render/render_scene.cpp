@@ -32,17 +32,14 @@ double segment_end_tolerance(const Vec3& f, double tmax) {
     return kSegmentEndTolerance * (std::abs(f.x) + std::abs(f.y) + std::abs(f.z) + tmax);
 }
 
-// Root of sphere i accepted for this ray, or +inf. Applies the from/to sphere rules of Ray,
-// takes only roots ahead of the origin (t > 0: a root at the origin is the surface a ray
-// starts on, such as a camera placed exactly on a sphere), and for a shadow segment leaves
-// out a crossing at its very end (see kSegmentEndTolerance).
-static inline double accepted_root(const RenderScene& scene, int i, const Ray& ray, bool shadow) {
-    if (i == ray.to_sphere) return kInfinity;
-    const bool is_origin = i == ray.from_sphere;
+double accepted_root(const SphereGeom& s, int index, const Ray& ray, bool shadow) {
+    if (index == ray.to_sphere) return kInfinity;
+    const bool is_origin = index == ray.from_sphere;
     if (is_origin && !ray.into_from_sphere) return kInfinity;
-    const SphereGeom& s = scene.spheres[i];
     double t_near, t_far;
     if (!sphere_roots(s, ray.o, ray.d, t_near, t_far)) return kInfinity;
+    // A root at the origin (t = 0) is the surface a ray starts on, such as a camera placed
+    // exactly on a sphere.
     const double tmax = shadow && ray.tmax < kInfinity ? ray.tmax - segment_end_tolerance(ray.o - s.centre, ray.tmax)
                                                        : ray.tmax;
     if (!is_origin && t_near >= ray.tmin && t_near > 0 && t_near <= tmax) return t_near;
@@ -77,7 +74,7 @@ bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {
     double best = kInfinity;
     int best_sphere = -1;
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i) {
-        const double t = accepted_root(*this, i, ray, false);
+        const double t = accepted_root(spheres[size_t(i)], i, ray, false);
         if (t < best) {
             best = t;
             best_sphere = i;
@@ -90,7 +87,7 @@ bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {
 
 bool RenderScene::is_occluded_linear(const Ray& ray) const {
     for (int i = 0; i < static_cast<int>(spheres.size()); ++i)
-        if (accepted_root(*this, i, ray, true) < kInfinity) return true;
+        if (accepted_root(spheres[size_t(i)], i, ray, true) < kInfinity) return true;
     return false;
 }
 

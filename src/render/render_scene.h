@@ -66,6 +66,7 @@ struct RenderScene {
     RendererSettings renderer;  // the file's renderer block
 
     SphereBvh bvh;  // over `spheres`; built by prepare_scene (call build_accel after edits)
+    AccelBackend accel_backend = AccelBackend::automatic;  // which BVH build_accel makes
     bool linear_scan = false;  // test every sphere instead of the BVH (the plain path, for checks)
 
     // Closest hit within [tmin, tmax]. Fills `hit` and returns true if there is one.
@@ -75,7 +76,7 @@ struct RenderScene {
     // The same two by testing every sphere in turn: the plain path the BVH is checked against.
     bool intersects_linear(const Ray& ray, Hit& hit) const;
     bool is_occluded_linear(const Ray& ray) const;
-    void build_accel() { bvh.build(spheres); }
+    void build_accel() { bvh.build(spheres, accel_backend); }
     size_t light_count() const { return point_lights.size() + area_lights.size(); }
 };
 
@@ -91,6 +92,12 @@ double segment_end_tolerance(const Vec3& origin_minus_centre, double tmax);
 // Ray-sphere roots of |o + t d - c|^2 = r^2 for unit d, in a cancellation-free form
 // (Haines et al., Ray Tracing Gems ch. 7). Returns false when the line misses.
 bool sphere_roots(const SphereGeom& s, const Vec3& o, const Vec3& d, double& t_near, double& t_far);
+
+// The distance at which `ray` hits sphere `s` (index `index` of the scene), or +inf: the
+// from/to sphere rules of Ray, only roots ahead of the origin (t > 0), within [tmin, tmax];
+// `shadow` leaves out a crossing at a segment's very end (kSegmentEndTolerance). The plain
+// path's test, and Embree's intersection callback.
+double accepted_root(const SphereGeom& s, int index, const Ray& ray, bool shadow);
 
 // Builds the render scene from what `scene.scene` references. Identical repeated primitives
 // (same shape) are merged, with a warning if their materials differ. Throws SceneError for
