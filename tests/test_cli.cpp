@@ -207,7 +207,13 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     EXPECT_NE(r.out.find("Mrays/s"), std::string::npos);
     r = run("bench --stress 20 --runs 1 --size 16");
     EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_NE(r.out.find("| 20 |"), std::string::npos) << r.out;
+    // One row per BVH: ours, and Embree's where the build has it.
+    EXPECT_NE(r.out.find("| 20 | own |"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("| 20 | embree |") != std::string::npos, kr::embree_available()) << r.out;
+    r = run("bench --stress 20 --runs 1 --size 16 --accel bogus");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--accel expects \"auto\", \"own\" or \"embree\""), std::string::npos) << r.err;
+    EXPECT_EQ(run("bench --throughput --accel own,embree").status, 2);  // one BVH at a time
     EXPECT_EQ(run("bench --bogus").status, 2);
     EXPECT_EQ(run("bench").status, 2);
     // --write-stress never overwrites.

@@ -25,7 +25,7 @@ namespace kr {
 namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
-  keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear]
+  keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
