@@ -86,6 +86,41 @@ TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
     EXPECT_TRUE(m.settings().paused);
 }
 
+// Rebuilding the BVH after every edit made it most of an edit's latency in a large scene: an
+// edit that moves no sphere keeps it, one that moves a sphere builds it again.
+TEST(ResetRule, EditsThatMoveNoSphereKeepTheBvh) {
+    test::SceneBuilder b;
+    const int m = b.material(MaterialType::diffuse);
+    for (int i = 0; i < 40; ++i) b.sphere({double(i % 7) - 3, double(i / 7) - 3, 0}, 0.3, m);
+    const int lamp = b.emitter({0, 8, -4}, 2, Color(4), m);
+    ViewerModel model;
+    model.set_scene(b.scene, {});
+    ASSERT_TRUE(model.has_scene());
+    EXPECT_EQ(model.prepared()->bvh.backend(), embree_available() ? AccelBackend::embree : AccelBackend::own);
+    auto before = model.prepared();
+    const auto kept = [&](Edit kind, auto change) {
+        EXPECT_TRUE(model.edit(kind, change));
+        const bool same = model.prepared()->bvh.same_build(before->bvh);
+        before = model.prepared();
+        return same;
+    };
+    EXPECT_TRUE(kept(Edit::camera, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].fov = 30; }));
+    EXPECT_TRUE(kept(Edit::material, [](Scene& s, ViewerSettings&) { s.materials[0].rho = Color(0.2); }));
+    EXPECT_TRUE(kept(Edit::light, [](Scene& s, ViewerSettings&) { s.lights[0].power = Color(9); }));
+    EXPECT_TRUE(kept(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 3; }));
+    // The lamp's radius is a sphere's: a new BVH, which finds the lamp's new surface.
+    EXPECT_FALSE(kept(Edit::light, [&](Scene& s, ViewerSettings&) { s.shapes[size_t(lamp)].radius = 3; }));
+    Ray up;
+    up.o = {0, 4, -4};  // under the lamp, above the balls
+    up.d = {0, 1, 0};
+    Hit hit;
+    ASSERT_TRUE(model.prepared()->intersects(up, hit));
+    EXPECT_EQ(hit.sphere, model.prepared()->area_lights[0].sphere);
+    EXPECT_NEAR(hit.t, 1.0, 1e-12);  // radius 3, not 2
+    // A reload of the same file keeps it too.
+    EXPECT_TRUE(kept(Edit::scene, [](Scene&, ViewerSettings&) {}));
+}
+
 // Authored and prepared stay apart: an edit the renderer cannot take is undone whole.
 TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
     ViewerModel m = model_of(3);

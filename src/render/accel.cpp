@@ -1,6 +1,7 @@
 #include "render/accel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 #include <stdexcept>
 
@@ -348,6 +349,8 @@ bool embree_available() {
 }
 
 void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backend) {
+    static std::atomic<uint64_t> builds{0};
+    build_id_ = ++builds;
     nodes_.clear();
     blocks_.clear();
     depth_ = 0;

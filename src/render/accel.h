@@ -56,6 +56,8 @@ public:
     // Whether any sphere is accepted within [tmin, tmax].
     bool any(const Ray& ray) const;
 
+    // Whether this and `other` are copies of one build (their trees are the same).
+    bool same_build(const SphereBvh& other) const { return build_id_ != 0 && build_id_ == other.build_id_; }
     // Which BVH the last build made (own or embree); the counts below are of our own BVH
     // (0 when Embree's was built).
     AccelBackend backend() const { return embree_ ? AccelBackend::embree : AccelBackend::own; }
@@ -68,6 +70,7 @@ private:
     std::vector<SphereBlock> blocks_;
     int depth_ = 0;
     std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
+    uint64_t build_id_ = 0;                        // a number per build() in this process
 };
 
 // Embree's side (accel_embree.cpp, only in builds with Embree).

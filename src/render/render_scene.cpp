@@ -91,7 +91,7 @@ bool RenderScene::is_occluded_linear(const Ray& ray) const {
     return false;
 }
 
-RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings) {
+RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings, const RenderScene* previous) {
     const std::string file = scene.source_file.string();
     auto warn = [&](const std::string& path, const std::string& message) {
         if (warnings) warnings->push_back(file + ": " + path + ": " + message);
@@ -197,7 +197,12 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         else
             rs.area_lights[i - rs.point_lights.size()].select_prob = prob;
     }
-    rs.build_accel();
+    // The BVH depends on the spheres alone. At 100,000 spheres its build is most of the
+    // viewer's latency after a camera edit (about 80 of 140 ms).
+    if (previous && previous->accel_backend == rs.accel_backend && previous->spheres == rs.spheres)
+        rs.bvh = previous->bvh;
+    else
+        rs.build_accel();
     return rs;
 }
 

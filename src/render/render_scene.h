@@ -40,6 +40,7 @@ struct Hit {
 struct SphereGeom {
     Vec3 centre;
     double radius = 1;
+    bool operator==(const SphereGeom&) const = default;
 };
 
 struct PointLight {
@@ -102,6 +103,9 @@ double accepted_root(const SphereGeom& s, int index, const Ray& ray, bool shadow
 // Builds the render scene from what `scene.scene` references. Identical repeated primitives
 // (same shape) are merged, with a warning if their materials differ. Throws SceneError for
 // problems only visible at this stage (e.g. an active area light no primitive carries).
-RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings = nullptr);
+// `previous`, the render scene before an edit: where the edit moved no sphere (camera, lens,
+// material, light power, renderer settings), its BVH is kept rather than built again.
+RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings = nullptr,
+                          const RenderScene* previous = nullptr);
 
 }  // namespace kr

@@ -11,9 +11,11 @@ namespace {
 
 // prepare_scene throws SceneError; CameraModel::from throws invalid_argument (camera
 // position equal to target), which an edit can produce.
-std::shared_ptr<const RenderScene> prepare(const Scene& scene, std::vector<std::string>* warnings) {
+// `previous`: the render scene before the edit, whose BVH serves again if no sphere moved.
+std::shared_ptr<const RenderScene> prepare(const Scene& scene, std::vector<std::string>* warnings,
+                                           const RenderScene* previous) {
     try {
-        return std::make_shared<const RenderScene>(prepare_scene(scene, warnings));
+        return std::make_shared<const RenderScene>(prepare_scene(scene, warnings, previous));
     } catch (const std::invalid_argument& e) {
         throw SceneError(scene.source_file.string(), "", e.what());
     }
@@ -27,7 +29,7 @@ void ViewerModel::load(const std::filesystem::path& file) {
 }
 
 void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
-    auto prepared = prepare(scene, &warnings);  // throws before anything changes
+    auto prepared = prepare(scene, &warnings, prepared_.get());  // throws before anything changes
     ViewerSettings settings = settings_;
     const ToneSettings tone = settings_.tone;
     settings.render = RenderSettings::from_scene(scene.renderer);
@@ -56,7 +58,7 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
     change(scene, settings);
     std::vector<std::string> warnings;
     try {
-        prepared_ = prepare(scene, &warnings);
+        prepared_ = prepare(scene, &warnings, prepared_.get());
     } catch (const SceneError& e) {
         if (error) *error = e.what();
         return false;
