@@ -357,13 +357,22 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     embree_.reset();
     if (backend == AccelBackend::embree && !embree_available())
         throw std::runtime_error("this build of keithray has no Embree (libembree-dev was not found)");
-    if (backend == AccelBackend::embree ||
-        (backend == AccelBackend::automatic && embree_available() && spheres.size() >= kEmbreeFromSpheres)) {
 #ifdef KEITHRAY_HAVE_EMBREE
+    if (backend == AccelBackend::embree) {
         embree_ = build_embree_spheres(spheres);
         return;
-#endif
     }
+    if (backend == AccelBackend::automatic && spheres.size() >= kEmbreeFromSpheres) {
+        // Embree is only the faster choice here: where it fails (no device on this CPU, or
+        // its build runs out of memory), our own tree takes the scene.
+        try {
+            embree_ = build_embree_spheres(spheres);
+            return;
+        } catch (const std::runtime_error&) {
+            embree_.reset();
+        }
+    }
+#endif
     Builder builder{{}, nodes_, blocks_};
     builder.items.reserve(spheres.size());
     for (size_t i = 0; i < spheres.size(); ++i) {

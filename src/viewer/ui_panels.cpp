@@ -285,6 +285,9 @@ void ViewerApp::panel_stats() {
     const Scene& scene = model_.scene();
     ImGui::Text("image %dx%d, UI %.0f frames/s (%.1f ms of work each)", scene.renderer.width,
                 scene.renderer.height, ui_fps_, 1e3 * ui_work_);
+    if (const auto& prepared = model_.prepared())
+        ImGui::Text("%zu spheres, %s BVH", prepared->spheres.size(),
+                    prepared->bvh.backend() == AccelBackend::embree ? "Embree's" : "keithray's own");
     const bool current = shown_ && shown_->generation == model_.generation();
     if (!current) {
         ImGui::Text("rendering the first preview...");
