@@ -181,6 +181,10 @@ TEST(Accel, AutomaticChoiceBySphereCount) {
             load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
         EXPECT_EQ(scene.bvh.backend(), AccelBackend::own) << "scene " << n;
     }
+    // Spheres beyond single precision's range: our tree, which works in double throughout.
+    const RenderScene huge = random_spheres(40, 1e37, 5, false);
+    EXPECT_EQ(huge.bvh.backend(), AccelBackend::own);
+    EXPECT_EQ(compare(huge, 1e37, 3, 300).mismatches, 0);
     if (!embree_available()) {
         RenderScene scene = random_spheres(40, 1.0, 5, false);
         scene.accel_backend = AccelBackend::embree;

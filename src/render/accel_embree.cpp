@@ -125,6 +125,10 @@ std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<Sphe
     auto a = std::make_shared<EmbreeSpheres>();
     a->spheres = spheres;
     for (const SphereGeom& s : spheres) a->extent = std::max(a->extent, length(s.centre) + s.radius);
+    // Three times the extent (a shifted ray's origin) must be a finite float, with room.
+    if (!(a->extent < 1e36))
+        throw std::runtime_error("Embree: spheres reach " + std::to_string(a->extent) +
+                                 " from the origin, beyond its single-precision boxes");
     // Float rounding of the ray (shifted within 3 extents of the origin, see embree_ray) and
     // of Embree's slab tests moves a box test by under 2^-20 of the extent; the pad is four
     // times that.
