@@ -17,9 +17,9 @@ constexpr int kBins = 16;
 // are spheres with huge boxes that every ray enters (docs/performance.md: scene 6, of ten
 // spheres, as a tree of 7 nodes took 40% more instructions than as one leaf).
 constexpr int kMaxLeafSpheres = 16;
-// Above this many spheres, AccelBackend::automatic takes Embree where the build has it. Whole
+// From this many spheres, AccelBackend::automatic takes Embree where the build has it. Whole
 // renders of the stress scenes (`bench --stress`, both interleaved): our tree 8 % faster at
-// 20 spheres, even at 40, Embree 6 % faster at 100 and 25 % at 10,000 and 100,000.
+// 20 spheres, Embree 5 to 8 % faster at 30 to 100 and 13 to 23 % from 1,000 to 100,000.
 constexpr size_t kEmbreeFromSpheres = 33;
 constexpr int kMaxTreeDepth = 60;    // traversal stack size; deeper sets become leaves
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -23,7 +23,7 @@ struct EmbreeSpheres;  // accel_embree.cpp
 //            for small scenes (the brief's have 5 to 10 spheres).
 // embree:    Embree's BVH over user geometry whose intersection callbacks are our double-
 //            precision sphere tests: the faster one for large scenes (ray casting alone 1.4x
-//            at 1,000 to 100,000 spheres, whole renders 1.25x; docs/performance.md).
+//            at 1,000 to 100,000 spheres, whole renders 1.13x to 1.23x; docs/performance.md).
 // automatic: embree for more than 32 spheres where the build has Embree, else own.
 enum class AccelBackend { automatic, own, embree };
 inline constexpr EnumNames<AccelBackend, 3> accel_backend_names{{"auto", "own", "embree"}};
