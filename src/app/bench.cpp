@@ -175,8 +175,10 @@ int bench_throughput(const BenchOptions& o) {
             return 1;
         }
         scene.linear_scan = o.linear;
-        scene.accel_backend = o.accel.front();
-        scene.build_accel();
+        if (o.accel.front() != AccelBackend::automatic) {  // prepare_scene built the automatic one
+            scene.accel_backend = o.accel.front();
+            scene.build_accel();
+        }
         const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
         const int spp = std::max(1, int(std::lround(settings.target_spp * o.fraction)));
         const int w = scene.renderer.width, h = scene.renderer.height;

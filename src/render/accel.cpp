@@ -369,7 +369,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
             embree_ = build_embree_spheres(spheres);
             return;
         } catch (const std::runtime_error&) {
-            embree_.reset();
+            // embree_ stays empty: on to our tree
         }
     }
 #endif
