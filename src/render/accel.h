@@ -56,6 +56,10 @@ public:
     // Whether any sphere is accepted within [tmin, tmax].
     bool any(const Ray& ray) const;
 
+    // Whether the build is our one leaf (up to 16 spheres), whose spheres packet tracing
+    // (packet.cpp) tests in turn for four rays at once.
+    bool packets() const { return !embree_ && nodes_.size() == 1; }
+
     // Whether this and `other` are copies of one build (their trees are the same).
     bool same_build(const SphereBvh& other) const { return build_id_ != 0 && build_id_ == other.build_id_; }
     // Which BVH the last build made (own or embree); the counts below are of our own BVH

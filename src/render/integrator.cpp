@@ -1,10 +1,109 @@
-// The two integrators: Whitted-style recursive ray tracing and iterative path tracing.
+// The two integrators: Whitted-style recursive ray tracing and iterative path tracing, one
+// sample at a time. Path tracing of four samples at once is packet.cpp; the steps both
+// path tracers share are here (path.h).
 #include <algorithm>
 
 #include "render/material.h"
-#include "render/render.h"
+#include "render/path.h"
 
 namespace kr {
+
+// A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
+// whole Ray just after its fields were stored stalls on store forwarding (measured: a
+// tenth of the path loop's time).
+void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax, int to_sphere) {
+    r.o = hit.p;
+    r.d = dir;
+    r.tmin = 0;
+    r.tmax = tmax;
+    r.from_sphere = hit.sphere;
+    r.into_from_sphere = dot(dir, hit.n) < 0;
+    r.to_sphere = to_sphere;
+}
+namespace {
+
+// Direct light from one point light at a surface with a smooth lobe (no selection pdf):
+// the shadow ray to cast and what it brings if nothing blocks it. False: nothing to bring.
+bool point_light_direct(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp,
+                        Ray& shadow, Color& direct) {
+    Vec3 wi = light.position - hit.p;
+    const double d2 = dot(wi, wi);
+    if (!(d2 > 0)) return false;
+    const double d = std::sqrt(d2);
+    wi = wi / d;
+    const Color f_cos = eval_smooth(m, sp, wi);
+    if (is_black(f_cos)) return false;
+    // Irradiance = I cos / d^2 (the power of a point light is its intensity).
+    respawn(shadow, hit, wi, d);
+    direct = f_cos * light.intensity / d2;
+    return true;
+}
+
+// Light sample towards one area light; `mis` weights it against BSDF sampling. The shadow
+// ray to cast and what it brings if nothing blocks it; false: nothing to bring.
+bool area_light_direct(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Material& m,
+                       const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
+                       Color& direct) {
+    if (light.sphere == hit.sphere) return false;  // a convex emitter cannot light itself
+    LightSample ls;
+    const SphereGeom& geom = scene.spheres[light.sphere];
+    if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
+    const Color f_cos = eval_smooth(m, sp, ls.wi);
+    if (is_black(f_cos)) return false;
+    respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
+    double weight = 1;
+    if (mis && ls.mis_pdf > 0) {
+        const double p_light = select_prob * ls.mis_pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
+        weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
+    }
+    direct = f_cos * light.radiance * (weight / (select_prob * ls.pdf));
+    return true;
+}
+
+}  // namespace
+
+double emission_weight(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Hit& hit,
+                       const Vec3& incoming, const PathHistory& history) {
+    if (history.full_emission || hit.sphere == history.last_sphere) return 1;
+    // The light sample at the last vertex counted all of this light, or could have found this
+    // point too: then the two strategies are weighed by the power heuristic.
+    if (!combines_with_bsdf(sampling)) return 0;
+    const SphereGeom& geom = scene.spheres[hit.sphere];
+    const double p_light = light.select_prob * sphere_light_pdf(geom, history.last_p, incoming, hit.t, hit.n, sampling);
+    const double p_bsdf = history.last_bsdf_pdf;
+    return light_emission_scale(geom, history.last_p, incoming, hit.n, sampling) * p_bsdf * p_bsdf /
+           (p_bsdf * p_bsdf + p_light * p_light);
+}
+
+bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
+                      const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
+    for (const PointLight& light : scene.point_lights) {
+        if (u < light.select_prob) {
+            if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;
+            direct = direct / light.select_prob;
+            return true;
+        }
+        u -= light.select_prob;
+    }
+    if (settings.integrator == Integrator::pt_naive || scene.area_lights.empty()) return false;
+    // Falls through to the last area light if rounding left u above the total.
+    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
+        const AreaLight& light = scene.area_lights[i];
+        if (u < light.select_prob || i + 1 == scene.area_lights.size())
+            return light.select_prob > 0 && area_light_direct(scene, settings.light_sampling, light, m, hit, sp, true,
+                                                               light.select_prob, u_point, shadow, direct);
+        u -= light.select_prob;
+    }
+    return false;
+}
+
+unsigned vertex_numbers_used(const RenderScene& scene, const Material& m, int bounce, int rr_depth) {
+    const bool next_event = has_smooth_lobe(m) && scene.light_count() > 0;
+    return (next_event && scene.light_count() > 1 ? Sampler::use_light_pick : 0u) |
+           (next_event && !scene.area_lights.empty() ? Sampler::use_light : 0u) |
+           (uses_lobe_choice(m) ? Sampler::use_lobe : 0u) | (uses_direction_sample(m) ? Sampler::use_bsdf : 0u) |
+           (bounce + 1 >= rr_depth ? Sampler::use_roulette : 0u);
+}
 
 namespace {
 
@@ -23,56 +122,23 @@ struct Tracer {
         return !scene.is_occluded(ray);
     }
 
-    // A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
-    // whole Ray just after its fields were stored stalls on store forwarding (measured: a
-    // tenth of the path loop's time).
-    static void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1) {
-        r.o = hit.p;
-        r.d = dir;
-        r.tmin = 0;
-        r.tmax = tmax;
-        r.from_sphere = hit.sphere;
-        r.into_from_sphere = dot(dir, hit.n) < 0;
-        r.to_sphere = to_sphere;
-    }
     static Ray spawn(const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1) {
         Ray r;
         respawn(r, hit, dir, tmax, to_sphere);
         return r;
     }
 
-    // Direct light from one point light at a surface with a smooth lobe (no selection pdf).
-    Color point_light_direct(const PointLight& light, const Material& m, const Hit& hit,
-                             const SurfacePoint& sp) {
-        Vec3 wi = light.position - hit.p;
-        const double d2 = dot(wi, wi);
-        if (!(d2 > 0)) return {};
-        const double d = std::sqrt(d2);
-        wi = wi / d;
-        const Color f_cos = eval_smooth(m, sp, wi);
-        if (is_black(f_cos)) return {};
-        // Irradiance = I cos / d^2 (the power of a point light is its intensity).
-        if (!visible(spawn(hit, wi, d))) return {};
-        return f_cos * light.intensity / d2;
+    // point_light_direct and area_light_direct with their shadow ray cast at once.
+    Color point_light_now(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp) {
+        Ray shadow;
+        Color direct;
+        return point_light_direct(light, m, hit, sp, shadow, direct) && visible(shadow) ? direct : Color();
     }
-
-    // Light sample towards one area light; `mis` weights it against BSDF sampling.
-    Color area_light_direct(const AreaLight& light, const Material& m, const Hit& hit,
-                            const SurfacePoint& sp, bool mis, double select_prob, Vec2 u) {
-        if (light.sphere == hit.sphere) return {};  // a convex emitter cannot light itself
-        LightSample ls;
-        const SphereGeom& geom = scene.spheres[light.sphere];
-        if (!sample_sphere_light(geom, hit.p, settings.light_sampling, u.x, u.y, ls))
-            return {};
-        const Color f_cos = eval_smooth(m, sp, ls.wi);
-        if (is_black(f_cos)) return {};
-        if (!visible(spawn(hit, ls.wi, ls.distance, light.sphere))) return {};
-        double weight = 1;
-        if (mis && ls.mis_pdf > 0) {
-            const double p_light = select_prob * ls.mis_pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
-            weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
-        }
-        return f_cos * light.radiance * (weight / (select_prob * ls.pdf));
+    Color area_light_now(const AreaLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp, Vec2 u) {
+        Ray shadow;
+        Color direct;
+        const bool lit = area_light_direct(scene, settings.light_sampling, light, m, hit, sp, false, 1.0, u, shadow, direct);
+        return lit && visible(shadow) ? direct : Color();
     }
 
     // ---- Whitted-style ray tracing: L D S* E, recursive. ----
@@ -90,10 +156,8 @@ struct Tracer {
         switch (m.type) {
             case MaterialType::diffuse:
                 // Every point light exactly; every area light with one sample (distributed RT).
-                for (const PointLight& light : scene.point_lights)
-                    L += point_light_direct(light, m, hit, sp);
-                for (const AreaLight& light : scene.area_lights)
-                    L += area_light_direct(light, m, hit, sp, false, 1.0, sampler.next_2d());
+                for (const PointLight& light : scene.point_lights) L += point_light_now(light, m, hit, sp);
+                for (const AreaLight& light : scene.area_lights) L += area_light_now(light, m, hit, sp, sampler.next_2d());
                 break;
             case MaterialType::specular:
                 L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
@@ -127,14 +191,11 @@ struct Tracer {
         return L;
     }
 
+
     // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
     Color path(Ray ray, double* primary_distance) {
-        const bool naive = settings.integrator == Integrator::pt_naive;
         Color L, throughput(1.0);
-        bool full_emission = true;  // camera ray, or last bounce had no light sample to match
-        double last_bsdf_pdf = 0;
-        Vec3 last_p;
-        int last_sphere = -1;
+        PathHistory history;
         for (int bounce = 0;; ++bounce) {
             Hit hit;
             if (!intersect(ray, hit)) break;
@@ -144,18 +205,8 @@ struct Tracer {
             const int light_index = scene.sphere_light[hit.sphere];
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
-                double weight = 1;
-                if (!full_emission && hit.sphere != last_sphere && !combines_with_bsdf(settings.light_sampling)) {
-                    weight = 0;  // the light sample at the last vertex counted all of this light
-                } else if (!full_emission && hit.sphere != last_sphere) {
-                    // The light sample at the last vertex could have found this point too.
-                    const SphereGeom& geom = scene.spheres[hit.sphere];
-                    const double p_light = light.select_prob * sphere_light_pdf(geom, last_p, ray.d, hit.t, hit.n,
-                                                                                settings.light_sampling);
-                    weight = light_emission_scale(geom, last_p, ray.d, hit.n, settings.light_sampling) *
-                             last_bsdf_pdf * last_bsdf_pdf / (last_bsdf_pdf * last_bsdf_pdf + p_light * p_light);
-                }
-                L += throughput * light.radiance * weight;
+                L += throughput * light.radiance *
+                     emission_weight(scene, settings.light_sampling, light, hit, ray.d, history);
             }
             if (bounce >= settings.max_depth) break;
 
@@ -165,54 +216,35 @@ struct Tracer {
             // Every vertex draws the same dimensions whatever its material, so each dimension
             // of a low-discrepancy sampler keeps one meaning across the pixel's samples; only
             // those this vertex reads are computed.
-            const bool next_event = has_smooth_lobe(m) && scene.light_count() > 0;
-            const bool roulette = bounce + 1 >= settings.rr_depth;
-            const Sampler::VertexNumbers u = sampler.next_vertex(
-                (next_event && scene.light_count() > 1 ? Sampler::use_light_pick : 0u) |
-                (next_event && !scene.area_lights.empty() ? Sampler::use_light : 0u) |
-                (uses_lobe_choice(m) ? Sampler::use_lobe : 0u) | (uses_direction_sample(m) ? Sampler::use_bsdf : 0u) |
-                (roulette ? Sampler::use_roulette : 0u));
+            const Sampler::VertexNumbers u =
+                sampler.next_vertex(vertex_numbers_used(scene, m, bounce, settings.rr_depth));
 
             // Next-event estimation: one light, chosen in proportion to its power.
-            // Point lights cannot be hit by chance, so even naive mode samples them.
-            if (next_event) L += throughput * sample_one_light(m, hit, sp, naive, u.light_pick, u.light);
+            if (has_smooth_lobe(m) && scene.light_count() > 0) {
+                Ray shadow;
+                Color direct;
+                if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, direct) &&
+                    visible(shadow))
+                    L += throughput * direct;
+            }
 
             ScatterSample s;
             if (!sample_material(m, sp, ray.d, u.lobe, u.bsdf, s)) break;
             throughput *= s.weight;
-            full_emission = naive || !s.smooth;
-            last_bsdf_pdf = s.pdf;
-            last_p = hit.p;
-            last_sphere = hit.sphere;
+            history.full_emission = settings.integrator == Integrator::pt_naive || !s.smooth;
+            history.last_bsdf_pdf = s.pdf;
+            history.last_p = hit.p;
+            history.last_sphere = hit.sphere;
             respawn(ray, hit, s.direction);
 
             // Russian roulette with q = max(throughput) (brief), past the threshold depth.
-            if (roulette) {
+            if (bounce + 1 >= settings.rr_depth) {
                 const double q = std::min(1.0, max_component(throughput));
                 if (!(u.roulette < q)) break;
                 throughput /= q;
             }
         }
         return L;
-    }
-
-    Color sample_one_light(const Material& m, const Hit& hit, const SurfacePoint& sp, bool naive, double u,
-                           Vec2 u_point) {
-        for (const PointLight& light : scene.point_lights) {
-            if (u < light.select_prob) return point_light_direct(light, m, hit, sp) / light.select_prob;
-            u -= light.select_prob;
-        }
-        if (naive || scene.area_lights.empty()) return {};
-        // Falls through to the last area light if rounding left u above the total.
-        for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-            const AreaLight& light = scene.area_lights[i];
-            if (u < light.select_prob || i + 1 == scene.area_lights.size())
-                return light.select_prob > 0
-                           ? area_light_direct(light, m, hit, sp, true, light.select_prob, u_point)
-                           : Color();
-            u -= light.select_prob;
-        }
-        return {};
     }
 };
 

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include <omp.h>
 
@@ -230,23 +231,20 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
             continue;
         }
-        for (int x = 0; x < width; ++x) {
-            const size_t pixel = static_cast<size_t>(y) * width + x;
-            if (!state.active.empty() && !state.active[pixel]) continue;
-            const int samples = state.pass_samples.empty() ? 1 : state.pass_samples[pixel];
-            for (int k = 0; k < samples; ++k) {
-                const uint32_t index = state.sample_index[pixel]++;
-                Sampler sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
-                const Vec2 sub = sampler.pixel();
-                Vec2 lens;
-                if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
-                else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
-                const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
-                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
-                Ray ray;
-                ray.o = cr.origin;
-                ray.d = cr.direction;
-                const SampleResult r = trace_sample(scene, settings, ray, sampler);
+        // Samples go to trace_samples kPacketSize at a time (path tracing traces their paths
+        // in SIMD lanes) and are accumulated in the order they were drawn, so every pixel's
+        // sums are those of tracing them one by one.
+        std::optional<Sampler> samplers[kPacketSize];
+        Sampler* batch_samplers[kPacketSize];
+        Ray batch_rays[kPacketSize];
+        size_t batch_pixels[kPacketSize];
+        int pending = 0;
+        auto flush = [&] {
+            SampleResult results[kPacketSize];
+            trace_samples(scene, settings, batch_rays, batch_samplers, pending, results);
+            for (int k = 0; k < pending; ++k) {
+                const SampleResult& r = results[k];
+                const size_t pixel = batch_pixels[k];
                 rays += r.rays;
                 // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
                 // would overflow the pixel's sum.
@@ -260,7 +258,32 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 state.luminance_sq_sum[pixel] += lum * lum;
                 state.sample_count[pixel] += 1;
             }
+            pending = 0;
+        };
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = static_cast<size_t>(y) * width + x;
+            if (!state.active.empty() && !state.active[pixel]) continue;
+            const int samples = state.pass_samples.empty() ? 1 : state.pass_samples[pixel];
+            for (int k = 0; k < samples; ++k) {
+                const uint32_t index = state.sample_index[pixel]++;
+                Sampler& sampler =
+                    samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+                const Vec2 sub = sampler.pixel();
+                Vec2 lens;
+                if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
+                else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
+                const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+                Ray& ray = batch_rays[pending];
+                ray = Ray();
+                ray.o = cr.origin;
+                ray.d = cr.direction;
+                batch_samplers[pending] = &sampler;
+                batch_pixels[pending] = pixel;
+                if (++pending == kPacketSize) flush();
+            }
         }
+        if (pending > 0) flush();
     }
     state.rays += rays;
     state.nonfinite_samples += nonfinite;

@@ -142,5 +142,11 @@ struct SampleResult {
 // `sampler` has given the sub-pixel and lens numbers already (or none, for a hand-made ray).
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
                           Sampler& sampler);
+// `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
+// camera rays kPacketSize at a time with their paths in SIMD lanes (packet.cpp) where the
+// scene is one leaf of our BVH; anything else goes one by one through trace_sample.
+inline constexpr int kPacketSize = 4;
+void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
+                   int count, SampleResult* results);
 
 }  // namespace kr

@@ -1,0 +1,538 @@
+// Path tracing of four samples at once, their paths in the lanes of SIMD registers (AVX2 where
+// the CPU has it). Casting rays, hit records, the diffuse bounce, throughput and Russian
+// roulette run lane-wise; the samplers, light samples and other materials run per lane
+// through the same functions as one path (path.h), so every path is the one trace_sample
+// gives, up to rounding. docs/performance.md ("Paths in lanes") has what it buys.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/sampling.h"
+#include "render/path.h"
+
+namespace kr {
+
+namespace {
+
+// Every helper taking or returning lanes is forced inline into trace_packet: a call would
+// pass them by the default clone's ABI, not the AVX2 one (so the vector ABI note does not
+// apply either).
+#pragma GCC diagnostic ignored "-Wpsabi"
+#define KR_LANES inline __attribute__((always_inline))
+
+typedef double v4d __attribute__((vector_size(32)));
+typedef int64_t v4l __attribute__((vector_size(32)));
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+KR_LANES v4d splat(double x) { return v4d{} + x; }
+KR_LANES v4d select(v4l mask, v4d a, v4d b) { return mask ? a : b; }
+KR_LANES v4d sqrt_lanes(v4d x) { return v4d{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])}; }
+KR_LANES bool any_lane(v4l m) { return (m[0] | m[1] | m[2] | m[3]) != 0; }
+KR_LANES v4d abs_lanes(v4d x) { return select(x < 0, -x, x); }
+KR_LANES v4l sign_bit(v4d x) {  // all ones where x is negative (-0 included)
+    v4l bits;
+    __builtin_memcpy(&bits, &x, sizeof bits);
+    return bits < 0;
+}
+
+// Four vectors, one per lane.
+struct V3 {
+    v4d x, y, z;
+};
+KR_LANES V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+KR_LANES V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+KR_LANES V3 operator*(const V3& a, v4d s) { return {a.x * s, a.y * s, a.z * s}; }
+KR_LANES V3 operator*(const V3& a, const V3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+KR_LANES V3 operator-(const V3& a) { return {-a.x, -a.y, -a.z}; }
+KR_LANES v4d dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+KR_LANES V3 select(v4l mask, const V3& a, const V3& b) {
+    return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
+}
+KR_LANES Vec3 lane(const V3& v, int k) { return {v.x[k], v.y[k], v.z[k]}; }
+KR_LANES void set_lane(V3& v, int k, const Vec3& value) { v.x[k] = value.x, v.y[k] = value.y, v.z[k] = value.z; }
+
+// ---- Lane-wise copies of the one-path routines, operation for operation ----
+
+// sin_cos_turns (core/sampling.h).
+KR_LANES void sin_cos_turns_lanes(v4d t, v4d& sin_out, v4d& cos_out) {
+    const v4d shift = splat(0x1.8p52);
+    const v4d quarter = (4.0 * t + shift) - shift;
+    const v4d x = 2.0 * kPi * (t - 0.25 * quarter);
+    const v4d x2 = x * x;
+    const v4d s = x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
+                  x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800 + x2 * (-1.0 / 1307674368000))))))));
+    const v4d c = 1 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 +
+                  x2 * (-1.0 / 3628800 + x2 * (1.0 / 479001600 + x2 * (-1.0 / 87178291200 +
+                  x2 * (1.0 / 20922789888000))))))));
+    const v4l k = __builtin_convertvector(quarter, v4l) & 3;
+    const v4l odd = (k & 1) != 0;
+    const v4d sin_mag = select(odd, c, s), cos_mag = select(odd, s, c);
+    sin_out = select((k & 2) != 0, -sin_mag, sin_mag);
+    cos_out = select(((k + 1) & 2) != 0, -cos_mag, cos_mag);
+}
+
+// sample_cosine_hemisphere (core/sampling.cpp): the concentric disk lifted to the hemisphere.
+KR_LANES V3 cosine_hemisphere_lanes(v4d u1, v4d u2) {
+    const v4d a = 2.0 * u1 - 1.0, b = 2.0 * u2 - 1.0;
+    const v4l centre = (a == 0) & (b == 0);
+    const v4l a_major = abs_lanes(a) > abs_lanes(b);
+    const v4d r = select(a_major, a, b);
+    const v4d ratio = select(a_major, b, a) / r;
+    const v4d turns = select(a_major, 0.125 * ratio, 0.25 - 0.125 * ratio);
+    v4d s, c;
+    sin_cos_turns_lanes(turns, s, c);
+    const v4d x = select(centre, v4d{}, r * c), y = select(centre, v4d{}, r * s);
+    const v4d one_minus = 1.0 - x * x - y * y;
+    return {x, y, sqrt_lanes(select(one_minus > 0, one_minus, v4d{}))};
+}
+
+// Frame::from_normal(n).to_world(local) (core/math.h).
+KR_LANES V3 to_world_lanes(const V3& n, const V3& local) {
+    const v4d sign = select(sign_bit(n.z), splat(-1.0), splat(1.0));
+    const v4d a = -1.0 / (sign + n.z);
+    const v4d b = n.x * n.y * a;
+    const V3 s{1 + sign * n.x * n.x * a, sign * b, -sign * n.x};
+    const V3 t{b, sign + n.y * n.y * a, -n.y};
+    return s * local.x + t * local.y + n * local.z;
+}
+
+// accepted_root (render_scene.cpp) of four rays against one sphere: the distance per lane, or
+// +inf. The rays start at tmin = 0 (trace_packet checks). kShadow: segments with an end and a
+// target sphere; closest-hit rays have neither. Where q = 0 the roots come out as +-inf, NaN
+// and 0, none of which is accepted, as accepted_root rejects that case; where disc < 0 the
+// square root is NaN and the lane is rejected too.
+template <bool kShadow>
+KR_LANES v4d sphere_lanes(const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to, const SphereGeom& sphere,
+                        int64_t id) {
+    const double r2 = sphere.radius * sphere.radius;
+    const V3 f{o.x - sphere.centre.x, o.y - sphere.centre.y, o.z - sphere.centre.z};
+    const v4d b = dot(f, d);
+    const V3 p{f.x - b * d.x, f.y - b * d.y, f.z - b * d.z};
+    const v4d disc = r2 - dot(p, p);
+    const v4d c = dot(f, f) - r2;
+    const v4l origin = from == id;
+    // Most spheres miss every lane: the line passes them by, or they lie behind an origin
+    // outside them, or (shadow rays) they are the target or begin beyond the segment's end
+    // (from outside, the near root is at least c / (2 |b|), as in accel.cpp). Then the square
+    // root and division are skipped.
+    v4l candidate = (disc >= 0) & ~((c > 0) & (b > 0) & ~origin);
+    if constexpr (kShadow) {
+        constexpr double kMargin = 16 * std::numeric_limits<double>::epsilon();
+        const v4d f2 = dot(f, f);
+        const v4l beyond = ~origin & (c > kMargin * (f2 + r2)) & (c > (-2.0 * (1.0 + kMargin)) * b * tmax);
+        candidate &= ~beyond & (to != id);
+    }
+    if (!any_lane(candidate)) return splat(kInf);
+    const v4d root = sqrt_lanes(disc);
+    const v4d q = -b - select(sign_bit(b), -root, root);  // copysign(root, b)
+    const v4d t0 = c / q;
+    const v4l t0_first = t0 < q;
+    const v4d t_near = select(t0_first, t0, q), t_far = select(t0_first, q, t0);
+    v4l near_ok = ~origin & (t_near > 0) & candidate, far_ok = (t_far > 0) & (~origin | into) & candidate;
+    if constexpr (kShadow) {
+        const v4d f_l1 = abs_lanes(f.x) + abs_lanes(f.y) + abs_lanes(f.z);
+        const v4d end = select(tmax < kInf, tmax - kSegmentEndTolerance * (f_l1 + tmax), tmax);
+        near_ok &= t_near <= end;
+        far_ok &= t_far <= end;
+    }
+    return select(near_ok, t_near, select(far_ok, t_far, splat(kInf)));
+}
+
+// The light chosen by sample_one_light (path.h) for `u`: an area light's index, or -1 for a
+// point light or none (those lanes take sample_one_light itself).
+KR_LANES int chosen_area_light(const RenderScene& scene, double u) {
+    for (const PointLight& light : scene.point_lights) {
+        if (u < light.select_prob) return -1;
+        u -= light.select_prob;
+    }
+    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
+        if (u < scene.area_lights[i].select_prob || i + 1 == scene.area_lights.size()) return int(i);
+        u -= scene.area_lights[i].select_prob;
+    }
+    return -1;
+}
+
+// sample_sphere_light (light.cpp) for a shading point outside the light, lane-wise, for the
+// `brief` and `cone` strategies. `valid`: lanes with a sample.
+struct LightLanes {
+    V3 wi;
+    v4d distance, pdf, mis_pdf;
+    v4l valid;
+};
+KR_LANES LightLanes sample_light_lanes(LightSampling strategy, const V3& centre, v4d radius, const V3& p, v4d u1,
+                                     v4d u2, v4l lanes) {
+    LightLanes out;
+    const V3 to_centre = centre - p;
+    const v4d d2 = dot(to_centre, to_centre);
+    const v4d r2 = radius * radius;
+    const v4d d = sqrt_lanes(d2);
+    if (strategy == LightSampling::cone) {
+        // cone_one_minus_cos, sample_uniform_cone, then the distance to the near side.
+        const v4d sin2_max = r2 / d2;
+        const v4d one_minus_sin2 = 1.0 - sin2_max;
+        const v4d cos_max = sqrt_lanes(select(0.0 < one_minus_sin2, one_minus_sin2, v4d{}));
+        const v4d one_minus_cos_max = sin2_max / (1.0 + cos_max);
+        const v4d one_minus_cos = u1 * one_minus_cos_max;
+        const v4d sin2 = one_minus_cos * (2.0 - one_minus_cos);
+        const v4d sin_theta = sqrt_lanes(select(0.0 < sin2, sin2, v4d{}));
+        v4d s, c;
+        sin_cos_turns_lanes(u2, s, c);
+        const V3 local{sin_theta * c, sin_theta * s, 1.0 - one_minus_cos};
+        out.wi = to_world_lanes(to_centre * (1.0 / d), local);
+        const v4d local_sin2 = local.x * local.x + local.y * local.y;
+        const v4d inside = r2 - d2 * local_sin2;
+        out.distance = d * local.z - sqrt_lanes(select(0.0 < inside, inside, v4d{}));
+        out.pdf = 1.0 / (2.0 * kPi * one_minus_cos_max);
+        out.mis_pdf = out.pdf;
+        out.valid = lanes & (out.distance > 0);
+        return out;
+    }
+    // brief: BriefProposal's mixture; its logarithm (and the rare log-uniform branch) per lane.
+    const v4d a = d * d + radius * radius, b = 2 * d * radius, gap = d - radius;
+    const v4d ratio = a / (gap * gap);
+    v4d v_max;
+    for (int k = 0; k < 4; ++k) v_max[k] = lanes[k] ? std::log(ratio[k]) : 0.0;
+    const v4d mix = 1.0 + v_max * v_max * v_max;
+    const v4d alpha = 1.0 / mix;
+    const v4d x = u1 * mix;
+    v4d cos_axis = sqrt_lanes(select(x < 1, x, v4d{}));
+    const v4l log_part = lanes & ~(x < 1);
+    if (any_lane(log_part))
+        for (int k = 0; k < 4; ++k)
+            if (log_part[k]) {
+                const double t = (x[k] - 1) / (v_max[k] * v_max[k] * v_max[k]);
+                cos_axis[k] = std::clamp(-a[k] * std::expm1(-t * v_max[k]) / b[k], 0.0, 1.0);
+            }
+    const v4d one_minus = 1.0 - cos_axis * cos_axis;
+    const v4d sin_axis = sqrt_lanes(select(0.0 < one_minus, one_minus, v4d{}));
+    v4d sin_phi, cos_phi;
+    sin_cos_turns_lanes(u2, sin_phi, cos_phi);
+    const V3 axis = (-to_centre) * (1.0 / d);
+    const V3 n = to_world_lanes(axis, V3{sin_axis * cos_phi, sin_axis * sin_phi, cos_axis});
+    const V3 w = (centre + n * radius) - p;
+    const v4d dist2 = dot(w, w);
+    const v4d dist = sqrt_lanes(dist2);
+    out.valid = lanes & (dist > 0) & (cos_axis > 0);
+    out.wi = w * (1.0 / dist);
+    out.distance = dist;
+    const v4d area_density_dist2 = alpha * (2 * cos_axis * dist2 + v_max * v_max * b) / (2 * kPi * r2);
+    out.pdf = area_density_dist2 / cos_axis;
+    const v4d cos_light = -dot(n, out.wi);
+    const v4l visible_cap = (cos_axis * d > radius) & (cos_light > 0);
+    out.mis_pdf = select(visible_cap, area_density_dist2 / cos_light, v4d{});
+    return out;
+}
+
+// What a path vertex's per-lane part (samplers, light choice, other materials) hands to the
+// lane-wise part.
+struct LaneVertex {
+    bool shadow = false, light_lane = false, diffuse = false, ok = false, smooth = false;
+    Vec3 shadow_d, direct, rho, next_dir, weight, light_centre, light_radiance;
+    Vec2 u_bsdf{0.5, 0.5}, u_light{0.5, 0.5};
+    double shadow_tmax = kInf, pdf = 0, u_roulette = 0, light_radius = 1, light_select = 1;
+    int64_t shadow_into = 0, shadow_to = -1, light_to = -1;
+};
+KR_LANES v4d gather(const LaneVertex (&v)[4], double LaneVertex::*field) {
+    return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+}
+KR_LANES v4l gather(const LaneVertex (&v)[4], int64_t LaneVertex::*field) {
+    return v4l{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+}
+KR_LANES v4l gather_mask(const LaneVertex (&v)[4], bool LaneVertex::*field) {
+    return v4l{-int64_t(v[0].*field), -int64_t(v[1].*field), -int64_t(v[2].*field), -int64_t(v[3].*field)};
+}
+KR_LANES V3 gather(const LaneVertex (&v)[4], Vec3 LaneVertex::*field) {
+    return {v4d{(v[0].*field).x, (v[1].*field).x, (v[2].*field).x, (v[3].*field).x},
+            v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y},
+            v4d{(v[0].*field).z, (v[1].*field).z, (v[2].*field).z, (v[3].*field).z}};
+}
+KR_LANES v4d gather_x(const LaneVertex (&v)[4], Vec2 LaneVertex::*field) {
+    return v4d{(v[0].*field).x, (v[1].*field).x, (v[2].*field).x, (v[3].*field).x};
+}
+KR_LANES v4d gather_y(const LaneVertex (&v)[4], Vec2 LaneVertex::*field) {
+    return v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y};
+}
+
+// The four paths.
+struct Paths {
+    V3 o, d;  // the rays to cast next: from a surface or the camera, tmin 0, unbounded
+    v4l from, into;
+    v4l alive;
+    V3 throughput, L;
+    v4l full_emission;  // PathHistory, lane-wise
+    v4d last_bsdf_pdf;
+    V3 last_p;
+    v4l last_sphere;
+    v4d primary_distance;
+    uint64_t rays[4] = {};
+};
+
+// The closest sphere of each live lane's ray (its index and distance; -1 where none).
+KR_LANES void closest_lanes(const RenderScene& scene, const Paths& paths, v4d& best, v4l& best_id) {
+    best = splat(kInf);
+    best_id = v4l{} - 1;
+    for (size_t s = 0; s < scene.spheres.size(); ++s) {
+        const v4d t = sphere_lanes<false>(paths.o, paths.d, paths.from, paths.into, v4d{}, v4l{},
+                                          scene.spheres[s], int64_t(s));
+        const v4l nearer = t < best;  // ties keep the lower index, as the linear scan does
+        best = select(nearer, t, best);
+        best_id = nearer ? v4l{} + int64_t(s) : best_id;
+    }
+    best_id = paths.alive ? best_id : v4l{} - 1;
+}
+
+// Whether anything blocks each shadow segment (lanes outside `cast` are left unblocked).
+KR_LANES v4l occluded_lanes(const RenderScene& scene, const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to,
+                          v4l cast) {
+    v4l blocked = v4l{};
+    for (size_t s = 0; s < scene.spheres.size(); ++s)
+        blocked |= sphere_lanes<true>(o, d, from, into, tmax, to, scene.spheres[s], int64_t(s)) < kInf;
+    return blocked & cast;
+}
+
+// Where packets apply: path tracing on a scene our one-leaf BVH takes (up to 16 spheres), not
+// the plain path. Embree's scenes and our trees cast rays one by one.
+bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
+    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets();
+}
+
+}  // namespace
+
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__)
+#define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define KR_CLONES
+#endif
+
+// Up to four paths, a bounce at a time. Camera rays as render_pass makes them (tmin 0,
+// unbounded, from no sphere); trace_samples checks.
+KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& settings, const Ray* rays,
+                            Sampler* const* samplers, int count, SampleResult* results) {
+    const bool naive = settings.integrator == Integrator::pt_naive;
+    const bool next_event_possible = scene.light_count() > 0;
+    // Area-light samples lane-wise: the `brief` and `cone` strategies (the others per lane).
+    const bool lane_lights = !naive && (settings.light_sampling == LightSampling::brief ||
+                                        settings.light_sampling == LightSampling::cone);
+    Paths paths;
+    paths.alive = v4l{};
+    paths.from = v4l{} - 1;
+    paths.into = v4l{};
+    paths.throughput = {splat(1), splat(1), splat(1)};
+    paths.L = {v4d{}, v4d{}, v4d{}};
+    paths.full_emission = ~v4l{};
+    paths.last_bsdf_pdf = v4d{};
+    paths.last_p = {v4d{}, v4d{}, v4d{}};
+    paths.last_sphere = v4l{} - 1;
+    paths.primary_distance = splat(kMissDepth);
+    paths.o = paths.d = {v4d{}, v4d{}, splat(1)};
+    for (int k = 0; k < count; ++k) {
+        set_lane(paths.o, k, rays[k].o);
+        set_lane(paths.d, k, rays[k].d);
+        paths.alive[k] = -1;
+    }
+
+    for (int bounce = 0;; ++bounce) {
+        // Closest hits; a path whose ray leaves the scene ends.
+        for (int k = 0; k < 4; ++k) paths.rays[k] += paths.alive[k] != 0;
+        v4d t;
+        v4l id;
+        closest_lanes(scene, paths, t, id);
+        paths.alive &= id >= 0;
+        if (!any_lane(paths.alive)) break;
+        if (bounce == 0) paths.primary_distance = select(paths.alive, t, paths.primary_distance);
+
+        // Hit records (RenderScene::hit_at): the point projected back onto its sphere.
+        const SphereGeom* hit_sphere[4];
+        for (int k = 0; k < 4; ++k) hit_sphere[k] = &scene.spheres[paths.alive[k] ? size_t(id[k]) : 0];
+        const V3 centre{v4d{hit_sphere[0]->centre.x, hit_sphere[1]->centre.x, hit_sphere[2]->centre.x,
+                            hit_sphere[3]->centre.x},
+                        v4d{hit_sphere[0]->centre.y, hit_sphere[1]->centre.y, hit_sphere[2]->centre.y,
+                            hit_sphere[3]->centre.y},
+                        v4d{hit_sphere[0]->centre.z, hit_sphere[1]->centre.z, hit_sphere[2]->centre.z,
+                            hit_sphere[3]->centre.z}};
+        const v4d radius{hit_sphere[0]->radius, hit_sphere[1]->radius, hit_sphere[2]->radius, hit_sphere[3]->radius};
+        const V3 offset = (paths.o + paths.d * t) - centre;
+        const v4d offset_length = sqrt_lanes(dot(offset, offset));
+        const V3 n = select(offset_length > 0, offset * (1.0 / offset_length), -paths.d);
+        const V3 p = centre + n * radius;
+
+        // Emission seen along the path (rare: per lane).
+        for (int k = 0; k < 4; ++k) {
+            if (!paths.alive[k]) continue;
+            const int light_index = scene.sphere_light[size_t(id[k])];
+            if (light_index < 0) continue;
+            const AreaLight& light = scene.area_lights[size_t(light_index)];
+            const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
+            const PathHistory history{paths.full_emission[k] != 0, paths.last_bsdf_pdf[k], lane(paths.last_p, k),
+                                      int(paths.last_sphere[k])};
+            const Color add = lane(paths.throughput, k) * light.radiance *
+                              emission_weight(scene, settings.light_sampling, light, hit, lane(paths.d, k), history);
+            set_lane(paths.L, k, lane(paths.L, k) + add);
+        }
+        if (bounce >= settings.max_depth) break;
+
+        const v4l front = dot(paths.d, n) < 0;
+        const V3 ns = select(front, n, -n);
+
+        // Per lane: the vertex's numbers, its light sample and, off the diffuse lobe, its
+        // scattering (the functions one path uses). Written to plain records and gathered into
+        // lanes after the loop: stores into single lanes of a vector would stall its next load.
+        LaneVertex vertex[4];
+        for (int k = 0; k < 4; ++k) {
+            if (!paths.alive[k]) continue;
+            LaneVertex& v = vertex[k];
+            const Material& m = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
+            const Sampler::VertexNumbers u =
+                samplers[k]->next_vertex(vertex_numbers_used(scene, m, bounce, settings.rr_depth));
+            v.u_roulette = u.roulette;
+            const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
+            const SurfacePoint sp{hit.n, front[k] != 0};
+            const int area = lane_lights && has_smooth_lobe(m) ? chosen_area_light(scene, u.light_pick) : -1;
+            const int light_sphere = area >= 0 ? scene.area_lights[size_t(area)].sphere : -1;
+            const SphereGeom* light_geom = area >= 0 ? &scene.spheres[size_t(light_sphere)] : nullptr;
+            if (light_geom && light_sphere != hit.sphere &&
+                dot(hit.p - light_geom->centre, hit.p - light_geom->centre) > light_geom->radius * light_geom->radius) {
+                // An area light seen from outside: sampled lane-wise below.
+                const AreaLight& light = scene.area_lights[size_t(area)];
+                v.light_lane = true;
+                v.light_centre = light_geom->centre;
+                v.light_radius = light_geom->radius;
+                v.light_select = light.select_prob;
+                v.light_radiance = light.radiance;
+                v.light_to = light_sphere;
+                v.u_light = u.light;
+            } else if (has_smooth_lobe(m) && next_event_possible) {
+                Ray shadow;
+                Color light;
+                if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, light)) {
+                    v.shadow = true;
+                    v.shadow_d = shadow.d;
+                    v.shadow_tmax = shadow.tmax;
+                    v.shadow_into = shadow.into_from_sphere ? -1 : 0;
+                    v.shadow_to = shadow.to_sphere;
+                    v.direct = lane(paths.throughput, k) * light;
+                }
+            }
+            if (m.type == MaterialType::diffuse) {
+                v.diffuse = true;
+                v.rho = m.rho;
+                v.u_bsdf = u.bsdf;
+                continue;
+            }
+            ScatterSample s;
+            v.ok = sample_material(m, sp, lane(paths.d, k), u.lobe, u.bsdf, s);
+            v.next_dir = s.direction;
+            v.weight = s.weight;
+            v.pdf = s.pdf;
+            v.smooth = s.smooth;
+        }
+        v4l shadow_cast = gather_mask(vertex, &LaneVertex::shadow);
+        const v4l diffuse = gather_mask(vertex, &LaneVertex::diffuse), light_lane = gather_mask(vertex, &LaneVertex::light_lane);
+        V3 shadow_d = select(shadow_cast, gather(vertex, &LaneVertex::shadow_d), ns);
+        v4d shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
+        v4l shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
+        V3 direct = gather(vertex, &LaneVertex::direct);
+        const V3 rho = gather(vertex, &LaneVertex::rho);
+        V3 next_dir = gather(vertex, &LaneVertex::next_dir), weight = gather(vertex, &LaneVertex::weight);
+        v4d pdf = gather(vertex, &LaneVertex::pdf);
+        v4l ok = gather_mask(vertex, &LaneVertex::ok), smooth = gather_mask(vertex, &LaneVertex::smooth);
+        const v4d u_roulette = gather(vertex, &LaneVertex::u_roulette);
+        const V3 shadow_o = p;
+        const v4l shadow_from = id;
+
+        // area_light_direct (integrator.cpp) for those lanes: the light sample, the diffuse lobe
+        // towards it (eval_smooth, pdf_smooth) and the power heuristic.
+        if (any_lane(light_lane)) {
+            const V3 light_centre = gather(vertex, &LaneVertex::light_centre);
+            const V3 light_radiance = gather(vertex, &LaneVertex::light_radiance);
+            const v4d light_select = gather(vertex, &LaneVertex::light_select);
+            const v4l light_to = gather(vertex, &LaneVertex::light_to);
+            const v4d u_light_x = gather_x(vertex, &LaneVertex::u_light), u_light_y = gather_y(vertex, &LaneVertex::u_light);
+            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre,
+                                                     gather(vertex, &LaneVertex::light_radius), p, u_light_x, u_light_y,
+                                                     light_lane);
+            const v4d cos_o = dot(ns, ls.wi);
+            const v4d lambert = select(cos_o > 0, kInvPi * cos_o, v4d{});
+            const V3 f_cos = rho * lambert;
+            const v4l lit = ls.valid & ~((f_cos.x == 0) & (f_cos.y == 0) & (f_cos.z == 0));
+            const v4d p_light = light_select * ls.mis_pdf, p_bsdf = select(cos_o > 0, cos_o * kInvPi, v4d{});
+            const v4d weight_mis = select(ls.mis_pdf > 0, p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf),
+                                          splat(1.0));
+            const V3 light = (f_cos * light_radiance) * (weight_mis / (light_select * ls.pdf));
+            shadow_cast |= lit;
+            shadow_d = select(lit, ls.wi, shadow_d);
+            shadow_tmax = select(lit, ls.distance, shadow_tmax);
+            shadow_into = lit ? v4l(dot(ls.wi, n) < 0) : shadow_into;
+            shadow_to = lit ? light_to : shadow_to;
+            direct = select(lit, paths.throughput * light, direct);
+        }
+
+        // The light samples' shadow rays, together; each clear one adds its light.
+        if (any_lane(shadow_cast)) {
+            for (int k = 0; k < 4; ++k) paths.rays[k] += shadow_cast[k] != 0;
+            const v4l clear =
+                shadow_cast & ~occluded_lanes(scene, shadow_o, shadow_d, shadow_from, shadow_into, shadow_tmax,
+                                              shadow_to, shadow_cast);
+            paths.L = select(clear, paths.L + direct, paths.L);
+        }
+
+        // The diffuse bounce, lane-wise (sample_material's diffuse case).
+        if (any_lane(diffuse)) {
+            const V3 local =
+                cosine_hemisphere_lanes(gather_x(vertex, &LaneVertex::u_bsdf), gather_y(vertex, &LaneVertex::u_bsdf));
+            const v4d cos_pdf = select(local.z > 0, local.z * kInvPi, v4d{});
+            next_dir = select(diffuse, to_world_lanes(ns, local), next_dir);
+            weight = select(diffuse, rho, weight);
+            pdf = select(diffuse, cos_pdf, pdf);
+            ok = diffuse ? v4l(cos_pdf > 0) : ok;
+            smooth |= diffuse;
+        }
+        paths.alive &= ok;
+        paths.throughput = select(paths.alive, paths.throughput * weight, V3{v4d{}, v4d{}, v4d{}});
+        paths.full_emission = naive ? ~v4l{} : ~smooth;
+        paths.last_bsdf_pdf = pdf;
+        paths.last_p = p;
+        paths.last_sphere = id;
+        paths.o = p;
+        paths.d = next_dir;
+        paths.from = id;
+        paths.into = dot(next_dir, n) < 0;
+
+        // Russian roulette with q = max(throughput) (brief), past the threshold depth.
+        if (bounce + 1 >= settings.rr_depth) {
+            const V3& th = paths.throughput;
+            const v4d y_or_z = select(th.y < th.z, th.z, th.y);
+            const v4d largest = select(th.x < y_or_z, y_or_z, th.x);
+            const v4d q = select(largest < 1.0, largest, splat(1.0));
+            paths.alive &= u_roulette < q;
+            paths.throughput = select(paths.alive, paths.throughput * (1.0 / q), V3{v4d{}, v4d{}, v4d{}});
+        }
+        if (!any_lane(paths.alive)) break;
+    }
+    for (int k = 0; k < count; ++k) {
+        results[k].radiance = lane(paths.L, k);
+        results[k].primary_distance = paths.primary_distance[k];
+        results[k].rays = paths.rays[k];
+    }
+}
+
+void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
+                   int count, SampleResult* results) {
+    const bool packets = packets_apply(scene, settings);
+    for (int first = 0; first < count; first += kPacketSize) {
+        const int n = std::min(kPacketSize, count - first);
+        bool camera_rays = true;  // as trace_packet takes them
+        for (int k = first; k < first + n; ++k)
+            camera_rays &= rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 &&
+                           rays[k].to_sphere < 0;
+        if (packets && camera_rays && n > 1) {
+            trace_packet(scene, settings, rays + first, samplers + first, n, results + first);
+        } else {
+            for (int k = first; k < first + n; ++k) results[k] = trace_sample(scene, settings, rays[k], *samplers[k]);
+        }
+    }
+}
+
+}  // namespace kr
