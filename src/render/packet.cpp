@@ -24,6 +24,8 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// A one-leaf scene has at most 16 spheres, so at most 16 materials are used.
+constexpr size_t kMaxPacketMaterials = 16;
 
 KR_LANES v4d splat(double x) { return v4d{} + x; }
 KR_LANES v4d select(v4l mask, v4d a, v4d b) { return mask ? a : b; }
@@ -225,13 +227,14 @@ KR_LANES LightLanes sample_light_lanes(LightSampling strategy, const V3& centre,
 }
 
 // What a path vertex's per-lane part (samplers, light choice, other materials) hands to the
-// lane-wise part.
+// lane-wise part. All zeros for a lane with nothing to do: the lane-wise part masks what such a
+// lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
 struct LaneVertex {
-    bool shadow = false, light_lane = false, diffuse = false, ok = false, smooth = false;
+    bool shadow, light_lane, diffuse, ok, smooth;
     Vec3 shadow_d, direct, rho, next_dir, weight, light_centre, light_radiance;
-    Vec2 u_bsdf{0.5, 0.5}, u_light{0.5, 0.5};
-    double shadow_tmax = kInf, pdf = 0, u_roulette = 0, light_radius = 1, light_select = 1;
-    int64_t shadow_into = 0, shadow_to = -1, light_to = -1;
+    Vec2 u_bsdf, u_light;
+    double shadow_tmax, pdf, u_roulette, light_radius, light_select;
+    int64_t shadow_into, shadow_to, light_to;
 };
 KR_LANES v4d gather(const LaneVertex (&v)[4], double LaneVertex::*field) {
     return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
@@ -294,7 +297,8 @@ KR_LANES v4l occluded_lanes(const RenderScene& scene, const V3& o, const V3& d, 
 // Where packets apply: path tracing on a scene our one-leaf BVH takes (up to 16 spheres), not
 // the plain path. Embree's scenes and our trees cast rays one by one.
 bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
-    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets();
+    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets() &&
+           scene.materials.size() <= kMaxPacketMaterials;
 }
 
 }  // namespace
@@ -333,7 +337,13 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         paths.alive[k] = -1;
     }
 
+    // The numbers a vertex reads on each material (vertex_numbers_used, less Russian roulette,
+    // which goes by depth alone).
+    unsigned numbers_used[kMaxPacketMaterials];
+    for (size_t i = 0; i < scene.materials.size(); ++i)
+        numbers_used[i] = vertex_numbers_used(scene, scene.materials[i], 0, kMaxDepth + 2);
     for (int bounce = 0;; ++bounce) {
+        const unsigned roulette = bounce + 1 >= settings.rr_depth ? Sampler::use_roulette : 0u;
         // Closest hits; a path whose ray leaves the scene ends.
         for (int k = 0; k < 4; ++k) paths.rays[k] += paths.alive[k] != 0;
         v4d t;
@@ -379,13 +389,13 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // Per lane: the vertex's numbers, its light sample and, off the diffuse lobe, its
         // scattering (the functions one path uses). Written to plain records and gathered into
         // lanes after the loop: stores into single lanes of a vector would stall its next load.
-        LaneVertex vertex[4];
+        LaneVertex vertex[4] = {};
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
             LaneVertex& v = vertex[k];
-            const Material& m = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
-            const Sampler::VertexNumbers u =
-                samplers[k]->next_vertex(vertex_numbers_used(scene, m, bounce, settings.rr_depth));
+            const int material = scene.sphere_material[size_t(id[k])];
+            const Material& m = scene.materials[size_t(material)];
+            const Sampler::VertexNumbers u = samplers[k]->next_vertex(numbers_used[size_t(material)] | roulette);
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
