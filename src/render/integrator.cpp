@@ -20,6 +20,7 @@ void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax, int to_sphere
     r.into_from_sphere = dot(dir, hit.n) < 0;
     r.to_sphere = to_sphere;
 }
+
 namespace {
 
 // Direct light from one point light at a surface with a smooth lobe (no selection pdf):
