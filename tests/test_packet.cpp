@@ -96,9 +96,9 @@ TEST(Packet, SameSamplesAsOneByOne) {
     }
 }
 
-// A scene with what the brief's lack: point lights beside two area lights (so the light
-// choice goes both ways), every material, a translucent ball, a shading point inside a light
-// (the camera's), and packets of one to three samples.
+// A scene with what the brief's lack: point lights beside area lights (so the light choice
+// goes both ways), a black area light, every material, shading points inside a light, and
+// packets of one to four samples.
 TEST(Packet, PointLightsEveryMaterialAndPartialPackets) {
     test::SceneBuilder b;
     b.scene.renderer.width = b.scene.renderer.height = 32;
@@ -118,12 +118,15 @@ TEST(Packet, PointLightsEveryMaterialAndPartialPackets) {
     b.point_light({-4, 1, -4}, Color(10, 20, 30));
     b.emitter({4, 3, 0}, 0.8, Color(5), grey);
     b.emitter({-4, 4, 3}, 0.5, Color(2, 6, 3), grey);
-    // A big dim light around everything: every shading point is inside it.
+    // A big dim light around everything: every shading point is inside it. And a black one,
+    // which the light choice never picks.
     b.emitter({0, 0, 0}, 60, Color(0.05), b.material(MaterialType::diffuse, Color(0)));
+    b.emitter({2, 5, 5}, 0.5, Color(0), grey);
     const RenderScene scene = b.build();
     ASSERT_TRUE(scene.bvh.packets());
     ASSERT_EQ(scene.point_lights.size(), 2u);
-    ASSERT_EQ(scene.area_lights.size(), 3u);
+    ASSERT_EQ(scene.area_lights.size(), 4u);
+    ASSERT_EQ(scene.area_lights.back().select_prob, 0.0);
     for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area}) {
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
         settings.light_sampling = light;

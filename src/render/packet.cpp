@@ -406,7 +406,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
-            const int area = lane_lights && has_smooth_lobe(m) ? chosen_area_light(scene, u.light_pick) : -1;
+            int area = lane_lights && has_smooth_lobe(m) ? chosen_area_light(scene, u.light_pick) : -1;
+            if (area >= 0 && !(scene.area_lights[size_t(area)].select_prob > 0)) area = -1;  // a black light
             const int light_sphere = area >= 0 ? scene.area_lights[size_t(area)].sphere : -1;
             const SphereGeom* light_geom = area >= 0 ? &scene.spheres[size_t(light_sphere)] : nullptr;
             if (light_geom && light_sphere != hit.sphere &&
