@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "render/lanes.h"
 #include "render/render_scene.h"
 
 namespace kr {
@@ -159,32 +160,6 @@ struct Builder {
     }
 };
 
-// The lanes below never cross a non-inlined call, so the vector ABI note does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
-
-// Four lanes of doubles (GCC vector extension): SSE2 pairs by default, one AVX register in
-// the x86-64-v3 clone.
-typedef double v4d __attribute__((vector_size(32)));
-typedef int64_t v4l __attribute__((vector_size(32)));
-
-inline v4d load4(const double* p) {
-    v4d v;
-    __builtin_memcpy(&v, p, sizeof v);
-    return v;
-}
-inline v4d sqrt4(v4d x) { return v4d{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])}; }
-inline v4d select4(v4l mask, v4d a, v4d b) { return mask ? a : b; }
-// Whether any lane of a mask is set: the two halves or-ed as vectors first, which takes
-// fewer instructions than extracting the four lanes one by one.
-inline bool any_lane(v4l mask) {
-    typedef int64_t v2l __attribute__((vector_size(16)));
-    v2l low, high;
-    __builtin_memcpy(&low, &mask, sizeof low);
-    __builtin_memcpy(&high, reinterpret_cast<const char*>(&mask) + sizeof low, sizeof high);
-    const v2l either = low | high;
-    return (either[0] | either[1]) != 0;
-}
-
 // Accepted distance of each lane's sphere for `ray` within [ray.tmin, tmax], or +inf.
 // The same root choice as the scalar sphere_roots + accept rules of render_scene.cpp,
 // written without branches so all four lanes go together. `shadow`: an any-hit query,
@@ -192,8 +167,8 @@ inline bool any_lane(v4l mask) {
 template <bool kShadow>
 inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, const Ray& ray, double tmax) {
     const v4d inf = v4d{} + kInf, zero = v4d{};
-    const v4d fx = ray.o.x - load4(b.cx), fy = ray.o.y - load4(b.cy), fz = ray.o.z - load4(b.cz);
-    const v4d r2 = load4(b.r2);
+    const v4d fx = ray.o.x - load_lanes(b.cx), fy = ray.o.y - load_lanes(b.cy), fz = ray.o.z - load_lanes(b.cz);
+    const v4d r2 = load_lanes(b.r2);
     const v4d half_b = fx * ray.d.x + fy * ray.d.y + fz * ray.d.z;
     // Discriminant from the line's distance to the centre (no cancellation).
     const v4d px = fx - half_b * ray.d.x, py = fy - half_b * ray.d.y, pz = fz - half_b * ray.d.z;
@@ -220,24 +195,24 @@ inline __attribute__((always_inline)) v4d block_distances(const SphereBlock& b, 
         candidate &= ~beyond;
     }
     if (!any_lane(candidate)) return inf;
-    const v4d root = sqrt4(select4(disc > 0, disc, zero));
+    const v4d root = sqrt_lanes(select(disc > 0, disc, zero));
     // Vieta: q = -b - sign(b) sqrt(disc); roots q and c / q (both 0 when q is).
-    const v4d q = -half_b - select4(half_b >= 0, root, -root);
-    const v4d t0 = select4(q != 0, c / q, zero);
-    const v4d t_near = select4(t0 < q, t0, q), t_far = select4(t0 < q, q, t0);
+    const v4d q = -half_b - select(half_b >= 0, root, -root);
+    const v4d t0 = select(q != 0, c / q, zero);
+    const v4d t_near = select(t0 < q, t0, q), t_far = select(t0 < q, q, t0);
     v4d end = v4d{} + tmax;
     if constexpr (kShadow) {
         if (tmax < kInf) {
-            const v4d fx_abs = select4(fx < 0, -fx, fx), fy_abs = select4(fy < 0, -fy, fy),
-                      fz_abs = select4(fz < 0, -fz, fz);
+            const v4d fx_abs = select(fx < 0, -fx, fx), fy_abs = select(fy < 0, -fy, fy),
+                      fz_abs = select(fz < 0, -fz, fz);
             end = tmax - kSegmentEndTolerance * (fx_abs + fy_abs + fz_abs + tmax);
         }
     }
     // Only roots ahead of the origin (t > 0); the origin's own sphere only when entering it.
     const v4l near_ok = ~origin & (t_near >= ray.tmin) & (t_near > 0) & (t_near <= end);
     const v4l far_ok = (t_far >= ray.tmin) & (t_far > 0) & (t_far <= end) & (~origin | into);
-    const v4d t = select4(near_ok, t_near, select4(far_ok, t_far, inf));
-    return select4(candidate, t, inf);
+    const v4d t = select(near_ok, t_near, select(far_ok, t_far, inf));
+    return select(candidate, t, inf);
 }
 
 // Takes the nearest of a block's lane distances if it improves on `best` (the lanes were
@@ -393,17 +368,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     depth_ = builder.depth;
 }
 
-// Two versions of each entry point: the default x86-64 one and an AVX2/FMA one, chosen by
-// the dynamic loader from the CPU's features (GCC function multi-versioning). Not under a
-// sanitizer: the loader runs the IFUNC resolver while relocating, before the sanitizer's
-// runtime is up, and GCC instruments the resolver too (its __tsan_func_entry segfaults).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
-    !defined(__SANITIZE_THREAD__)
-#define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define KR_CLONES
-#endif
-
+// Two versions of each entry point (KR_CLONES, lanes.h).
 KR_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
 #ifdef KEITHRAY_HAVE_EMBREE
     if (embree_) return embree_closest(*embree_, ray, t);

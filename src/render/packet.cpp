@@ -8,36 +8,19 @@
 #include <limits>
 
 #include "core/sampling.h"
+#include "render/lanes.h"
 #include "render/path.h"
 
 namespace kr {
 
 namespace {
 
-// Every helper taking or returning lanes is forced inline into trace_packet: a call would
-// pass them by the default clone's ABI, not the AVX2 one (so the vector ABI note does not
-// apply either).
-#pragma GCC diagnostic ignored "-Wpsabi"
-#define KR_LANES inline __attribute__((always_inline))
-
-typedef double v4d __attribute__((vector_size(32)));
-typedef int64_t v4l __attribute__((vector_size(32)));
+using kr::select;  // lanes.h's, beside the three-vector one below
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A one-leaf scene has at most 16 spheres, so at most 16 materials are used.
 constexpr size_t kMaxPacketMaterials = 16;
 
-KR_LANES v4d splat(double x) { return v4d{} + x; }
-KR_LANES v4d select(v4l mask, v4d a, v4d b) { return mask ? a : b; }
-KR_LANES v4d sqrt_lanes(v4d x) { return v4d{std::sqrt(x[0]), std::sqrt(x[1]), std::sqrt(x[2]), std::sqrt(x[3])}; }
-KR_LANES bool any_lane(v4l m) {  // the halves or-ed as vectors first (fewer instructions)
-    typedef int64_t v2l __attribute__((vector_size(16)));
-    v2l low, high;
-    __builtin_memcpy(&low, &m, sizeof low);
-    __builtin_memcpy(&high, reinterpret_cast<const char*>(&m) + sizeof low, sizeof high);
-    const v2l either = low | high;
-    return (either[0] | either[1]) != 0;
-}
 KR_LANES v4d abs_lanes(v4d x) { return select(x < 0, -x, x); }
 KR_LANES v4l sign_bit(v4d x) {  // all ones where x is negative (-0 included)
     v4l bits;
@@ -309,13 +292,6 @@ bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
 }
 
 }  // namespace
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
-    !defined(__SANITIZE_THREAD__)
-#define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#else
-#define KR_CLONES
-#endif
 
 // Up to four paths, a bounce at a time. Camera rays as render_pass makes them (tmin 0,
 // unbounded, from no sphere); trace_samples checks.
