@@ -13,25 +13,34 @@ struct Vec2 {
     double x = 0, y = 0;
 };
 
+// sin and cos of 2 pi t, the step of sin_cos_turns that works on one double and on SIMD lanes
+// (GCC vector extensions, render/packet.cpp) alike: t = quarter/4 + r with |r| <= 1/8 turn,
+// and (s, c) = (sin, cos)(2 pi r) by Taylor polynomials. Forced inline: lanes must not cross
+// a call (render/lanes.h).
+template <class T>
+inline __attribute__((always_inline)) void sin_cos_eighth_turn(T t, T& quarter, T& s, T& c) {
+    // Nearest integer by adding and removing 1.5 * 2^52, exact for |4t| < 2^51 (ties to even):
+    // std::nearbyint is a libm call on baseline x86-64, which has no rounding instruction.
+    constexpr double kRoundingShift = 0x1.8p52;
+    quarter = (4.0 * t + kRoundingShift) - kRoundingShift;
+    const T x = 2.0 * kPi * (t - 0.25 * quarter);  // in [-pi/4, pi/4]
+    const T x2 = x * x;
+    // Taylor series to x^15 / x^16: the first omitted term is below 3e-16 at pi/4.
+    s = x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
+        x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800 + x2 * (-1.0 / 1307674368000))))))));
+    c = 1 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 +
+        x2 * (-1.0 / 3628800 + x2 * (1.0 / 479001600 + x2 * (-1.0 / 87178291200 +
+        x2 * (1.0 / 20922789888000))))))));
+}
+
 // sin and cos of 2 pi t (t in turns), to about 1e-15: reduced to an eighth of a turn and
 // evaluated by Taylor polynomials. The samplers call it for every direction; libm's general
 // sincos was a tenth of the render time.
 // Inline and without branches: the quarter turn is random per sample, so a switch on it
 // mispredicts three times in four.
 inline void sin_cos_turns(double t, double& sin_out, double& cos_out) {
-    // t = k/4 + r with |r| <= 1/8 turn, so the angle x = 2 pi r lies in [-pi/4, pi/4].
-    // Nearest integer by adding and removing 1.5 * 2^52, exact for |4t| < 2^51 (ties to even):
-    // std::nearbyint is a libm call on baseline x86-64, which has no rounding instruction.
-    constexpr double kRoundingShift = 0x1.8p52;
-    const double quarter = (4.0 * t + kRoundingShift) - kRoundingShift;
-    const double x = 2.0 * kPi * (t - 0.25 * quarter);
-    const double x2 = x * x;
-    // Taylor series to x^15 / x^16: the first omitted term is below 3e-16 at pi/4.
-    const double s = x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
-                     x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800 + x2 * (-1.0 / 1307674368000))))))));
-    const double c = 1 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 +
-                     x2 * (-1.0 / 3628800 + x2 * (1.0 / 479001600 + x2 * (-1.0 / 87178291200 +
-                     x2 * (1.0 / 20922789888000))))))));
+    double quarter, s, c;
+    sin_cos_eighth_turn(t, quarter, s, c);
     // Rotate by k quarter turns: (sin, cos) -> (s, c), (c, -s), (-s, -c), (-c, s).
     const int64_t k = static_cast<int64_t>(quarter) & 3;
     const bool odd = k & 1;

@@ -46,17 +46,11 @@ KR_LANES void set_lane(V3& v, int k, const Vec3& value) { v.x[k] = value.x, v.y[
 
 // ---- Lane-wise copies of the one-path routines, operation for operation ----
 
-// sin_cos_turns (core/sampling.h).
+// sin_cos_turns (core/sampling.h): the same reduction and polynomials, then the quarter
+// turns lane-wise.
 KR_LANES void sin_cos_turns_lanes(v4d t, v4d& sin_out, v4d& cos_out) {
-    const v4d shift = splat(0x1.8p52);
-    const v4d quarter = (4.0 * t + shift) - shift;
-    const v4d x = 2.0 * kPi * (t - 0.25 * quarter);
-    const v4d x2 = x * x;
-    const v4d s = x * (1 + x2 * (-1.0 / 6 + x2 * (1.0 / 120 + x2 * (-1.0 / 5040 + x2 * (1.0 / 362880 +
-                  x2 * (-1.0 / 39916800 + x2 * (1.0 / 6227020800 + x2 * (-1.0 / 1307674368000))))))));
-    const v4d c = 1 + x2 * (-1.0 / 2 + x2 * (1.0 / 24 + x2 * (-1.0 / 720 + x2 * (1.0 / 40320 +
-                  x2 * (-1.0 / 3628800 + x2 * (1.0 / 479001600 + x2 * (-1.0 / 87178291200 +
-                  x2 * (1.0 / 20922789888000))))))));
+    v4d quarter, s, c;
+    sin_cos_eighth_turn(t, quarter, s, c);
     const v4l k = __builtin_convertvector(quarter, v4l) & 3;
     const v4l odd = (k & 1) != 0;
     const v4d sin_mag = select(odd, c, s), cos_mag = select(odd, s, c);
