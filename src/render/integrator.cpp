@@ -76,26 +76,40 @@ double emission_weight(const RenderScene& scene, LightSampling sampling, const A
            (p_bsdf * p_bsdf + p_light * p_light);
 }
 
-bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
-                      const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
-    for (const PointLight& light : scene.point_lights) {
-        if (u < light.select_prob) {
-            if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;
-            direct = direct / light.select_prob;
-            return true;
+LightChoice choose_light(const RenderScene& scene, bool naive, double u) {
+    LightChoice choice;
+    for (size_t i = 0; i < scene.point_lights.size(); ++i) {
+        if (u < scene.point_lights[i].select_prob) {
+            choice.point = int(i);
+            return choice;
         }
-        u -= light.select_prob;
+        u -= scene.point_lights[i].select_prob;
     }
-    if (settings.integrator == Integrator::pt_naive || scene.area_lights.empty()) return false;
+    if (naive) return choice;
     // Falls through to the last area light if rounding left u above the total.
     for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-        const AreaLight& light = scene.area_lights[i];
-        if (u < light.select_prob || i + 1 == scene.area_lights.size())
-            return light.select_prob > 0 && area_light_direct(scene, settings.light_sampling, light, m, hit, sp, true,
-                                                               light.select_prob, u_point, shadow, direct);
-        u -= light.select_prob;
+        if (u < scene.area_lights[i].select_prob || i + 1 == scene.area_lights.size()) {
+            choice.area = int(i);
+            return choice;
+        }
+        u -= scene.area_lights[i].select_prob;
     }
-    return false;
+    return choice;
+}
+
+bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
+                      const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
+    const LightChoice choice = choose_light(scene, settings.integrator == Integrator::pt_naive, u);
+    if (choice.point >= 0) {
+        const PointLight& light = scene.point_lights[size_t(choice.point)];
+        if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;
+        direct = direct / light.select_prob;
+        return true;
+    }
+    if (choice.area < 0) return false;
+    const AreaLight& light = scene.area_lights[size_t(choice.area)];
+    return light.select_prob > 0 && area_light_direct(scene, settings.light_sampling, light, m, hit, sp, true,
+                                                       light.select_prob, u_point, shadow, direct);
 }
 
 unsigned vertex_numbers_used(const RenderScene& scene, const Material& m, int bounce, int rr_depth) {

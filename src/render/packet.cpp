@@ -125,20 +125,6 @@ KR_LANES v4d sphere_lanes(const V3& o, const V3& d, v4l from, v4l into, v4d tmax
     return select(near_ok, t_near, select(far_ok, t_far, splat(kInf)));
 }
 
-// The light chosen by sample_one_light (path.h) for `u`: an area light's index, or -1 for a
-// point light or none (those lanes take sample_one_light itself).
-KR_LANES int chosen_area_light(const RenderScene& scene, double u) {
-    for (const PointLight& light : scene.point_lights) {
-        if (u < light.select_prob) return -1;
-        u -= light.select_prob;
-    }
-    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-        if (u < scene.area_lights[i].select_prob || i + 1 == scene.area_lights.size()) return int(i);
-        u -= scene.area_lights[i].select_prob;
-    }
-    return -1;
-}
-
 // sample_sphere_light (light.cpp) for a shading point outside the light, lane-wise, for the
 // `brief` and `cone` strategies. `valid`: lanes with a sample.
 struct LightLanes {
@@ -376,7 +362,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
-            int area = lane_lights && has_smooth_lobe(m) ? chosen_area_light(scene, u.light_pick) : -1;
+            int area = lane_lights && has_smooth_lobe(m) ? choose_light(scene, naive, u.light_pick).area : -1;
             if (area >= 0 && !(scene.area_lights[size_t(area)].select_prob > 0)) area = -1;  // a black light
             const int light_sphere = area >= 0 ? scene.area_lights[size_t(area)].sphere : -1;
             const SphereGeom* light_geom = area >= 0 ? &scene.spheres[size_t(light_sphere)] : nullptr;
