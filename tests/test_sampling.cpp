@@ -3,11 +3,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "core/rng.h"
 #include "core/sampling.h"
+#include "render/lanes.h"
 #include "render/light.h"
 #include "render/render.h"
 #include "test_util.h"
@@ -278,6 +281,33 @@ TEST(Sampling, SinCosTurnsMatchesLibm) {
         worst = std::max({worst, std::abs(s - std::sin(2 * kPi * t)), std::abs(c - std::cos(2 * kPi * t))});
     }
     EXPECT_LT(worst, 2e-15);
+}
+
+TEST(Sampling, LogMatchesLibmOnOneDoubleAndOnLanes) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    Rng rng(11, 3);
+    double worst_ulps = 0;
+    for (int i = 0; i < 200000; ++i) {
+        // Mantissas across [1, 2) at exponents over the whole normal range, and values near 1.
+        const double x = i % 4 == 0 ? 1.0 + (rng.next() - 0.5) * 1e-3
+                                    : (1.0 + rng.next()) * std::ldexp(1.0, int(rng.next() * 2044) - 1022);
+        const double exact = std::log(x), got = log_positive(x);
+        const double ulp = std::nextafter(std::abs(exact), kInf) - std::abs(exact);
+        worst_ulps = std::max(worst_ulps, std::abs(got - exact) / ulp);
+        // Four lanes give what one double gives.
+        const v4d lanes = log_normal_positive<v4d, v4u>(v4d{x, 2 * x, 0.5 * x, x});
+        ASSERT_EQ(lanes[0], got);
+        ASSERT_EQ(lanes[3], got);
+    }
+    EXPECT_LE(worst_ulps, 1.0);
+    EXPECT_EQ(log_positive(1.0), 0.0);
+    EXPECT_EQ(log_positive(2.0), std::log(2.0));
+    // Outside the normal range it answers as libm does.
+    EXPECT_EQ(log_positive(0.0), -kInf);
+    EXPECT_EQ(log_positive(kInf), kInf);
+    EXPECT_TRUE(std::isnan(log_positive(-1.0)));
+    EXPECT_EQ(log_positive(0x1.0p-1070), std::log(0x1.0p-1070));
+    std::printf("log_positive: worst error %.2f ulp\n", worst_ulps);
 }
 
 // The brief's light integral, int over the hemisphere facing p of cos_i cos_axis / dist^2 dA,

@@ -49,6 +49,45 @@ inline void sin_cos_turns(double t, double& sin_out, double& cos_out) {
     cos_out = ((k + 1) & 2) ? -cos_mag : cos_mag;
 }
 
+// Natural logarithm of a positive, finite, normal x, within about 1 ulp, for one double (U =
+// uint64_t) and for SIMD lanes (U: the lanes' bits as unsigned integers) alike: the brief
+// light sampler takes one per shading point, and libm's is a call per lane. Other inputs
+// give garbage: callers check the range (log_positive below).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // forced inline: lanes never cross a call (render/lanes.h)
+template <class T, class U>
+inline __attribute__((always_inline)) T log_normal_positive(T x) {
+    // x = 2^k m with m in [sqrt(1/2), sqrt(2)): offsetting the bits by those of sqrt(1/2)
+    // puts k + 1023 in the exponent field without a comparison (as musl's log does).
+    constexpr uint64_t kSqrtHalfBits = 0x3fe6a09e667f3bcdull, kMantissa = (1ull << 52) - 1;
+    U bits;
+    __builtin_memcpy(&bits, &x, sizeof bits);
+    bits += 0x3ff0000000000000ull - kSqrtHalfBits;
+    U k_bits = (bits >> 52) + (0x4338000000000000ull - 1023);  // the bits of 1.5 * 2^52 + k
+    bits = (bits & kMantissa) + kSqrtHalfBits;
+    T m, k;
+    __builtin_memcpy(&m, &bits, sizeof m);
+    __builtin_memcpy(&k, &k_bits, sizeof k);
+    k = k - 0x1.8p52;
+    // log m = 2 atanh(s) = 2s + s tail, s = (m - 1) / (m + 1), |s| <= 0.1716: the odd series
+    // to s^21, whose first omitted term is below 1e-17 of the sum.
+    const T f = m - 1.0;
+    const T s = f / (m + 1.0);
+    const T s2 = s * s;
+    const T tail = s2 * (2.0 / 3 + s2 * (2.0 / 5 + s2 * (2.0 / 7 + s2 * (2.0 / 9 + s2 * (2.0 / 11 +
+                   s2 * (2.0 / 13 + s2 * (2.0 / 15 + s2 * (2.0 / 17 + s2 * (2.0 / 19 + s2 * (2.0 / 21))))))))));
+    // k ln 2 in two parts, the first with trailing zero bits so that k times it is exact.
+    constexpr double kLn2High = 0x1.62e42fee00000p-1, kLn2Low = 0x1.a39ef35793c76p-33;
+    // 2s = f - s f, so log m = f - s (f - tail): f is exact and the rest a small correction.
+    return k * kLn2High + (f - (s * (f - tail) - k * kLn2Low));
+}
+#pragma GCC diagnostic pop
+// One double: log_normal_positive in its range, libm outside it (0, subnormals, infinity,
+// NaN and negatives keep their libm answers).
+inline double log_positive(double x) {
+    return x >= 0x1.0p-1022 && x <= 0x1.fffffffffffffp1023 ? log_normal_positive<double, uint64_t>(x) : std::log(x);
+}
+
 // Cosine-weighted direction about +z (Malley: concentric disk lifted to the hemisphere).
 Vec3 sample_cosine_hemisphere(double u1, double u2);
 inline double cosine_hemisphere_pdf(double cos_theta) { return cos_theta > 0 ? cos_theta * kInvPi : 0; }

@@ -11,6 +11,7 @@ namespace kr {
 // SSE2 pairs by default, one AVX register in the x86-64-v3 clone.
 typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
+typedef uint64_t v4u __attribute__((vector_size(32)));  // bits, shifted without sign
 
 // Every helper taking or returning lanes is forced inline into its KR_CLONES caller: a call
 // would pass them by the default clone's ABI, not the AVX2 one. So no lane crosses a

@@ -30,7 +30,8 @@ struct BriefProposal {
     // ln(a / (d - r)^2) = -ln(1 - b / a): one log of a ratio, cheaper than log1p. For a far
     // light the ratio is near 1 and loses relative precision, but v_max is then tiny and the
     // log-uniform part's weight 1 - alpha ~ v_max^3 negligible.
-    static double log_ratio(double a, double gap) { return std::log(a / (gap * gap)); }
+    // log_positive: packet.cpp takes the same logarithm lane-wise.
+    static double log_ratio(double a, double gap) { return log_positive(a / (gap * gap)); }
 
     // mix = 1 / alpha = 1 + v_max^3, so that sampling needs no division.
     double a, b, v_max, mix, alpha;

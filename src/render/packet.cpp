@@ -160,11 +160,15 @@ KR_LANES LightLanes sample_light_lanes(LightSampling strategy, const V3& centre,
         out.valid = lanes & (out.distance > 0);
         return out;
     }
-    // brief: BriefProposal's mixture; its logarithm (and the rare log-uniform branch) per lane.
+    // brief: BriefProposal's mixture; the rare log-uniform branch per lane, and the logarithm
+    // too where a lane's ratio is outside log_normal_positive's range.
     const v4d a = d * d + radius * radius, b = 2 * d * radius, gap = d - radius;
     const v4d ratio = a / (gap * gap);
-    v4d v_max;
-    for (int k = 0; k < 4; ++k) v_max[k] = lanes[k] ? std::log(ratio[k]) : 0.0;
+    const v4l normal = (ratio >= 0x1.0p-1022) & (ratio <= 0x1.fffffffffffffp1023);
+    v4d v_max = select(lanes, log_normal_positive<v4d, v4u>(select(normal, ratio, splat(1.0))), v4d{});
+    if (any_lane(lanes & ~normal))
+        for (int k = 0; k < 4; ++k)
+            if (lanes[k] && !normal[k]) v_max[k] = std::log(ratio[k]);
     const v4d mix = 1.0 + v_max * v_max * v_max;
     const v4d alpha = 1.0 / mix;
     const v4d x = u1 * mix;
