@@ -236,6 +236,7 @@ struct Paths {
     V3 o, d;  // the rays to cast next: from a surface or the camera, tmin 0, unbounded
     v4l from, into;
     v4l alive;
+    v4l depth;  // of the vertex the next ray finds
     V3 throughput, L;
     v4l full_emission;  // PathHistory, lane-wise
     v4d last_bsdf_pdf;
@@ -277,8 +278,10 @@ bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
 
 }  // namespace
 
-// Up to four paths, a bounce at a time. Camera rays as render_pass makes them (tmin 0,
-// unbounded, from no sphere); trace_samples checks.
+// `count` samples, four paths at a time, a bounce at a time: a lane whose path ends hands in
+// its result and takes the next sample, so lanes stay busy while paths have different
+// lengths. Camera rays as render_pass makes them (tmin 0, unbounded, from no sphere);
+// trace_samples checks.
 KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& settings, const Ray* rays,
                             Sampler* const* samplers, int count, SampleResult* results) {
     const bool naive = settings.integrator == Integrator::pt_naive;
@@ -288,6 +291,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                                         settings.light_sampling == LightSampling::cone);
     Paths paths;
     paths.alive = v4l{};
+    paths.depth = v4l{};
     paths.from = v4l{} - 1;
     paths.into = v4l{};
     paths.throughput = {splat(1), splat(1), splat(1)};
@@ -298,27 +302,55 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     paths.last_sphere = v4l{} - 1;
     paths.primary_distance = splat(kMissDepth);
     paths.o = paths.d = {v4d{}, v4d{}, splat(1)};
-    for (int k = 0; k < count; ++k) {
-        set_lane(paths.o, k, rays[k].o);
-        set_lane(paths.d, k, rays[k].d);
-        paths.alive[k] = -1;
-    }
+    int lane_sample[4] = {-1, -1, -1, -1};  // the sample each lane traces
+    Sampler* lane_sampler[4] = {};
+    int next_sample = 0;
 
     // The numbers a vertex reads on each material (vertex_numbers_used, less Russian roulette,
     // which goes by depth alone).
     unsigned numbers_used[kMaxPacketMaterials];
     for (size_t i = 0; i < scene.materials.size(); ++i)
         numbers_used[i] = vertex_numbers_used(scene, scene.materials[i], 0, kMaxDepth + 2);
-    for (int bounce = 0;; ++bounce) {
-        const unsigned roulette = bounce + 1 >= settings.rr_depth ? Sampler::use_roulette : 0u;
+    for (;;) {
+        // Lanes whose path has ended hand in its result and start the next sample's.
+        for (int k = 0; k < 4; ++k) {
+            if (paths.alive[k]) continue;
+            if (lane_sample[k] >= 0) {
+                SampleResult& r = results[lane_sample[k]];
+                r.radiance = lane(paths.L, k);
+                r.primary_distance = paths.primary_distance[k];
+                r.rays = paths.rays[k];
+                lane_sample[k] = -1;
+            }
+            if (next_sample == count) continue;
+            lane_sample[k] = next_sample;
+            lane_sampler[k] = samplers[next_sample];
+            set_lane(paths.o, k, rays[next_sample].o);
+            set_lane(paths.d, k, rays[next_sample].d);
+            ++next_sample;
+            paths.alive[k] = -1;
+            paths.depth[k] = 0;
+            paths.from[k] = -1;
+            paths.into[k] = 0;
+            set_lane(paths.throughput, k, Color(1));
+            set_lane(paths.L, k, Color(0));
+            paths.full_emission[k] = -1;
+            paths.last_bsdf_pdf[k] = 0;
+            set_lane(paths.last_p, k, Vec3());
+            paths.last_sphere[k] = -1;
+            paths.primary_distance[k] = kMissDepth;
+            paths.rays[k] = 0;
+        }
+        if (!any_lane(paths.alive)) break;
+
         // Closest hits; a path whose ray leaves the scene ends.
         for (int k = 0; k < 4; ++k) paths.rays[k] += paths.alive[k] != 0;
         v4d t;
         v4l id;
         closest_lanes(scene, paths, t, id);
         paths.alive &= id >= 0;
-        if (!any_lane(paths.alive)) break;
-        if (bounce == 0) paths.primary_distance = select(paths.alive, t, paths.primary_distance);
+        if (!any_lane(paths.alive)) continue;
+        paths.primary_distance = select(paths.alive & (paths.depth == 0), t, paths.primary_distance);
 
         // Hit records (RenderScene::hit_at): the point projected back onto its sphere.
         const SphereGeom* hit_sphere[4];
@@ -348,7 +380,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                               emission_weight(scene, settings.light_sampling, light, hit, lane(paths.d, k), history);
             set_lane(paths.L, k, lane(paths.L, k) + add);
         }
-        if (bounce >= settings.max_depth) break;
+        paths.alive &= paths.depth < settings.max_depth;
+        if (!any_lane(paths.alive)) continue;
 
         const v4l front = dot(paths.d, n) < 0;
         const V3 ns = select(front, n, -n);
@@ -362,7 +395,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             LaneVertex& v = vertex[k];
             const int material = scene.sphere_material[size_t(id[k])];
             const Material& m = scene.materials[size_t(material)];
-            const Sampler::VertexNumbers u = samplers[k]->next_vertex(numbers_used[size_t(material)] | roulette);
+            const unsigned roulette = paths.depth[k] + 1 >= settings.rr_depth ? Sampler::use_roulette : 0u;
+            const Sampler::VertexNumbers u = lane_sampler[k]->next_vertex(numbers_used[size_t(material)] | roulette);
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
@@ -479,37 +513,30 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         paths.into = dot(next_dir, n) < 0;
 
         // Russian roulette with q = max(throughput) (brief), past the threshold depth.
-        if (bounce + 1 >= settings.rr_depth) {
+        const v4l roulette = paths.alive & (paths.depth + 1 >= settings.rr_depth);
+        if (any_lane(roulette)) {
             const V3& th = paths.throughput;
             const v4d y_or_z = select(th.y < th.z, th.z, th.y);
             const v4d largest = select(th.x < y_or_z, y_or_z, th.x);
             const v4d q = select(largest < 1.0, largest, splat(1.0));
-            paths.alive &= u_roulette < q;
-            paths.throughput = select(paths.alive, paths.throughput * (1.0 / q), V3{v4d{}, v4d{}, v4d{}});
+            paths.alive &= ~roulette | (u_roulette < q);
+            paths.throughput = select(paths.alive, select(roulette, paths.throughput * (1.0 / q), paths.throughput),
+                                      V3{v4d{}, v4d{}, v4d{}});
         }
-        if (!any_lane(paths.alive)) break;
-    }
-    for (int k = 0; k < count; ++k) {
-        results[k].radiance = lane(paths.L, k);
-        results[k].primary_distance = paths.primary_distance[k];
-        results[k].rays = paths.rays[k];
+        paths.depth += 1;
     }
 }
 
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results) {
-    const bool packets = packets_apply(scene, settings);
-    for (int first = 0; first < count; first += kPacketSize) {
-        const int n = std::min(kPacketSize, count - first);
-        bool camera_rays = true;  // as trace_packet takes them
-        for (int k = first; k < first + n; ++k)
-            camera_rays &= rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 &&
-                           rays[k].to_sphere < 0;
-        if (packets && camera_rays && n > 1) {
-            trace_packet(scene, settings, rays + first, samplers + first, n, results + first);
-        } else {
-            for (int k = first; k < first + n; ++k) results[k] = trace_sample(scene, settings, rays[k], *samplers[k]);
-        }
+    bool camera_rays = true;  // as trace_packet takes them
+    for (int k = 0; k < count; ++k)
+        camera_rays &=
+            rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
+    if (packets_apply(scene, settings) && camera_rays && count > 1) {
+        trace_packet(scene, settings, rays, samplers, count, results);
+    } else {
+        for (int k = 0; k < count; ++k) results[k] = trace_sample(scene, settings, rays[k], *samplers[k]);
     }
 }
 

@@ -231,16 +231,16 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
             continue;
         }
-        // Samples go to trace_samples kPacketSize at a time (path tracing traces their paths
+        // Samples go to trace_samples kSampleBatch at a time (path tracing traces their paths
         // in SIMD lanes) and are accumulated in the order they were drawn, so every pixel's
         // sums are those of tracing them one by one.
-        std::optional<Sampler> samplers[kPacketSize];
-        Sampler* batch_samplers[kPacketSize];
-        Ray batch_rays[kPacketSize];
-        size_t batch_pixels[kPacketSize];
+        std::optional<Sampler> samplers[kSampleBatch];
+        Sampler* batch_samplers[kSampleBatch];
+        Ray batch_rays[kSampleBatch];
+        size_t batch_pixels[kSampleBatch];
         int pending = 0;
         auto flush = [&] {
-            SampleResult results[kPacketSize];
+            SampleResult results[kSampleBatch];
             trace_samples(scene, settings, batch_rays, batch_samplers, pending, results);
             for (int k = 0; k < pending; ++k) {
                 const SampleResult& r = results[k];
@@ -280,7 +280,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 ray.d = cr.direction;
                 batch_samplers[pending] = &sampler;
                 batch_pixels[pending] = pixel;
-                if (++pending == kPacketSize) flush();
+                if (++pending == kSampleBatch) flush();
             }
         }
         if (pending > 0) flush();

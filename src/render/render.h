@@ -143,9 +143,11 @@ struct SampleResult {
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
                           Sampler& sampler);
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
-// camera rays kPacketSize at a time with their paths in SIMD lanes (packet.cpp) where the
-// scene is one leaf of our BVH; anything else goes one by one through trace_sample.
-inline constexpr int kPacketSize = 4;
+// camera rays four paths at a time in SIMD lanes (packet.cpp), a lane starting the next sample
+// as its path ends, where the scene is one leaf of our BVH; anything else goes one by one
+// through trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less
+// time lanes idle at the batch's end.
+inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);
 
