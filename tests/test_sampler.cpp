@@ -44,6 +44,48 @@ TEST(Sobol, FirstDimensionsAreTheSobolSequence) {
     EXPECT_EQ(reverse_bits(0x12345678u), 0x1e6a2c48u);
 }
 
+// The second dimension against its definition: the index's bits pick columns of the
+// generator matrix, Pascal's triangle mod 2 (column k+1 = column k xor column k shifted
+// down a bit, from the top bit), xor-ed together.
+TEST(Sobol, SecondDimensionIsItsGeneratorMatrix) {
+    uint32_t column[32];
+    column[0] = 1u << 31;
+    for (int k = 1; k < 32; ++k) column[k] = column[k - 1] ^ (column[k - 1] >> 1);
+    Rng rng(5, 6);
+    for (int trial = 0; trial < 20000; ++trial) {
+        const uint32_t index = trial < 256 ? uint32_t(trial) : rng.next_u32();
+        uint32_t expected = 0;
+        for (int k = 0; k < 32; ++k)
+            if (index & (1u << k)) expected ^= column[k];
+        ASSERT_EQ(sobol_dimension1(index), expected) << index;
+    }
+}
+
+// The packet tracer draws Sobol numbers in SIMD lanes of words (render/packet.cpp) with the
+// same templates: every lane must give the bits one word gives.
+#pragma GCC diagnostic ignored "-Wpsabi"  // the lanes stay in this function
+TEST(Sobol, LanesGiveWhatOneWordGives) {
+    typedef uint32_t v8w __attribute__((vector_size(32)));
+    Rng rng(8, 9);
+    for (int trial = 0; trial < 2000; ++trial) {
+        v8w key, index_reversed, dimension;
+        for (int k = 0; k < 8; ++k) {
+            key[k] = rng.next_u32();
+            index_reversed[k] = rng.next_u32();
+            dimension[k] = rng.next_u32() % 64;
+        }
+        const v8w reversed = reverse_bits(key);
+        const SobolDimension<v8w> lanes(key, index_reversed, dimension);
+        const v8w x = lanes.x(), y = lanes.y();
+        for (int k = 0; k < 8; ++k) {
+            ASSERT_EQ(reversed[k], reverse_bits(key[k]));
+            const SobolDimension<uint32_t> one(key[k], index_reversed[k], dimension[k]);
+            ASSERT_EQ(x[k], one.x());
+            ASSERT_EQ(y[k], one.y());
+        }
+    }
+}
+
 // An Owen scramble is a bijection that maps each dyadic interval onto a dyadic interval of
 // the same size: two fractions sharing their top k bits still share them after scrambling.
 TEST(Sobol, OwenScrambleKeepsDyadicIntervalsTogether) {
@@ -64,7 +106,7 @@ TEST(Sobol, OwenScrambleKeepsDyadicIntervalsTogether) {
 // puts exactly one point in each elementary interval of area 2^-m: 2^a by 2^(m-a) cells.
 TEST(Sobol, EveryPowerOfTwoPrefixIsANet) {
     for (uint64_t pixel : {0ull, 1ull, 12345ull}) {
-        for (int pair : {0, 1, 4, 11}) {
+        for (int pair : {0, 1, 4, 11, 20, 57}) {  // the camera's and vertices' up to depth 11
             for (int m = 0; m <= 8; ++m) {
                 const uint32_t n = 1u << m;
                 for (uint32_t first : {0u, n, 5 * n}) {
@@ -190,7 +232,7 @@ TEST(Sobol, VertexNumbersLeftOutDoNotShiftOthers) {
             partial.pixel();
             full.skip_2d();
             partial.skip_2d();
-            for (int vertex = 0; vertex < 4; ++vertex) {  // past the scrambled dimensions
+            for (int vertex = 0; vertex < 4; ++vertex) {
                 const Sampler::VertexNumbers a = full.next_vertex(all), b = partial.next_vertex(use);
                 if (use & Sampler::use_light) {
                     EXPECT_EQ(a.light.x, b.light.x);

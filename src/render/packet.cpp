@@ -200,6 +200,37 @@ KR_LANES LightLanes sample_light_lanes(LightSampling strategy, const V3& centre,
     return out;
 }
 
+// The five numbers of a path vertex (Sampler::next_vertex) of four Sobol samplers at once:
+// their dimensions d (light choice), d + 1 (light point), d + 2 (lobe), d + 3 (BSDF
+// direction) and d + 4 (roulette), each lane at its own d. Two dimensions share a register of
+// eight words. The per-lane part keeps the numbers its vertex reads, as the one-path sampler
+// draws only those; the lobe is drawn only where some lane reads it.
+typedef uint32_t v4w __attribute__((vector_size(16)));  // four 32-bit words
+typedef uint32_t v8w __attribute__((vector_size(32)));  // eight: two dimensions of four lanes
+struct VertexLanes {
+    v4d light_pick, light_x, light_y, lobe, bsdf_x, bsdf_y, roulette;
+};
+KR_LANES v4d unit_lanes(v4w fraction) {  // Sampler::to_unit, exactly: the words convert exactly
+    typedef int32_t v4i __attribute__((vector_size(16)));
+    const v4i centred = v4i(fraction ^ 0x80000000u);  // AVX2 converts signed words only
+    return (__builtin_convertvector(centred, v4d) + 2147483648.5) * 0x1.0p-32;
+}
+KR_LANES v8w pair(v4w low, v4w high) { return __builtin_shufflevector(low, high, 0, 1, 2, 3, 4, 5, 6, 7); }
+KR_LANES v4d unit_low(v8w words) { return unit_lanes(__builtin_shufflevector(words, words, 0, 1, 2, 3)); }
+KR_LANES v4d unit_high(v8w words) { return unit_lanes(__builtin_shufflevector(words, words, 4, 5, 6, 7)); }
+KR_LANES VertexLanes sobol_vertex_lanes(v4w key, v4w index_reversed, v4w d, bool lobe) {
+    VertexLanes v;
+    const v8w key2 = pair(key, key), index2 = pair(index_reversed, index_reversed);
+    const SobolDimension<v8w> light_bsdf(key2, index2, pair(d + 1, d + 3));
+    const v8w x = light_bsdf.x(), y = light_bsdf.y();
+    v.light_x = unit_low(x), v.bsdf_x = unit_high(x);
+    v.light_y = unit_low(y), v.bsdf_y = unit_high(y);
+    const v8w pick_roulette = SobolDimension<v8w>(key2, index2, pair(d, d + 4)).x();
+    v.light_pick = unit_low(pick_roulette), v.roulette = unit_high(pick_roulette);
+    v.lobe = lobe ? unit_lanes(SobolDimension<v4w>(key, index_reversed, d + 2).x()) : v4d{};
+    return v;
+}
+
 // What a path vertex's per-lane part (samplers, light choice, other materials) hands to the
 // lane-wise part. All zeros for a lane with nothing to do: the lane-wise part masks what such a
 // lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
@@ -305,6 +336,9 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     int lane_sample[4] = {-1, -1, -1, -1};  // the sample each lane traces
     Sampler* lane_sampler[4] = {};
     int next_sample = 0;
+    // Sobol samplers draw their vertex numbers lane-wise; the others one lane at a time.
+    bool sobol_lanes = true;
+    for (int k = 0; k < count; ++k) sobol_lanes &= samplers[k]->sobol();
 
     // The numbers a vertex reads on each material (vertex_numbers_used, less Russian roulette,
     // which goes by depth alone).
@@ -386,6 +420,27 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const v4l front = dot(paths.d, n) < 0;
         const V3 ns = select(front, n, -n);
 
+        // The numbers each vertex reads (vertex_numbers_used), and Sobol samplers' in lanes.
+        unsigned use[4] = {}, use_any = 0;
+        for (int k = 0; k < 4; ++k) {
+            if (!paths.alive[k]) continue;
+            const bool roulette = paths.depth[k] + 1 >= settings.rr_depth;
+            use[k] = numbers_used[size_t(scene.sphere_material[size_t(id[k])])] | (roulette ? Sampler::use_roulette : 0u);
+            use_any |= use[k];
+        }
+        VertexLanes sobol;
+        if (sobol_lanes) {
+            v4w key{}, index_reversed{}, dimension{};
+            for (int k = 0; k < 4; ++k) {
+                if (!paths.alive[k]) continue;
+                key[k] = lane_sampler[k]->sobol_key();
+                index_reversed[k] = lane_sampler[k]->index_reversed();
+                dimension[k] = lane_sampler[k]->dimension();
+                lane_sampler[k]->skip_dimensions(5);
+            }
+            sobol = sobol_vertex_lanes(key, index_reversed, dimension, use_any & Sampler::use_lobe);
+        }
+
         // Per lane: the vertex's numbers, its light sample and, off the diffuse lobe, its
         // scattering (the functions one path uses). Written to plain records and gathered into
         // lanes after the loop: stores into single lanes of a vector would stall its next load.
@@ -395,8 +450,16 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             LaneVertex& v = vertex[k];
             const int material = scene.sphere_material[size_t(id[k])];
             const Material& m = scene.materials[size_t(material)];
-            const unsigned roulette = paths.depth[k] + 1 >= settings.rr_depth ? Sampler::use_roulette : 0u;
-            const Sampler::VertexNumbers u = lane_sampler[k]->next_vertex(numbers_used[size_t(material)] | roulette);
+            Sampler::VertexNumbers u;
+            if (sobol_lanes) {  // those the vertex reads; 0 for the others, as next_vertex gives
+                if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
+                if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
+                if (use[k] & Sampler::use_lobe) u.lobe = sobol.lobe[k];
+                if (use[k] & Sampler::use_bsdf) u.bsdf = {sobol.bsdf_x[k], sobol.bsdf_y[k]};
+                if (use[k] & Sampler::use_roulette) u.roulette = sobol.roulette[k];
+            } else {
+                u = lane_sampler[k]->next_vertex(use[k]);
+            }
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};

@@ -7,11 +7,13 @@ namespace kr {
 
 Sampler::Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target)
     : estimator_(estimator),
-      rng_(Rng::for_sample(seed, pixel, index)),
-      pixel_seed_(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull))),
+      sobol_key_(uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)))),
       index_(index),
       index_reversed_(reverse_bits(index)),
-      target_(std::max(target, 1)) {}
+      target_(std::max(target, 1)) {
+    // Sobol samples draw every number from the sequence, so only the others need a stream.
+    if (estimator != Estimator::sobol) rng_ = Rng::for_sample(seed, pixel, index);
+}
 
 Vec2 Sampler::pixel() {
     if (estimator_ == Estimator::sobol) return next_2d();

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 #include "core/rng.h"
 #include "core/sampling.h"
@@ -17,17 +18,29 @@ namespace kr {
 //             (i mod e, i div e), e = floor(sqrt(s)); everything else uniform random.
 // sobol:      every dimension pair from the 2-D Sobol (0,2)-sequence, with the sample index
 //             shuffled and the points Owen-scrambled per pixel and per dimension (Burley
-//             2020, "Practical hash-based Owen scrambling"). Any prefix of 2^k samples is a
-//             stratified (0,k,2)-net in each pair, so it keeps its advantage with no target
-//             count, including the viewer's unbounded accumulation.
+//             2020, "Practical hash-based Owen scrambling"), at every depth. Any prefix of
+//             2^k samples is a stratified (0,k,2)-net in each pair, so it keeps its advantage
+//             with no target count, including the viewer's unbounded accumulation.
 enum class Estimator { uniform, stratified, sobol };
 inline constexpr EnumNames<Estimator, 3> estimator_names{{"uniform", "stratified", "sobol"}};
 
-// Sobol sequence building blocks (exposed for tests), all on 32-bit binary fractions. Inline:
-// a path vertex draws five dimensions, and in a cheap scene that is a third of the work.
-inline uint32_t reverse_bits(uint32_t x) {
-    // Bytes by a byte swap, then the bits within each byte by three swap steps.
-    x = __builtin_bswap32(x);
+// Sobol sequence building blocks (exposed for tests), all on 32-bit binary fractions, each
+// for one word (U = uint32_t) and for SIMD lanes of words (packet.cpp) alike: integer
+// operations, so both give the same bits. Forced inline: a path vertex draws five
+// dimensions, and lanes must not cross a call (render/lanes.h).
+#define KR_SOBOL_INLINE inline __attribute__((always_inline))
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // forced inline: lanes never cross a call
+
+template <class U>
+KR_SOBOL_INLINE U reverse_bits(U x) {
+    if constexpr (std::is_integral_v<U>) {
+        x = __builtin_bswap32(x);  // bytes by one instruction
+    } else {
+        x = (x >> 16) | (x << 16);
+        x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
+    }
+    // then the bits within each byte by three swap steps
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
     x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
     return ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
@@ -36,26 +49,18 @@ inline uint32_t reverse_bits(uint32_t x) {
 // van der Corput: the bits of the index mirrored.
 inline uint32_t sobol_dimension0(uint32_t index) { return reverse_bits(index); }
 
-// The second Sobol dimension: XOR of its generator matrix's columns for the index's bits,
-// tabulated per index byte at compile time. Column k+1 = column k xor (column k >> 1) builds
-// the upper-triangular Pascal matrix mod 2. The table holds the columns bit-reversed, the
-// order the Owen scramble works in, which saves a reversal per sample (and reversal is
-// linear over XOR, so reversing each column reverses the sum).
-constexpr std::array<std::array<uint32_t, 256>, 4> sobol_dimension1_reversed_table() {
-    std::array<uint32_t, 32> column{};  // reversed: the k-th column's top bit is bit 0 here
-    column[0] = 1u;
-    for (int k = 1; k < 32; ++k) column[k] = column[k - 1] ^ (column[k - 1] << 1);
-    std::array<std::array<uint32_t, 256>, 4> table{};
-    for (int b = 0; b < 4; ++b)
-        for (uint32_t v = 0; v < 256; ++v)
-            for (int bit = 0; bit < 8; ++bit)
-                if (v & (1u << bit)) table[b][v] ^= column[8 * b + bit];
-    return table;
-}
-inline constexpr auto kSobolDimension1ReversedBytes = sobol_dimension1_reversed_table();
-inline uint32_t sobol_dimension1_reversed(uint32_t index) {
-    const auto& t = kSobolDimension1ReversedBytes;
-    return t[0][index & 0xff] ^ t[1][(index >> 8) & 0xff] ^ t[2][(index >> 16) & 0xff] ^ t[3][index >> 24];
+// The second Sobol dimension bit-reversed, the order the Owen scramble works in. Its
+// generator matrix is Pascal's triangle mod 2: bit k of the index adds the polynomial
+// (1 + z)^k (z: one bit up), so the fraction is the index polynomial with 1 + z put for its
+// variable. Over GF(2), (1 + z)^(2^m) = 1 + z^(2^m), so five steps do it, each folding the
+// upper half of every block of 2^(m+1) bits onto its lower half.
+template <class U>
+KR_SOBOL_INLINE U sobol_dimension1_reversed(U index) {
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    return index ^ ((index >> 16) & 0x0000ffffu);
 }
 inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits(sobol_dimension1_reversed(index)); }
 
@@ -63,7 +68,8 @@ inline uint32_t sobol_dimension1(uint32_t index) { return reverse_bits(sobol_dim
 // of the bits below k (addition carries and multiplication by even constants only move
 // information upwards), so applied to a bit-reversed fraction it is a nested, per-prefix
 // random flip: an Owen scramble.
-inline uint32_t laine_karras(uint32_t x, uint32_t seed) {
+template <class U>
+KR_SOBOL_INLINE U laine_karras(U x, U seed) {
     x += seed;
     x ^= x * 0x6c50b47cu;
     x ^= x * 0xb82f1e52u;
@@ -77,17 +83,42 @@ inline uint32_t owen_scramble(uint32_t fraction, uint32_t seed) {
     return reverse_bits(laine_karras(reverse_bits(fraction), seed));
 }
 
+// A 32-bit integer hash with full avalanche (two multiply-xorshift rounds; Wellons'
+// "lowbias32" constants).
+template <class U>
+KR_SOBOL_INLINE U hash32(U x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    return x ^ (x >> 16);
+}
+
+// One dimension of one Sobol sample: the sample index shuffled and the point scrambled by
+// seeds of their own for each (pixel, dimension). The index is shuffled first so that
+// different dimensions are not correlated through it; an Owen scramble of the index keeps
+// every aligned block of 2^k indices together, so prefixes stay nets. Its two coordinates
+// (x, y) are Sobol dimensions 0 and 1, Owen-scrambled; `key` is the pixel's, from its seed.
+template <class U>
+struct SobolDimension {
+    U index, seed;
+    KR_SOBOL_INLINE SobolDimension(U key, U index_reversed, U dimension) {
+        const U h = hash32(key ^ (dimension * 0x9e3779b9u));
+        index = reverse_bits(laine_karras(index_reversed, h));
+        seed = hash32(h + 0x632be5abu);
+    }
+    // owen_scramble(sobol_dimension0(index)): the two bit reversals in between cancel.
+    KR_SOBOL_INLINE U x() const { return reverse_bits(laine_karras(index, seed)); }
+    // owen_scramble(sobol_dimension1(index)), its inner reversal left out of the matrix.
+    KR_SOBOL_INLINE U y() const { return reverse_bits(laine_karras(sobol_dimension1_reversed(index), seed ^ 0xb5297a4du)); }
+};
+#pragma GCC diagnostic pop
+
 // The numbers one sample of one pixel consumes, in a fixed order of dimensions: the
 // sub-pixel position, the lens, then per path vertex the light choice, the light point, the
 // BSDF lobe choice, the BSDF direction and Russian roulette.
 class Sampler {
 public:
-    // The Sobol estimator scrambles this many dimensions (1-D or 2-D each): the sub-pixel
-    // position, the lens and the first two path vertices (five each). Later ones come from
-    // the pixel's PCG32 stream: little of the image depends on them, and scrambling costs
-    // time (measured in docs/accuracy.md).
-    static constexpr uint32_t kSobolDimensions = 12;
-
     // `target` is the sample count the stratified estimator divides the pixel for.
     Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target);
     // For tools and tests that trace rays by hand: the uniform estimator on one RNG stream.
@@ -96,20 +127,16 @@ public:
     Vec2 pixel();  // sub-pixel position in [0,1)^2; call first
 
     double next_1d() {
-        if (!scrambling()) return rng_.next();
-        const Shuffle s = shuffle(dimension_++);
-        // owen_scramble(sobol_dimension0(i)): the two bit reversals in between cancel.
-        return to_unit(reverse_bits(laine_karras(s.index, s.seed)));
+        if (!sobol()) return rng_.next();
+        return to_unit(next_dimension().x());
     }
     Vec2 next_2d() {
-        if (!scrambling()) {
+        if (!sobol()) {
             const double u1 = rng_.next();
             return {u1, rng_.next()};
         }
-        const Shuffle s = shuffle(dimension_++);
-        return {to_unit(reverse_bits(laine_karras(s.index, s.seed))),
-                // owen_scramble(sobol_dimension1(i)), its inner reversal taken by the table.
-                to_unit(reverse_bits(laine_karras(sobol_dimension1_reversed(s.index), s.seed ^ 0xb5297a4du)))};
+        const SobolDimension<uint32_t> d = next_dimension();
+        return {to_unit(d.x()), to_unit(d.y())};
     }
 
     // One path vertex's five dimensions, in the fixed order below. Those `use` leaves out
@@ -137,19 +164,32 @@ public:
     // Skip a dimension (the lens of a pinhole camera, numbers a vertex does not read) without
     // computing it, so every later dimension is the same as when it is drawn.
     void skip_1d() {
-        if (scrambling()) {
+        if (sobol()) {
             ++dimension_;
         } else {
             rng_.next_u32(), rng_.next_u32();  // next() uses two
         }
     }
     void skip_2d() {
-        if (scrambling()) {
+        if (sobol()) {
             ++dimension_;
         } else {
             rng_.next_u32(), rng_.next_u32(), rng_.next_u32(), rng_.next_u32();
         }
     }
+
+    // The Sobol estimator's state, for drawing four samplers' numbers in SIMD lanes
+    // (packet.cpp): the pixel's key, the index bit-reversed, and the next dimension. The
+    // lanes move each sampler on by the dimensions they drew.
+    bool sobol() const { return estimator_ == Estimator::sobol; }
+    uint32_t sobol_key() const { return sobol_key_; }
+    uint32_t index_reversed() const { return index_reversed_; }
+    uint32_t dimension() const { return dimension_; }
+    void skip_dimensions(uint32_t count) { dimension_ += count; }
+
+    // A 32-bit binary fraction to a double in (0, 1): the centre of its 2^-32 interval, so
+    // the sample never lands on 0 (where some warps have a zero density) nor on 1.
+    static double to_unit(uint32_t fraction) { return (double(fraction) + 0.5) * 0x1.0p-32; }
 
 private:
     double draw_1d(bool used) {
@@ -162,27 +202,13 @@ private:
         skip_2d();
         return {};
     }
-    struct Shuffle {
-        uint32_t index;  // this dimension's shuffled sample index
-        uint32_t seed;   // and the seed of its point scramble
-    };
-    bool scrambling() const { return estimator_ == Estimator::sobol && dimension_ < kSobolDimensions; }
-    Shuffle shuffle(uint32_t dimension) const {
-        // One independent scramble per (pixel, dimension). The index is shuffled first so that
-        // different dimensions are not correlated through it; an Owen scramble of the index
-        // keeps every aligned block of 2^k indices together, so prefixes stay nets. One
-        // multiply-xorshift round makes the seeds: the Laine-Karras steps mix further.
-        uint64_t h = (pixel_seed_ ^ (uint64_t(dimension) * 0x9e3779b97f4a7c15ull)) * 0xbf58476d1ce4e5b9ull;
-        h ^= h >> 31;
-        return {reverse_bits(laine_karras(index_reversed_, uint32_t(h))), uint32_t(h >> 32)};
+    SobolDimension<uint32_t> next_dimension() {
+        return SobolDimension<uint32_t>(sobol_key_, index_reversed_, dimension_++);
     }
-    // A 32-bit binary fraction to a double in (0, 1): the centre of its 2^-32 interval, so
-    // the sample never lands on 0 (where some warps have a zero density) nor on 1.
-    static double to_unit(uint32_t fraction) { return (double(fraction) + 0.5) * 0x1.0p-32; }
 
     Estimator estimator_;
-    Rng rng_;
-    uint64_t pixel_seed_ = 0;
+    Rng rng_;  // the uniform and stratified estimators' stream
+    uint32_t sobol_key_ = 0;
     uint32_t index_ = 0;
     uint32_t index_reversed_ = 0;
     uint32_t dimension_ = 0;
