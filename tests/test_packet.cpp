@@ -179,3 +179,45 @@ TEST(Packet, RenderPassImageIsOneByOnes) {
         EXPECT_NEAR(double(state.rays), double(rays), double(rays) * 1e-3) << "scene " << n;
     }
 }
+
+// Camera rays four at a time (Sobol samplers and a pinhole; otherwise one by one) against one
+// by one: the same rays, and every sampler left where the one-by-one sampler is. Seven
+// samples, so the last group is partial; scene 3 also through its thin lens.
+TEST(Packet, CameraRaysAreOneByOnes) {
+    RenderScene scene = brief_scene(3);
+    const int width = scene.renderer.width, height = scene.renderer.height;
+    for (double lens_radius : {0.0, 0.2})
+        for (Estimator estimator : {Estimator::sobol, Estimator::uniform}) {
+            scene.camera.lens_radius = lens_radius;
+            constexpr int kCount = 7;
+            std::vector<std::optional<Sampler>> together(kCount), alone(kCount);
+            std::vector<Sampler*> samplers(kCount);
+            int xs[kCount], ys[kCount];
+            for (int k = 0; k < kCount; ++k) {
+                xs[k] = (k * 37) % width, ys[k] = (k * 101) % height;
+                const uint64_t pixel = uint64_t(ys[k]) * uint64_t(width) + uint64_t(xs[k]);
+                together[size_t(k)].emplace(estimator, 4, pixel, uint32_t(k), 16);
+                alone[size_t(k)].emplace(estimator, 4, pixel, uint32_t(k), 16);
+                samplers[size_t(k)] = &*together[size_t(k)];
+            }
+            Ray rays[kCount];
+            camera_rays(scene, width, height, xs, ys, samplers.data(), kCount, rays);
+            for (int k = 0; k < kCount; ++k) {
+                Sampler& sampler = *alone[size_t(k)];
+                const Vec2 sub = sampler.pixel();
+                Vec2 lens;
+                if (lens_radius > 0) lens = sampler.next_2d();
+                else sampler.skip_2d();
+                const Vec2 film = raster_to_camera(xs[k] + sub.x, ys[k] + sub.y, width, height);
+                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+                const std::string where = std::string(estimator_names.name(estimator)) + " lens " +
+                                          std::to_string(lens_radius) + " sample " + std::to_string(k);
+                for (int axis = 0; axis < 3; ++axis) {
+                    EXPECT_TRUE(close(rays[k].o[axis], cr.origin[axis])) << where;
+                    EXPECT_TRUE(close(rays[k].d[axis], cr.direction[axis])) << where;
+                }
+                EXPECT_EQ(rays[k].tmin, 0.0);
+                EXPECT_EQ(together[size_t(k)]->next_1d(), sampler.next_1d()) << where;
+            }
+        }
+}

@@ -590,6 +590,59 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     }
 }
 
+KR_CLONES void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
+                           Sampler* const* samplers, int count, Ray* rays) {
+    const CameraModel& camera = scene.camera;
+    for (int first = 0; first < count; first += 4) {
+        const int n = std::min(4, count - first);
+        bool lanes = camera.lens_radius <= 0;
+        for (int k = first; k < first + n; ++k) lanes &= samplers[k]->sobol() && samplers[k]->dimension() == 0;
+        if (!lanes) {
+            for (int k = first; k < first + n; ++k) {
+                Sampler& sampler = *samplers[k];
+                const Vec2 sub = sampler.pixel();
+                Vec2 lens;
+                if (camera.lens_radius > 0) lens = sampler.next_2d();
+                else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
+                const Vec2 film = raster_to_camera(xs[k] + sub.x, ys[k] + sub.y, width, height);
+                const CameraRay cr = camera.generate(film.x, film.y, lens.x, lens.y);
+                rays[k] = Ray();
+                rays[k].o = cr.origin;
+                rays[k].d = cr.direction;
+            }
+            continue;
+        }
+        // Sampler::pixel (Sobol dimension 0) and the lens's skip, lane-wise; lanes past `n`
+        // repeat the first sample.
+        v4w key, index_reversed;
+        v4d x, y;
+        for (int k = 0; k < 4; ++k) {
+            const int i = first + (k < n ? k : 0);
+            key[k] = samplers[i]->sobol_key();
+            index_reversed[k] = samplers[i]->index_reversed();
+            x[k] = xs[i], y[k] = ys[i];
+        }
+        for (int k = first; k < first + n; ++k) samplers[k]->skip_dimensions(2);
+        const SobolDimension<v4w> pixel(key, index_reversed, v4w{});
+        // raster_to_camera, then CameraModel::generate for a pinhole: the point on the image
+        // plane at distance 1, normalised.
+        const v4d fx = ((x + unit_lanes(pixel.x())) - 0.5) / double(width);
+        const v4d fy = ((y + unit_lanes(pixel.y())) + 0.5) / double(height);
+        const v4d px = (2.0 * fx - 1.0) * camera.tan_half_fov * camera.aspect;
+        const v4d py = (1.0 - 2.0 * fy) * camera.tan_half_fov;
+        const V3 dir{camera.forward.x + px * camera.right.x + py * camera.up.x,
+                     camera.forward.y + px * camera.right.y + py * camera.up.y,
+                     camera.forward.z + px * camera.right.z + py * camera.up.z};
+        const V3 unit = dir * (1.0 / sqrt_lanes(dot(dir, dir)));
+        for (int k = 0; k < n; ++k) {
+            Ray& ray = rays[first + k];
+            ray = Ray();
+            ray.o = camera.position;
+            ray.d = lane(unit, k);
+        }
+    }
+}
+
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results) {
     bool camera_rays = true;  // as trace_packet takes them

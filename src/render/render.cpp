@@ -236,10 +236,12 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         // sums are those of tracing them one by one.
         std::optional<Sampler> samplers[kSampleBatch];
         Sampler* batch_samplers[kSampleBatch];
-        Ray batch_rays[kSampleBatch];
+        int batch_x[kSampleBatch], batch_y[kSampleBatch];
         size_t batch_pixels[kSampleBatch];
         int pending = 0;
         auto flush = [&] {
+            Ray batch_rays[kSampleBatch];
+            camera_rays(scene, width, height, batch_x, batch_y, batch_samplers, pending, batch_rays);
             SampleResult results[kSampleBatch];
             trace_samples(scene, settings, batch_rays, batch_samplers, pending, results);
             for (int k = 0; k < pending; ++k) {
@@ -266,19 +268,10 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             const int samples = state.pass_samples.empty() ? 1 : state.pass_samples[pixel];
             for (int k = 0; k < samples; ++k) {
                 const uint32_t index = state.sample_index[pixel]++;
-                Sampler& sampler =
-                    samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
-                const Vec2 sub = sampler.pixel();
-                Vec2 lens;
-                if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
-                else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
-                const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
-                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
-                Ray& ray = batch_rays[pending];
-                ray = Ray();
-                ray.o = cr.origin;
-                ray.d = cr.direction;
-                batch_samplers[pending] = &sampler;
+                batch_samplers[pending] =
+                    &samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+                batch_x[pending] = x;
+                batch_y[pending] = y;
                 batch_pixels[pending] = pixel;
                 if (++pending == kSampleBatch) flush();
             }

@@ -142,6 +142,13 @@ struct SampleResult {
 // `sampler` has given the sub-pixel and lens numbers already (or none, for a hand-made ray).
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
                           Sampler& sampler);
+// The camera rays of `count` samples of pixels (xs[i], ys[i]) of a width x height image, each
+// sampler having given nothing yet: it gives the sub-pixel position and the lens numbers
+// (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp) for Sobol samplers and a
+// pinhole, each ray as one at a time gives it up to rounding.
+void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
+                 Sampler* const* samplers, int count, Ray* rays);
+
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
 // camera rays four paths at a time in SIMD lanes (packet.cpp), a lane starting the next sample
 // as its path ends, where the scene is one leaf of our BVH; anything else goes one by one
