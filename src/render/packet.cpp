@@ -277,6 +277,27 @@ struct Paths {
     uint64_t rays[4] = {};
 };
 
+// choose_light (integrator.cpp) lane-wise, for next-event estimation (not naive): the area
+// light each lane's number picks, or -1 where it picks a point light. The same subtractions
+// in the same order, so the same choices.
+KR_LANES v4l area_choice_lanes(const RenderScene& scene, v4d u) {
+    v4l undecided = ~v4l{};
+    for (const PointLight& light : scene.point_lights) {
+        undecided &= ~(u < light.select_prob);
+        u = u - light.select_prob;
+    }
+    v4l area = v4l{} - 1;
+    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
+        // The last light takes what rounding leaves above the total.
+        const bool last = i + 1 == scene.area_lights.size();
+        const v4l pick = undecided & ((u < scene.area_lights[i].select_prob) | (last ? ~v4l{} : v4l{}));
+        area = pick ? v4l{} + int64_t(i) : area;
+        undecided &= ~pick;
+        u = u - scene.area_lights[i].select_prob;
+    }
+    return area;
+}
+
 // The closest sphere of each live lane's ray (its index and distance; -1 where none).
 KR_LANES void closest_lanes(const RenderScene& scene, const Paths& paths, v4d& best, v4l& best_id) {
     best = splat(kInf);
@@ -441,17 +462,12 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             sobol = sobol_vertex_lanes(key, index_reversed, dimension, use_any & Sampler::use_lobe);
         }
 
-        // Per lane: the vertex's numbers, its light sample and, off the diffuse lobe, its
-        // scattering (the functions one path uses). Written to plain records and gathered into
-        // lanes after the loop: stores into single lanes of a vector would stall its next load.
-        LaneVertex vertex[4] = {};
+        // Each lane's numbers: those its vertex reads, 0 for the others, as next_vertex gives.
+        Sampler::VertexNumbers numbers[4];
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
-            LaneVertex& v = vertex[k];
-            const int material = scene.sphere_material[size_t(id[k])];
-            const Material& m = scene.materials[size_t(material)];
-            Sampler::VertexNumbers u;
-            if (sobol_lanes) {  // those the vertex reads; 0 for the others, as next_vertex gives
+            Sampler::VertexNumbers& u = numbers[k];
+            if (sobol_lanes) {
                 if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
                 if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
                 if (use[k] & Sampler::use_lobe) u.lobe = sobol.lobe[k];
@@ -460,10 +476,26 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             } else {
                 u = lane_sampler[k]->next_vertex(use[k]);
             }
+        }
+        const v4l area_choice =
+            lane_lights ? area_choice_lanes(scene, v4d{numbers[0].light_pick, numbers[1].light_pick,
+                                                       numbers[2].light_pick, numbers[3].light_pick})
+                        : v4l{} - 1;
+
+        // Per lane: the vertex's light sample and, off the diffuse lobe, its scattering (the
+        // functions one path uses). Written to plain records and gathered into lanes after the
+        // loop: stores into single lanes of a vector would stall its next load.
+        LaneVertex vertex[4] = {};
+        for (int k = 0; k < 4; ++k) {
+            if (!paths.alive[k]) continue;
+            LaneVertex& v = vertex[k];
+            const int material = scene.sphere_material[size_t(id[k])];
+            const Material& m = scene.materials[size_t(material)];
+            const Sampler::VertexNumbers& u = numbers[k];
             v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
-            int area = lane_lights && has_smooth_lobe(m) ? choose_light(scene, naive, u.light_pick).area : -1;
+            int area = lane_lights && has_smooth_lobe(m) ? int(area_choice[k]) : -1;
             if (area >= 0 && !(scene.area_lights[size_t(area)].select_prob > 0)) area = -1;  // a black light
             const int light_sphere = area >= 0 ? scene.area_lights[size_t(area)].sphere : -1;
             const SphereGeom* light_geom = area >= 0 ? &scene.spheres[size_t(light_sphere)] : nullptr;
