@@ -367,7 +367,11 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     for (size_t i = 0; i < scene.materials.size(); ++i)
         numbers_used[i] = vertex_numbers_used(scene, scene.materials[i], 0, kMaxDepth + 2);
     for (;;) {
-        // Lanes whose path has ended hand in its result and start the next sample's.
+        // Lanes whose path has ended hand in its result and start the next sample's. The new
+        // paths' state is blended in lane-wise: stores into single lanes would stall the
+        // vectors' next loads.
+        v4l start{};
+        const Ray* start_ray[4] = {rays, rays, rays, rays};
         for (int k = 0; k < 4; ++k) {
             if (paths.alive[k]) continue;
             if (lane_sample[k] >= 0) {
@@ -380,21 +384,32 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             if (next_sample == count) continue;
             lane_sample[k] = next_sample;
             lane_sampler[k] = samplers[next_sample];
-            set_lane(paths.o, k, rays[next_sample].o);
-            set_lane(paths.d, k, rays[next_sample].d);
-            ++next_sample;
-            paths.alive[k] = -1;
-            paths.depth[k] = 0;
-            paths.from[k] = -1;
-            paths.into[k] = 0;
-            set_lane(paths.throughput, k, Color(1));
-            set_lane(paths.L, k, Color(0));
-            paths.full_emission[k] = -1;
-            paths.last_bsdf_pdf[k] = 0;
-            set_lane(paths.last_p, k, Vec3());
-            paths.last_sphere[k] = -1;
-            paths.primary_distance[k] = kMissDepth;
+            start_ray[k] = &rays[next_sample];
+            start[k] = -1;
             paths.rays[k] = 0;
+            ++next_sample;
+        }
+        if (any_lane(start)) {
+            const V3 o{v4d{start_ray[0]->o.x, start_ray[1]->o.x, start_ray[2]->o.x, start_ray[3]->o.x},
+                       v4d{start_ray[0]->o.y, start_ray[1]->o.y, start_ray[2]->o.y, start_ray[3]->o.y},
+                       v4d{start_ray[0]->o.z, start_ray[1]->o.z, start_ray[2]->o.z, start_ray[3]->o.z}};
+            const V3 d{v4d{start_ray[0]->d.x, start_ray[1]->d.x, start_ray[2]->d.x, start_ray[3]->d.x},
+                       v4d{start_ray[0]->d.y, start_ray[1]->d.y, start_ray[2]->d.y, start_ray[3]->d.y},
+                       v4d{start_ray[0]->d.z, start_ray[1]->d.z, start_ray[2]->d.z, start_ray[3]->d.z}};
+            const V3 zero{v4d{}, v4d{}, v4d{}};
+            paths.o = select(start, o, paths.o);
+            paths.d = select(start, d, paths.d);
+            paths.alive |= start;
+            paths.depth = start ? v4l{} : paths.depth;
+            paths.from = start ? v4l{} - 1 : paths.from;
+            paths.into = start ? v4l{} : paths.into;
+            paths.throughput = select(start, V3{splat(1), splat(1), splat(1)}, paths.throughput);
+            paths.L = select(start, zero, paths.L);
+            paths.full_emission |= start;
+            paths.last_bsdf_pdf = select(start, v4d{}, paths.last_bsdf_pdf);
+            paths.last_p = select(start, zero, paths.last_p);
+            paths.last_sphere = start ? v4l{} - 1 : paths.last_sphere;
+            paths.primary_distance = select(start, splat(kMissDepth), paths.primary_distance);
         }
         if (!any_lane(paths.alive)) break;
 

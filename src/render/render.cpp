@@ -238,11 +238,11 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         Sampler* batch_samplers[kSampleBatch];
         int batch_x[kSampleBatch], batch_y[kSampleBatch];
         size_t batch_pixels[kSampleBatch];
+        Ray batch_rays[kSampleBatch];
+        SampleResult results[kSampleBatch];
         int pending = 0;
         auto flush = [&] {
-            Ray batch_rays[kSampleBatch];
             camera_rays(scene, width, height, batch_x, batch_y, batch_samplers, pending, batch_rays);
-            SampleResult results[kSampleBatch];
             trace_samples(scene, settings, batch_rays, batch_samplers, pending, results);
             for (int k = 0; k < pending; ++k) {
                 const SampleResult& r = results[k];
