@@ -236,10 +236,9 @@ KR_LANES VertexLanes sobol_vertex_lanes(v4w key, v4w index_reversed, v4w d, bool
 // lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
 struct LaneVertex {
     bool shadow, light_lane, diffuse, ok, smooth;
-    Vec3 shadow_d, direct, rho, next_dir, weight, light_centre, light_radiance;
-    Vec2 u_bsdf, u_light;
-    double shadow_tmax, pdf, u_roulette, light_radius, light_select;
-    int64_t shadow_into, shadow_to, light_to;
+    Vec3 shadow_d, direct, next_dir, weight;
+    double shadow_tmax, pdf;
+    int64_t shadow_into, shadow_to, light_area;
 };
 KR_LANES v4d gather(const LaneVertex (&v)[4], double LaneVertex::*field) {
     return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
@@ -255,10 +254,14 @@ KR_LANES V3 gather(const LaneVertex (&v)[4], Vec3 LaneVertex::*field) {
             v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y},
             v4d{(v[0].*field).z, (v[1].*field).z, (v[2].*field).z, (v[3].*field).z}};
 }
-KR_LANES v4d gather_x(const LaneVertex (&v)[4], Vec2 LaneVertex::*field) {
+// The same for the vertex numbers of the lanes.
+KR_LANES v4d gather(const Sampler::VertexNumbers (&v)[4], double Sampler::VertexNumbers::*field) {
+    return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+}
+KR_LANES v4d gather_x(const Sampler::VertexNumbers (&v)[4], Vec2 Sampler::VertexNumbers::*field) {
     return v4d{(v[0].*field).x, (v[1].*field).x, (v[2].*field).x, (v[3].*field).x};
 }
-KR_LANES v4d gather_y(const LaneVertex (&v)[4], Vec2 LaneVertex::*field) {
+KR_LANES v4d gather_y(const Sampler::VertexNumbers (&v)[4], Vec2 Sampler::VertexNumbers::*field) {
     return v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y};
 }
 
@@ -501,13 +504,14 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // functions one path uses). Written to plain records and gathered into lanes after the
         // loop: stores into single lanes of a vector would stall its next load.
         LaneVertex vertex[4] = {};
+        const Material* lane_material[4] = {&scene.materials[0], &scene.materials[0], &scene.materials[0],
+                                            &scene.materials[0]};
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
             LaneVertex& v = vertex[k];
-            const int material = scene.sphere_material[size_t(id[k])];
-            const Material& m = scene.materials[size_t(material)];
+            const Material& m = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
+            lane_material[k] = &m;
             const Sampler::VertexNumbers& u = numbers[k];
-            v.u_roulette = u.roulette;
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};
             int area = lane_lights && has_smooth_lobe(m) ? int(area_choice[k]) : -1;
@@ -517,14 +521,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             if (light_geom && light_sphere != hit.sphere &&
                 dot(hit.p - light_geom->centre, hit.p - light_geom->centre) > light_geom->radius * light_geom->radius) {
                 // An area light seen from outside: sampled lane-wise below.
-                const AreaLight& light = scene.area_lights[size_t(area)];
                 v.light_lane = true;
-                v.light_centre = light_geom->centre;
-                v.light_radius = light_geom->radius;
-                v.light_select = light.select_prob;
-                v.light_radiance = light.radiance;
-                v.light_to = light_sphere;
-                v.u_light = u.light;
+                v.light_area = area;
             } else if (has_smooth_lobe(m) && next_event_possible) {
                 Ray shadow;
                 Color light;
@@ -539,8 +537,6 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             }
             if (m.type == MaterialType::diffuse) {
                 v.diffuse = true;
-                v.rho = m.rho;
-                v.u_bsdf = u.bsdf;
                 continue;
             }
             ScatterSample s;
@@ -556,25 +552,46 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         v4d shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
         v4l shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
         V3 direct = gather(vertex, &LaneVertex::direct);
-        const V3 rho = gather(vertex, &LaneVertex::rho);
         V3 next_dir = gather(vertex, &LaneVertex::next_dir), weight = gather(vertex, &LaneVertex::weight);
         v4d pdf = gather(vertex, &LaneVertex::pdf);
         v4l ok = gather_mask(vertex, &LaneVertex::ok), smooth = gather_mask(vertex, &LaneVertex::smooth);
-        const v4d u_roulette = gather(vertex, &LaneVertex::u_roulette);
+        // The numbers the lane-wise steps read: Sobol ones as drawn (each such lane reads them),
+        // the others from the lanes' records.
+        using Numbers = Sampler::VertexNumbers;
+        const v4d u_roulette = sobol_lanes ? sobol.roulette : gather(numbers, &Numbers::roulette);
+        const V3 rho{v4d{lane_material[0]->rho.x, lane_material[1]->rho.x, lane_material[2]->rho.x,
+                         lane_material[3]->rho.x},
+                     v4d{lane_material[0]->rho.y, lane_material[1]->rho.y, lane_material[2]->rho.y,
+                         lane_material[3]->rho.y},
+                     v4d{lane_material[0]->rho.z, lane_material[1]->rho.z, lane_material[2]->rho.z,
+                         lane_material[3]->rho.z}};
         const V3 shadow_o = p;
         const v4l shadow_from = id;
 
         // area_light_direct (integrator.cpp) for those lanes: the light sample, the diffuse lobe
         // towards it (eval_smooth, pdf_smooth) and the power heuristic.
         if (any_lane(light_lane)) {
-            const V3 light_centre = gather(vertex, &LaneVertex::light_centre);
-            const V3 light_radiance = gather(vertex, &LaneVertex::light_radiance);
-            const v4d light_select = gather(vertex, &LaneVertex::light_select);
-            const v4l light_to = gather(vertex, &LaneVertex::light_to);
-            const v4d u_light_x = gather_x(vertex, &LaneVertex::u_light), u_light_y = gather_y(vertex, &LaneVertex::u_light);
-            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre,
-                                                     gather(vertex, &LaneVertex::light_radius), p, u_light_x, u_light_y,
-                                                     light_lane);
+            const AreaLight* area[4];
+            const SphereGeom* geom[4];
+            for (int k = 0; k < 4; ++k) {
+                area[k] = &scene.area_lights[vertex[k].light_lane ? size_t(vertex[k].light_area) : 0];
+                geom[k] = &scene.spheres[size_t(area[k]->sphere)];
+            }
+            const V3 light_centre{v4d{geom[0]->centre.x, geom[1]->centre.x, geom[2]->centre.x, geom[3]->centre.x},
+                                  v4d{geom[0]->centre.y, geom[1]->centre.y, geom[2]->centre.y, geom[3]->centre.y},
+                                  v4d{geom[0]->centre.z, geom[1]->centre.z, geom[2]->centre.z, geom[3]->centre.z}};
+            const v4d light_radius{geom[0]->radius, geom[1]->radius, geom[2]->radius, geom[3]->radius};
+            const V3 light_radiance{
+                v4d{area[0]->radiance.x, area[1]->radiance.x, area[2]->radiance.x, area[3]->radiance.x},
+                v4d{area[0]->radiance.y, area[1]->radiance.y, area[2]->radiance.y, area[3]->radiance.y},
+                v4d{area[0]->radiance.z, area[1]->radiance.z, area[2]->radiance.z, area[3]->radiance.z}};
+            const v4d light_select{area[0]->select_prob, area[1]->select_prob, area[2]->select_prob,
+                                   area[3]->select_prob};
+            const v4l light_to{area[0]->sphere, area[1]->sphere, area[2]->sphere, area[3]->sphere};
+            const v4d u_light_x = sobol_lanes ? sobol.light_x : gather_x(numbers, &Numbers::light);
+            const v4d u_light_y = sobol_lanes ? sobol.light_y : gather_y(numbers, &Numbers::light);
+            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre, light_radius, p, u_light_x,
+                                                     u_light_y, light_lane);
             const v4d cos_o = dot(ns, ls.wi);
             const v4d lambert = select(cos_o > 0, kInvPi * cos_o, v4d{});
             const V3 f_cos = rho * lambert;
@@ -603,7 +620,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // The diffuse bounce, lane-wise (sample_material's diffuse case).
         if (any_lane(diffuse)) {
             const V3 local =
-                cosine_hemisphere_lanes(gather_x(vertex, &LaneVertex::u_bsdf), gather_y(vertex, &LaneVertex::u_bsdf));
+                cosine_hemisphere_lanes(sobol_lanes ? sobol.bsdf_x : gather_x(numbers, &Numbers::bsdf),
+                                        sobol_lanes ? sobol.bsdf_y : gather_y(numbers, &Numbers::bsdf));
             const v4d cos_pdf = select(local.z > 0, local.z * kInvPi, v4d{});
             next_dir = select(diffuse, to_world_lanes(ns, local), next_dir);
             weight = select(diffuse, rho, weight);
