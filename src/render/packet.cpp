@@ -240,29 +240,38 @@ struct LaneVertex {
     double shadow_tmax, pdf;
     int64_t shadow_into, shadow_to, light_area;
 };
-KR_LANES v4d gather(const LaneVertex (&v)[4], double LaneVertex::*field) {
-    return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+
+// Lanes from one field of four records, or of the four records pointed to: the records are
+// written one lane at a time (a vector stored to lane by lane would stall its next load).
+template <class T>
+KR_LANES const T& record(const T& r) { return r; }
+template <class T>
+KR_LANES const T& record(const T* r) { return *r; }
+template <class R, class T>
+KR_LANES v4d gather(const R (&v)[4], double T::*field) {
+    return v4d{record(v[0]).*field, record(v[1]).*field, record(v[2]).*field, record(v[3]).*field};
 }
-KR_LANES v4l gather(const LaneVertex (&v)[4], int64_t LaneVertex::*field) {
-    return v4l{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+template <class R, class T, class I>  // an index: int or int64_t
+KR_LANES v4l gather(const R (&v)[4], I T::*field) {
+    return v4l{record(v[0]).*field, record(v[1]).*field, record(v[2]).*field, record(v[3]).*field};
 }
-KR_LANES v4l gather_mask(const LaneVertex (&v)[4], bool LaneVertex::*field) {
-    return v4l{-int64_t(v[0].*field), -int64_t(v[1].*field), -int64_t(v[2].*field), -int64_t(v[3].*field)};
+template <class R, class T>
+KR_LANES v4l gather_mask(const R (&v)[4], bool T::*field) {
+    return v4l{-int64_t(record(v[0]).*field), -int64_t(record(v[1]).*field), -int64_t(record(v[2]).*field),
+               -int64_t(record(v[3]).*field)};
 }
-KR_LANES V3 gather(const LaneVertex (&v)[4], Vec3 LaneVertex::*field) {
-    return {v4d{(v[0].*field).x, (v[1].*field).x, (v[2].*field).x, (v[3].*field).x},
-            v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y},
-            v4d{(v[0].*field).z, (v[1].*field).z, (v[2].*field).z, (v[3].*field).z}};
+template <class R, class T>
+KR_LANES V3 gather(const R (&v)[4], Vec3 T::*field) {
+    const Vec3 &a = record(v[0]).*field, &b = record(v[1]).*field, &c = record(v[2]).*field, &d = record(v[3]).*field;
+    return {v4d{a.x, b.x, c.x, d.x}, v4d{a.y, b.y, c.y, d.y}, v4d{a.z, b.z, c.z, d.z}};
 }
-// The same for the vertex numbers of the lanes.
-KR_LANES v4d gather(const Sampler::VertexNumbers (&v)[4], double Sampler::VertexNumbers::*field) {
-    return v4d{v[0].*field, v[1].*field, v[2].*field, v[3].*field};
+template <class R, class T>
+KR_LANES v4d gather_x(const R (&v)[4], Vec2 T::*field) {
+    return v4d{(record(v[0]).*field).x, (record(v[1]).*field).x, (record(v[2]).*field).x, (record(v[3]).*field).x};
 }
-KR_LANES v4d gather_x(const Sampler::VertexNumbers (&v)[4], Vec2 Sampler::VertexNumbers::*field) {
-    return v4d{(v[0].*field).x, (v[1].*field).x, (v[2].*field).x, (v[3].*field).x};
-}
-KR_LANES v4d gather_y(const Sampler::VertexNumbers (&v)[4], Vec2 Sampler::VertexNumbers::*field) {
-    return v4d{(v[0].*field).y, (v[1].*field).y, (v[2].*field).y, (v[3].*field).y};
+template <class R, class T>
+KR_LANES v4d gather_y(const R (&v)[4], Vec2 T::*field) {
+    return v4d{(record(v[0]).*field).y, (record(v[1]).*field).y, (record(v[2]).*field).y, (record(v[3]).*field).y};
 }
 
 // The four paths.
@@ -393,15 +402,9 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             ++next_sample;
         }
         if (any_lane(start)) {
-            const V3 o{v4d{start_ray[0]->o.x, start_ray[1]->o.x, start_ray[2]->o.x, start_ray[3]->o.x},
-                       v4d{start_ray[0]->o.y, start_ray[1]->o.y, start_ray[2]->o.y, start_ray[3]->o.y},
-                       v4d{start_ray[0]->o.z, start_ray[1]->o.z, start_ray[2]->o.z, start_ray[3]->o.z}};
-            const V3 d{v4d{start_ray[0]->d.x, start_ray[1]->d.x, start_ray[2]->d.x, start_ray[3]->d.x},
-                       v4d{start_ray[0]->d.y, start_ray[1]->d.y, start_ray[2]->d.y, start_ray[3]->d.y},
-                       v4d{start_ray[0]->d.z, start_ray[1]->d.z, start_ray[2]->d.z, start_ray[3]->d.z}};
             const V3 zero{v4d{}, v4d{}, v4d{}};
-            paths.o = select(start, o, paths.o);
-            paths.d = select(start, d, paths.d);
+            paths.o = select(start, gather(start_ray, &Ray::o), paths.o);
+            paths.d = select(start, gather(start_ray, &Ray::d), paths.d);
             paths.alive |= start;
             paths.depth = start ? v4l{} : paths.depth;
             paths.from = start ? v4l{} - 1 : paths.from;
@@ -428,13 +431,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // Hit records (RenderScene::hit_at): the point projected back onto its sphere.
         const SphereGeom* hit_sphere[4];
         for (int k = 0; k < 4; ++k) hit_sphere[k] = &scene.spheres[paths.alive[k] ? size_t(id[k]) : 0];
-        const V3 centre{v4d{hit_sphere[0]->centre.x, hit_sphere[1]->centre.x, hit_sphere[2]->centre.x,
-                            hit_sphere[3]->centre.x},
-                        v4d{hit_sphere[0]->centre.y, hit_sphere[1]->centre.y, hit_sphere[2]->centre.y,
-                            hit_sphere[3]->centre.y},
-                        v4d{hit_sphere[0]->centre.z, hit_sphere[1]->centre.z, hit_sphere[2]->centre.z,
-                            hit_sphere[3]->centre.z}};
-        const v4d radius{hit_sphere[0]->radius, hit_sphere[1]->radius, hit_sphere[2]->radius, hit_sphere[3]->radius};
+        const V3 centre = gather(hit_sphere, &SphereGeom::centre);
+        const v4d radius = gather(hit_sphere, &SphereGeom::radius);
         const V3 offset = (paths.o + paths.d * t) - centre;
         const v4d offset_length = sqrt_lanes(dot(offset, offset));
         const V3 n = select(offset_length > 0, offset * (1.0 / offset_length), -paths.d);
@@ -559,12 +557,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // the others from the lanes' records.
         using Numbers = Sampler::VertexNumbers;
         const v4d u_roulette = sobol_lanes ? sobol.roulette : gather(numbers, &Numbers::roulette);
-        const V3 rho{v4d{lane_material[0]->rho.x, lane_material[1]->rho.x, lane_material[2]->rho.x,
-                         lane_material[3]->rho.x},
-                     v4d{lane_material[0]->rho.y, lane_material[1]->rho.y, lane_material[2]->rho.y,
-                         lane_material[3]->rho.y},
-                     v4d{lane_material[0]->rho.z, lane_material[1]->rho.z, lane_material[2]->rho.z,
-                         lane_material[3]->rho.z}};
+        const V3 rho = gather(lane_material, &Material::rho);
         const V3 shadow_o = p;
         const v4l shadow_from = id;
 
@@ -577,21 +570,14 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                 area[k] = &scene.area_lights[vertex[k].light_lane ? size_t(vertex[k].light_area) : 0];
                 geom[k] = &scene.spheres[size_t(area[k]->sphere)];
             }
-            const V3 light_centre{v4d{geom[0]->centre.x, geom[1]->centre.x, geom[2]->centre.x, geom[3]->centre.x},
-                                  v4d{geom[0]->centre.y, geom[1]->centre.y, geom[2]->centre.y, geom[3]->centre.y},
-                                  v4d{geom[0]->centre.z, geom[1]->centre.z, geom[2]->centre.z, geom[3]->centre.z}};
-            const v4d light_radius{geom[0]->radius, geom[1]->radius, geom[2]->radius, geom[3]->radius};
-            const V3 light_radiance{
-                v4d{area[0]->radiance.x, area[1]->radiance.x, area[2]->radiance.x, area[3]->radiance.x},
-                v4d{area[0]->radiance.y, area[1]->radiance.y, area[2]->radiance.y, area[3]->radiance.y},
-                v4d{area[0]->radiance.z, area[1]->radiance.z, area[2]->radiance.z, area[3]->radiance.z}};
-            const v4d light_select{area[0]->select_prob, area[1]->select_prob, area[2]->select_prob,
-                                   area[3]->select_prob};
-            const v4l light_to{area[0]->sphere, area[1]->sphere, area[2]->sphere, area[3]->sphere};
+            const V3 light_radiance = gather(area, &AreaLight::radiance);
+            const v4d light_select = gather(area, &AreaLight::select_prob);
+            const v4l light_to = gather(area, &AreaLight::sphere);
             const v4d u_light_x = sobol_lanes ? sobol.light_x : gather_x(numbers, &Numbers::light);
             const v4d u_light_y = sobol_lanes ? sobol.light_y : gather_y(numbers, &Numbers::light);
-            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre, light_radius, p, u_light_x,
-                                                     u_light_y, light_lane);
+            const LightLanes ls = sample_light_lanes(settings.light_sampling, gather(geom, &SphereGeom::centre),
+                                                     gather(geom, &SphereGeom::radius), p, u_light_x, u_light_y,
+                                                     light_lane);
             const v4d cos_o = dot(ns, ls.wi);
             const v4d lambert = select(cos_o > 0, kInvPi * cos_o, v4d{});
             const V3 f_cos = rho * lambert;
