@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "core/math.h"
 
@@ -82,10 +83,13 @@ inline __attribute__((always_inline)) T log_normal_positive(T x) {
     return k * kLn2High + (f - (s * (f - tail) - k * kLn2Low));
 }
 #pragma GCC diagnostic pop
+// log_normal_positive's range.
+inline constexpr double kSmallestNormal = std::numeric_limits<double>::min();
+inline constexpr double kLargestFinite = std::numeric_limits<double>::max();
 // One double: log_normal_positive in its range, libm outside it (0, subnormals, infinity,
 // NaN and negatives keep their libm answers).
 inline double log_positive(double x) {
-    return x >= 0x1.0p-1022 && x <= 0x1.fffffffffffffp1023 ? log_normal_positive<double, uint64_t>(x) : std::log(x);
+    return x >= kSmallestNormal && x <= kLargestFinite ? log_normal_positive<double, uint64_t>(x) : std::log(x);
 }
 
 // Cosine-weighted direction about +z (Malley: concentric disk lifted to the hemisphere).

@@ -76,6 +76,15 @@ double emission_weight(const RenderScene& scene, LightSampling sampling, const A
            (p_bsdf * p_bsdf + p_light * p_light);
 }
 
+namespace {
+
+// The light next-event estimation takes for the number `u`, chosen in proportion to power:
+// a point light's index or an area light's (the last one where rounding leaves `u` above the
+// total), or neither. Naive path tracing takes point lights only. (packet.cpp makes the same
+// choice lane-wise.)
+struct LightChoice {
+    int point = -1, area = -1;
+};
 LightChoice choose_light(const RenderScene& scene, bool naive, double u) {
     LightChoice choice;
     for (size_t i = 0; i < scene.point_lights.size(); ++i) {
@@ -96,6 +105,8 @@ LightChoice choose_light(const RenderScene& scene, bool naive, double u) {
     }
     return choice;
 }
+
+}  // namespace
 
 bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
                       const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
@@ -205,7 +216,6 @@ struct Tracer {
         }
         return L;
     }
-
 
     // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
     Color path(Ray ray, double* primary_distance) {

@@ -164,7 +164,7 @@ KR_LANES LightLanes sample_light_lanes(LightSampling strategy, const V3& centre,
     // too where a lane's ratio is outside log_normal_positive's range.
     const v4d a = d * d + radius * radius, b = 2 * d * radius, gap = d - radius;
     const v4d ratio = a / (gap * gap);
-    const v4l normal = (ratio >= 0x1.0p-1022) & (ratio <= 0x1.fffffffffffffp1023);
+    const v4l normal = (ratio >= kSmallestNormal) & (ratio <= kLargestFinite);
     v4d v_max = select(lanes, log_normal_positive<v4d, v4u>(select(normal, ratio, splat(1.0))), v4d{});
     if (any_lane(lanes & ~normal))
         for (int k = 0; k < 4; ++k)
@@ -353,19 +353,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     // Area-light samples lane-wise: the `brief` and `cone` strategies (the others per lane).
     const bool lane_lights = !naive && (settings.light_sampling == LightSampling::brief ||
                                         settings.light_sampling == LightSampling::cone);
-    Paths paths;
-    paths.alive = v4l{};
-    paths.depth = v4l{};
-    paths.from = v4l{} - 1;
-    paths.into = v4l{};
-    paths.throughput = {splat(1), splat(1), splat(1)};
-    paths.L = {v4d{}, v4d{}, v4d{}};
-    paths.full_emission = ~v4l{};
-    paths.last_bsdf_pdf = v4d{};
-    paths.last_p = {v4d{}, v4d{}, v4d{}};
-    paths.last_sphere = v4l{} - 1;
-    paths.primary_distance = splat(kMissDepth);
-    paths.o = paths.d = {v4d{}, v4d{}, splat(1)};
+    Paths paths{};  // no lane alive: each path's state is set where its lane starts it, below
     int lane_sample[4] = {-1, -1, -1, -1};  // the sample each lane traces
     Sampler* lane_sampler[4] = {};
     int next_sample = 0;
@@ -457,12 +445,17 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const v4l front = dot(paths.d, n) < 0;
         const V3 ns = select(front, n, -n);
 
-        // The numbers each vertex reads (vertex_numbers_used), and Sobol samplers' in lanes.
+        // Each vertex's material and the numbers it reads (vertex_numbers_used), and Sobol
+        // samplers' numbers in lanes.
+        const Material* lane_material[4] = {&scene.materials[0], &scene.materials[0], &scene.materials[0],
+                                            &scene.materials[0]};
         unsigned use[4] = {}, use_any = 0;
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
+            const size_t material = size_t(scene.sphere_material[size_t(id[k])]);
+            lane_material[k] = &scene.materials[material];
             const bool roulette = paths.depth[k] + 1 >= settings.rr_depth;
-            use[k] = numbers_used[size_t(scene.sphere_material[size_t(id[k])])] | (roulette ? Sampler::use_roulette : 0u);
+            use[k] = numbers_used[material] | (roulette ? Sampler::use_roulette : 0u);
             use_any |= use[k];
         }
         VertexLanes sobol;
@@ -502,13 +495,10 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // functions one path uses). Written to plain records and gathered into lanes after the
         // loop: stores into single lanes of a vector would stall its next load.
         LaneVertex vertex[4] = {};
-        const Material* lane_material[4] = {&scene.materials[0], &scene.materials[0], &scene.materials[0],
-                                            &scene.materials[0]};
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
             LaneVertex& v = vertex[k];
-            const Material& m = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
-            lane_material[k] = &m;
+            const Material& m = *lane_material[k];
             const Sampler::VertexNumbers& u = numbers[k];
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const SurfacePoint sp{hit.n, front[k] != 0};

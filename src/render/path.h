@@ -26,14 +26,6 @@ struct PathHistory {
 double emission_weight(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Hit& hit,
                        const Vec3& incoming, const PathHistory& history);
 
-// The light next-event estimation takes for the number `u`, chosen in proportion to power:
-// a point light's index or an area light's (the last one where rounding leaves `u` above the
-// total), or neither. Naive path tracing takes point lights only.
-struct LightChoice {
-    int point = -1, area = -1;
-};
-LightChoice choose_light(const RenderScene& scene, bool naive, double u);
-
 // Next-event estimation: one light, chosen in proportion to its power (point lights cannot be
 // hit by chance, so even naive mode samples them). The chosen light's shadow ray, and the
 // light it brings over the selection probability if nothing blocks that ray; false: nothing.

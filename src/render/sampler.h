@@ -3,7 +3,6 @@
 // Owen-scrambled Sobol sequence that stays stratified at every sample count.
 #pragma once
 
-#include <array>
 #include <cstdint>
 #include <type_traits>
 
@@ -187,10 +186,6 @@ public:
     uint32_t dimension() const { return dimension_; }
     void skip_dimensions(uint32_t count) { dimension_ += count; }
 
-    // A 32-bit binary fraction to a double in (0, 1): the centre of its 2^-32 interval, so
-    // the sample never lands on 0 (where some warps have a zero density) nor on 1.
-    static double to_unit(uint32_t fraction) { return (double(fraction) + 0.5) * 0x1.0p-32; }
-
 private:
     double draw_1d(bool used) {
         if (used) return next_1d();
@@ -202,6 +197,10 @@ private:
         skip_2d();
         return {};
     }
+    // A 32-bit binary fraction to a double in (0, 1): the centre of its 2^-32 interval, so
+    // the sample never lands on 0 (where some warps have a zero density) nor on 1.
+    static double to_unit(uint32_t fraction) { return (double(fraction) + 0.5) * 0x1.0p-32; }
+
     SobolDimension<uint32_t> next_dimension() {
         return SobolDimension<uint32_t>(sobol_key_, index_reversed_, dimension_++);
     }
