@@ -235,10 +235,10 @@ KR_LANES VertexLanes sobol_vertex_lanes(v4w key, v4w index_reversed, v4w d, bool
 // lane-wise part. All zeros for a lane with nothing to do: the lane-wise part masks what such a
 // lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
 struct LaneVertex {
-    bool shadow, light_lane, diffuse, ok, smooth;
+    bool shadow, ok, smooth;
     Vec3 shadow_d, direct, next_dir, weight;
     double shadow_tmax, pdf;
-    int64_t shadow_into, shadow_to, light_area;
+    int64_t shadow_into, shadow_to;
 };
 
 // Lanes from one field of four records, or of the four records pointed to: the records are
@@ -458,7 +458,15 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             use[k] = numbers_used[material] | (roulette ? Sampler::use_roulette : 0u);
             use_any |= use[k];
         }
+        // has_smooth_lobe, lane-wise.
+        const v4l diffuse = paths.alive & v4l{-int64_t(lane_material[0]->type == MaterialType::diffuse),
+                                              -int64_t(lane_material[1]->type == MaterialType::diffuse),
+                                              -int64_t(lane_material[2]->type == MaterialType::diffuse),
+                                              -int64_t(lane_material[3]->type == MaterialType::diffuse)};
+        using Numbers = Sampler::VertexNumbers;
+        Numbers numbers[4];  // per lane: those its vertex reads, 0 for the others, as next_vertex gives
         VertexLanes sobol;
+        v4d u_pick;
         if (sobol_lanes) {
             v4w key{}, index_reversed{}, dimension{};
             for (int k = 0; k < 4; ++k) {
@@ -469,83 +477,93 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                 lane_sampler[k]->skip_dimensions(5);
             }
             sobol = sobol_vertex_lanes(key, index_reversed, dimension, use_any & Sampler::use_lobe);
+            const v4l pick_read = v4l{-int64_t((use[0] & Sampler::use_light_pick) != 0),
+                                      -int64_t((use[1] & Sampler::use_light_pick) != 0),
+                                      -int64_t((use[2] & Sampler::use_light_pick) != 0),
+                                      -int64_t((use[3] & Sampler::use_light_pick) != 0)};
+            u_pick = select(pick_read, sobol.light_pick, v4d{});
+        } else {
+            for (int k = 0; k < 4; ++k)
+                if (paths.alive[k]) numbers[k] = lane_sampler[k]->next_vertex(use[k]);
+            u_pick = gather(numbers, &Numbers::light_pick);
         }
 
-        // Each lane's numbers: those its vertex reads, 0 for the others, as next_vertex gives.
-        Sampler::VertexNumbers numbers[4];
-        for (int k = 0; k < 4; ++k) {
-            if (!paths.alive[k]) continue;
-            Sampler::VertexNumbers& u = numbers[k];
-            if (sobol_lanes) {
-                if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
-                if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
-                if (use[k] & Sampler::use_lobe) u.lobe = sobol.lobe[k];
-                if (use[k] & Sampler::use_bsdf) u.bsdf = {sobol.bsdf_x[k], sobol.bsdf_y[k]};
-                if (use[k] & Sampler::use_roulette) u.roulette = sobol.roulette[k];
-            } else {
-                u = lane_sampler[k]->next_vertex(use[k]);
+        // Diffuse vertices whose chosen light is an area light seen from outside (not the hit
+        // sphere, the point outside it) sample it lane-wise, below.
+        v4l light_lane{}, light_to{};
+        v4d light_select{}, light_radius{};
+        V3 light_centre{};
+        const AreaLight* area[4];
+        const SphereGeom* geom[4];
+        if (lane_lights && !scene.area_lights.empty()) {
+            const v4l area_index = diffuse ? area_choice_lanes(scene, u_pick) : v4l{} - 1;
+            for (int k = 0; k < 4; ++k) {
+                area[k] = &scene.area_lights[area_index[k] >= 0 ? size_t(area_index[k]) : 0];
+                geom[k] = &scene.spheres[size_t(area[k]->sphere)];
             }
+            light_select = gather(area, &AreaLight::select_prob);
+            light_to = gather(area, &AreaLight::sphere);
+            light_centre = gather(geom, &SphereGeom::centre);
+            light_radius = gather(geom, &SphereGeom::radius);
+            const V3 from_light = p - light_centre;
+            light_lane = (area_index >= 0) & (light_select > 0) & (light_to != id) &
+                         (dot(from_light, from_light) > light_radius * light_radius);
         }
-        const v4l area_choice =
-            lane_lights ? area_choice_lanes(scene, v4d{numbers[0].light_pick, numbers[1].light_pick,
-                                                       numbers[2].light_pick, numbers[3].light_pick})
-                        : v4l{} - 1;
 
-        // Per lane: the vertex's light sample and, off the diffuse lobe, its scattering (the
-        // functions one path uses). Written to plain records and gathered into lanes after the
-        // loop: stores into single lanes of a vector would stall its next load.
-        LaneVertex vertex[4] = {};
-        for (int k = 0; k < 4; ++k) {
-            if (!paths.alive[k]) continue;
-            LaneVertex& v = vertex[k];
-            const Material& m = *lane_material[k];
-            const Sampler::VertexNumbers& u = numbers[k];
-            const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
-            const SurfacePoint sp{hit.n, front[k] != 0};
-            int area = lane_lights && has_smooth_lobe(m) ? int(area_choice[k]) : -1;
-            if (area >= 0 && !(scene.area_lights[size_t(area)].select_prob > 0)) area = -1;  // a black light
-            const int light_sphere = area >= 0 ? scene.area_lights[size_t(area)].sphere : -1;
-            const SphereGeom* light_geom = area >= 0 ? &scene.spheres[size_t(light_sphere)] : nullptr;
-            if (light_geom && light_sphere != hit.sphere &&
-                dot(hit.p - light_geom->centre, hit.p - light_geom->centre) > light_geom->radius * light_geom->radius) {
-                // An area light seen from outside: sampled lane-wise below.
-                v.light_lane = true;
-                v.light_area = area;
-            } else if (has_smooth_lobe(m) && next_event_possible) {
-                Ray shadow;
-                Color light;
-                if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, light)) {
-                    v.shadow = true;
-                    v.shadow_d = shadow.d;
-                    v.shadow_tmax = shadow.tmax;
-                    v.shadow_into = shadow.into_from_sphere ? -1 : 0;
-                    v.shadow_to = shadow.to_sphere;
-                    v.direct = lane(paths.throughput, k) * light;
+        // Per lane, through the functions one path uses: other lights' samples at diffuse
+        // vertices, and scattering off the other materials. Written to plain records and
+        // gathered into lanes after the loop: stores into single lanes of a vector would stall
+        // its next load.
+        const v4l per_lane = paths.alive & (~diffuse | (next_event_possible ? ~light_lane : v4l{}));
+        v4l shadow_cast{}, shadow_into{}, shadow_to{}, ok{}, smooth{};
+        V3 shadow_d = ns, direct{}, next_dir{}, weight{};
+        v4d shadow_tmax{}, pdf{};
+        if (any_lane(per_lane)) {
+            LaneVertex vertex[4] = {};
+            for (int k = 0; k < 4; ++k) {
+                if (!per_lane[k]) continue;
+                LaneVertex& v = vertex[k];
+                const Material& m = *lane_material[k];
+                Numbers& u = numbers[k];
+                if (sobol_lanes) {
+                    if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
+                    if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
+                    if (use[k] & Sampler::use_lobe) u.lobe = sobol.lobe[k];
+                    if (use[k] & Sampler::use_bsdf) u.bsdf = {sobol.bsdf_x[k], sobol.bsdf_y[k]};
                 }
+                const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
+                const SurfacePoint sp{hit.n, front[k] != 0};
+                if (has_smooth_lobe(m)) {
+                    Ray shadow;
+                    Color light;
+                    if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, light)) {
+                        v.shadow = true;
+                        v.shadow_d = shadow.d;
+                        v.shadow_tmax = shadow.tmax;
+                        v.shadow_into = shadow.into_from_sphere ? -1 : 0;
+                        v.shadow_to = shadow.to_sphere;
+                        v.direct = lane(paths.throughput, k) * light;
+                    }
+                    continue;  // the diffuse bounce is lane-wise
+                }
+                ScatterSample s;
+                v.ok = sample_material(m, sp, lane(paths.d, k), u.lobe, u.bsdf, s);
+                v.next_dir = s.direction;
+                v.weight = s.weight;
+                v.pdf = s.pdf;
+                v.smooth = s.smooth;
             }
-            if (m.type == MaterialType::diffuse) {
-                v.diffuse = true;
-                continue;
-            }
-            ScatterSample s;
-            v.ok = sample_material(m, sp, lane(paths.d, k), u.lobe, u.bsdf, s);
-            v.next_dir = s.direction;
-            v.weight = s.weight;
-            v.pdf = s.pdf;
-            v.smooth = s.smooth;
+            shadow_cast = gather_mask(vertex, &LaneVertex::shadow);
+            shadow_d = select(shadow_cast, gather(vertex, &LaneVertex::shadow_d), ns);
+            shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
+            shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
+            direct = gather(vertex, &LaneVertex::direct);
+            next_dir = gather(vertex, &LaneVertex::next_dir), weight = gather(vertex, &LaneVertex::weight);
+            pdf = gather(vertex, &LaneVertex::pdf);
+            ok = gather_mask(vertex, &LaneVertex::ok), smooth = gather_mask(vertex, &LaneVertex::smooth);
         }
-        v4l shadow_cast = gather_mask(vertex, &LaneVertex::shadow);
-        const v4l diffuse = gather_mask(vertex, &LaneVertex::diffuse), light_lane = gather_mask(vertex, &LaneVertex::light_lane);
-        V3 shadow_d = select(shadow_cast, gather(vertex, &LaneVertex::shadow_d), ns);
-        v4d shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
-        v4l shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
-        V3 direct = gather(vertex, &LaneVertex::direct);
-        V3 next_dir = gather(vertex, &LaneVertex::next_dir), weight = gather(vertex, &LaneVertex::weight);
-        v4d pdf = gather(vertex, &LaneVertex::pdf);
-        v4l ok = gather_mask(vertex, &LaneVertex::ok), smooth = gather_mask(vertex, &LaneVertex::smooth);
         // The numbers the lane-wise steps read: Sobol ones as drawn (each such lane reads them),
         // the others from the lanes' records.
-        using Numbers = Sampler::VertexNumbers;
         const v4d u_roulette = sobol_lanes ? sobol.roulette : gather(numbers, &Numbers::roulette);
         const V3 rho = gather(lane_material, &Material::rho);
         const V3 shadow_o = p;
@@ -554,20 +572,11 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // area_light_direct (integrator.cpp) for those lanes: the light sample, the diffuse lobe
         // towards it (eval_smooth, pdf_smooth) and the power heuristic.
         if (any_lane(light_lane)) {
-            const AreaLight* area[4];
-            const SphereGeom* geom[4];
-            for (int k = 0; k < 4; ++k) {
-                area[k] = &scene.area_lights[vertex[k].light_lane ? size_t(vertex[k].light_area) : 0];
-                geom[k] = &scene.spheres[size_t(area[k]->sphere)];
-            }
             const V3 light_radiance = gather(area, &AreaLight::radiance);
-            const v4d light_select = gather(area, &AreaLight::select_prob);
-            const v4l light_to = gather(area, &AreaLight::sphere);
             const v4d u_light_x = sobol_lanes ? sobol.light_x : gather_x(numbers, &Numbers::light);
             const v4d u_light_y = sobol_lanes ? sobol.light_y : gather_y(numbers, &Numbers::light);
-            const LightLanes ls = sample_light_lanes(settings.light_sampling, gather(geom, &SphereGeom::centre),
-                                                     gather(geom, &SphereGeom::radius), p, u_light_x, u_light_y,
-                                                     light_lane);
+            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre, light_radius, p, u_light_x,
+                                                     u_light_y, light_lane);
             const v4d cos_o = dot(ns, ls.wi);
             const v4d lambert = select(cos_o > 0, kInvPi * cos_o, v4d{});
             const V3 f_cos = rho * lambert;
