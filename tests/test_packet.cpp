@@ -112,6 +112,13 @@ TEST(Packet, PointLightsEveryMaterialAndPartialPackets) {
     const int frosted = b.material(MaterialType::translucent, Color(0.9));
     b.scene.materials[size_t(glossy)].roughness = 0.3;
     b.scene.materials[size_t(frosted)].roughness = 0.2;
+    // Reflected and transmitted fractions that differ, and two indices, so that a branch
+    // taken or weighted wrongly shows.
+    for (int dielectric : {glass, frosted}) {
+        b.scene.materials[size_t(dielectric)].rho_r = Color(0.95, 0.7, 0.5);
+        b.scene.materials[size_t(dielectric)].rho_t = Color(0.5, 0.8, 0.95);
+    }
+    b.scene.materials[size_t(frosted)].eta = 1.33;
     b.sphere({0, -1005, 0}, 1000, grey);
     b.sphere({-3, -3, 2}, 2, mirror);
     b.sphere({3, -3, 2}, 2, glossy);

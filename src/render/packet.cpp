@@ -235,9 +235,9 @@ KR_LANES VertexLanes sobol_vertex_lanes(v4w key, v4w index_reversed, v4w d, bool
 // lane-wise part. All zeros for a lane with nothing to do: the lane-wise part masks what such a
 // lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
 struct LaneVertex {
-    bool shadow, ok, smooth;
-    Vec3 shadow_d, direct, next_dir, weight;
-    double shadow_tmax, pdf;
+    bool shadow;
+    Vec3 shadow_d, direct;
+    double shadow_tmax;
     int64_t shadow_into, shadow_to;
 };
 
@@ -272,6 +272,81 @@ KR_LANES v4d gather_x(const R (&v)[4], Vec2 T::*field) {
 template <class R, class T>
 KR_LANES v4d gather_y(const R (&v)[4], Vec2 T::*field) {
     return v4d{(record(v[0]).*field).y, (record(v[1]).*field).y, (record(v[2]).*field).y, (record(v[3]).*field).y};
+}
+
+// The lanes whose material is of the given type.
+KR_LANES v4l of_type(const Material* const (&material)[4], MaterialType type) {
+    return v4l{-int64_t(material[0]->type == type), -int64_t(material[1]->type == type),
+               -int64_t(material[2]->type == type), -int64_t(material[3]->type == type)};
+}
+
+KR_LANES V3 normalize_lanes(const V3& a) {  // normalize (core/math.h): a / length(a)
+    const v4d length = sqrt_lanes(dot(a, a));
+    return {a.x / length, a.y / length, a.z / length};
+}
+
+// sample_material (material.cpp) for the mirror, glossy and dielectric materials: the same
+// reflection, Fresnel split (split_dielectric, fresnel_dielectric, refract in core/math.h),
+// choice of branch and perturbation by roughness (brief eq. 2), lane-wise. None of them has
+// a smooth lobe, so there is no density.
+struct ScatterLanes {
+    V3 direction, weight;
+    v4l ok;
+};
+KR_LANES ScatterLanes scatter_lanes(const Material* const (&material)[4], v4l lanes, const V3& wi, const V3& ns,
+                                    v4l front, v4d u_lobe, v4d u_x, v4d u_y) {
+    const v4l specular = lanes & of_type(material, MaterialType::specular);
+    const v4l glossy = lanes & of_type(material, MaterialType::glossy);
+    const v4l translucent = lanes & of_type(material, MaterialType::translucent);
+    const v4l dielectric = (lanes & of_type(material, MaterialType::dielectric)) | translucent;
+    const v4d wi_n = dot(wi, ns);
+    const V3 reflected = wi - ns * (2.0 * wi_n);
+    v4l reflect_branch = ~dielectric;
+    V3 direction = reflected;
+    if (any_lane(dielectric)) {
+        const v4d eta = gather(material, &Material::eta);
+        const v4d eta_ratio = select(front, 1.0 / eta, eta);  // incident over transmitted
+        const v4d eta2 = eta_ratio * eta_ratio;
+        // fresnel_dielectric(-dot(wi, ns), eta_ratio), its cosine clamped to [0, 1]
+        const v4d cos_i = -wi_n;
+        const v4d cos_f = select(cos_i < 0, v4d{}, select(1.0 < cos_i, splat(1.0), cos_i));
+        const v4d sin2_f = eta2 * (1.0 - cos_f * cos_f);
+        const v4d cos_tf = sqrt_lanes(1.0 - sin2_f);
+        const v4d r_s = (eta_ratio * cos_f - cos_tf) / (eta_ratio * cos_f + cos_tf);
+        const v4d r_p = (cos_f - eta_ratio * cos_tf) / (cos_f + eta_ratio * cos_tf);
+        v4d reflectance = select(sin2_f >= 1.0, splat(1.0), 0.5 * (r_s * r_s + r_p * r_p));
+        // refract: total internal reflection where it fails, rounding included
+        const v4d one_minus = 1.0 - cos_i * cos_i;
+        const v4d sin2_t = eta2 * select(0.0 < one_minus, one_minus, v4d{});
+        const v4l refracts = ~(sin2_t >= 1.0);
+        const v4d cos_t = sqrt_lanes(1.0 - sin2_t);
+        const V3 transmitted = normalize_lanes(wi * eta_ratio + ns * (eta_ratio * cos_i - cos_t));
+        reflectance = select((reflectance < 1.0) & ~refracts, splat(1.0), reflectance);
+        reflect_branch |= u_lobe < reflectance;
+        direction = select(reflect_branch, reflected, transmitted);
+    }
+    const v4d beta = select(glossy | translucent, gather(material, &Material::roughness), v4d{});
+    const v4l rough = beta > 0;
+    if (any_lane(rough)) {
+        // perturb_direction: sample_uniform_sphere times beta added, then normalised
+        const v4d z = 1.0 - 2.0 * u_x;
+        const v4d one_minus = 1.0 - z * z;
+        const v4d r = sqrt_lanes(select(0.0 < one_minus, one_minus, v4d{}));
+        v4d s, c;
+        sin_cos_turns_lanes(u_y, s, c);
+        direction = select(rough, normalize_lanes(direction + V3{r * c, r * s, z} * beta), direction);
+    }
+    ScatterLanes out;
+    out.direction = direction;
+    const v4d cos_out = dot(direction, ns);
+    out.ok = specular | (reflect_branch ? v4l(cos_out > 0) : v4l(cos_out < 0));
+    const V3 rho = gather(material, &Material::rho);
+    out.weight = rho;
+    if (any_lane(dielectric))
+        out.weight = select(dielectric,
+                            select(reflect_branch, gather(material, &Material::rho_r), gather(material, &Material::rho_t)),
+                            rho);
+    return out;
 }
 
 // The four paths.
@@ -459,10 +534,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             use_any |= use[k];
         }
         // has_smooth_lobe, lane-wise.
-        const v4l diffuse = paths.alive & v4l{-int64_t(lane_material[0]->type == MaterialType::diffuse),
-                                              -int64_t(lane_material[1]->type == MaterialType::diffuse),
-                                              -int64_t(lane_material[2]->type == MaterialType::diffuse),
-                                              -int64_t(lane_material[3]->type == MaterialType::diffuse)};
+        const v4l diffuse = paths.alive & of_type(lane_material, MaterialType::diffuse);
         using Numbers = Sampler::VertexNumbers;
         Numbers numbers[4];  // per lane: those its vertex reads, 0 for the others, as next_vertex gives
         VertexLanes sobol;
@@ -510,57 +582,43 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                          (dot(from_light, from_light) > light_radius * light_radius);
         }
 
-        // Per lane, through the functions one path uses: other lights' samples at diffuse
-        // vertices, and scattering off the other materials. Written to plain records and
-        // gathered into lanes after the loop: stores into single lanes of a vector would stall
-        // its next load.
-        const v4l per_lane = paths.alive & (~diffuse | (next_event_possible ? ~light_lane : v4l{}));
-        v4l shadow_cast{}, shadow_into{}, shadow_to{}, ok{}, smooth{};
-        V3 shadow_d = ns, direct{}, next_dir{}, weight{};
-        v4d shadow_tmax{}, pdf{};
+        // Per lane, through the functions one path uses: the samples of other lights (point
+        // lights, lights around the vertex, the `area` and `brief-area` strategies) at diffuse
+        // vertices. Written to plain records and gathered into lanes after the loop: stores
+        // into single lanes of a vector would stall its next load.
+        const v4l per_lane = next_event_possible ? diffuse & ~light_lane : v4l{};
+        v4l shadow_cast{}, shadow_into{}, shadow_to{};
+        V3 shadow_d = ns, direct{};
+        v4d shadow_tmax{};
         if (any_lane(per_lane)) {
             LaneVertex vertex[4] = {};
             for (int k = 0; k < 4; ++k) {
                 if (!per_lane[k]) continue;
-                LaneVertex& v = vertex[k];
-                const Material& m = *lane_material[k];
                 Numbers& u = numbers[k];
                 if (sobol_lanes) {
                     if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
                     if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
-                    if (use[k] & Sampler::use_lobe) u.lobe = sobol.lobe[k];
-                    if (use[k] & Sampler::use_bsdf) u.bsdf = {sobol.bsdf_x[k], sobol.bsdf_y[k]};
                 }
                 const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
                 const SurfacePoint sp{hit.n, front[k] != 0};
-                if (has_smooth_lobe(m)) {
-                    Ray shadow;
-                    Color light;
-                    if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, light)) {
-                        v.shadow = true;
-                        v.shadow_d = shadow.d;
-                        v.shadow_tmax = shadow.tmax;
-                        v.shadow_into = shadow.into_from_sphere ? -1 : 0;
-                        v.shadow_to = shadow.to_sphere;
-                        v.direct = lane(paths.throughput, k) * light;
-                    }
-                    continue;  // the diffuse bounce is lane-wise
+                Ray shadow;
+                Color light;
+                LaneVertex& v = vertex[k];
+                if (sample_one_light(scene, settings, *lane_material[k], hit, sp, u.light_pick, u.light, shadow,
+                                     light)) {
+                    v.shadow = true;
+                    v.shadow_d = shadow.d;
+                    v.shadow_tmax = shadow.tmax;
+                    v.shadow_into = shadow.into_from_sphere ? -1 : 0;
+                    v.shadow_to = shadow.to_sphere;
+                    v.direct = lane(paths.throughput, k) * light;
                 }
-                ScatterSample s;
-                v.ok = sample_material(m, sp, lane(paths.d, k), u.lobe, u.bsdf, s);
-                v.next_dir = s.direction;
-                v.weight = s.weight;
-                v.pdf = s.pdf;
-                v.smooth = s.smooth;
             }
             shadow_cast = gather_mask(vertex, &LaneVertex::shadow);
             shadow_d = select(shadow_cast, gather(vertex, &LaneVertex::shadow_d), ns);
             shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
             shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
             direct = gather(vertex, &LaneVertex::direct);
-            next_dir = gather(vertex, &LaneVertex::next_dir), weight = gather(vertex, &LaneVertex::weight);
-            pdf = gather(vertex, &LaneVertex::pdf);
-            ok = gather_mask(vertex, &LaneVertex::ok), smooth = gather_mask(vertex, &LaneVertex::smooth);
         }
         // The numbers the lane-wise steps read: Sobol ones as drawn (each such lane reads them),
         // the others from the lanes' records.
@@ -602,18 +660,31 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             paths.L = select(clear, paths.L + direct, paths.L);
         }
 
-        // The diffuse bounce, lane-wise (sample_material's diffuse case).
+        // The next direction: the diffuse bounce (sample_material's diffuse case) and the other
+        // materials' scattering, lane-wise.
+        const v4d u_bsdf_x = sobol_lanes ? sobol.bsdf_x : gather_x(numbers, &Numbers::bsdf);
+        const v4d u_bsdf_y = sobol_lanes ? sobol.bsdf_y : gather_y(numbers, &Numbers::bsdf);
+        V3 next_dir{}, weight{};
+        v4d pdf{};
+        v4l ok{};
+        const v4l other = paths.alive & ~diffuse;
+        if (any_lane(other)) {
+            const ScatterLanes scatter =
+                scatter_lanes(lane_material, other, paths.d, ns, front,
+                              sobol_lanes ? sobol.lobe : gather(numbers, &Numbers::lobe), u_bsdf_x, u_bsdf_y);
+            next_dir = scatter.direction;
+            weight = scatter.weight;
+            ok = other & scatter.ok;
+        }
         if (any_lane(diffuse)) {
-            const V3 local =
-                cosine_hemisphere_lanes(sobol_lanes ? sobol.bsdf_x : gather_x(numbers, &Numbers::bsdf),
-                                        sobol_lanes ? sobol.bsdf_y : gather_y(numbers, &Numbers::bsdf));
+            const V3 local = cosine_hemisphere_lanes(u_bsdf_x, u_bsdf_y);
             const v4d cos_pdf = select(local.z > 0, local.z * kInvPi, v4d{});
             next_dir = select(diffuse, to_world_lanes(ns, local), next_dir);
             weight = select(diffuse, rho, weight);
             pdf = select(diffuse, cos_pdf, pdf);
             ok = diffuse ? v4l(cos_pdf > 0) : ok;
-            smooth |= diffuse;
         }
+        const v4l smooth = diffuse;
         paths.alive &= ok;
         paths.throughput = select(paths.alive, paths.throughput * weight, V3{v4d{}, v4d{}, v4d{}});
         paths.full_emission = naive ? ~v4l{} : ~smooth;
