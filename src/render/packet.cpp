@@ -1,8 +1,10 @@
 // Path tracing of four samples at once, their paths in the lanes of SIMD registers (AVX2 where
-// the CPU has it). Casting rays, hit records, the diffuse bounce, throughput and Russian
-// roulette run lane-wise; the samplers, light samples and other materials run per lane
-// through the same functions as one path (path.h), so every path is the one trace_sample
-// gives, up to rounding. docs/performance.md ("Paths in lanes") has what it buys.
+// the CPU has it). Casting rays, hit records, Sobol numbers, the light choice, the `brief`
+// and `cone` light samples, every material's scattering, throughput and Russian roulette
+// run lane-wise, as copies of the one-path routines, operation for operation; the other
+// light samples, emission weights and other estimators' numbers run per lane through the
+// same functions as one path (path.h). So every path is the one trace_sample gives, up to
+// rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
 #include <algorithm>
 #include <cmath>
 #include <limits>
