@@ -233,7 +233,7 @@ KR_LANES VertexLanes sobol_vertex_lanes(v4w key, v4w index_reversed, v4w d, bool
     return v;
 }
 
-// What a path vertex's per-lane part (samplers, light choice, other materials) hands to the
+// What a path vertex's per-lane part (the light samples taken one lane at a time) hands to the
 // lane-wise part. All zeros for a lane with nothing to do: the lane-wise part masks what such a
 // lane computes (zeros, as one block of stores, cost a fifth of what member defaults did).
 struct LaneVertex {
@@ -295,8 +295,8 @@ struct ScatterLanes {
     V3 direction, weight;
     v4l ok;
 };
-KR_LANES ScatterLanes scatter_lanes(const Material* const (&material)[4], v4l lanes, const V3& wi, const V3& ns,
-                                    v4l front, v4d u_lobe, v4d u_x, v4d u_y) {
+KR_LANES ScatterLanes scatter_lanes(const Material* const (&material)[4], const V3& rho, v4l lanes, const V3& wi,
+                                    const V3& ns, v4l front, v4d u_lobe, v4d u_x, v4d u_y) {
     const v4l specular = lanes & of_type(material, MaterialType::specular);
     const v4l glossy = lanes & of_type(material, MaterialType::glossy);
     const v4l translucent = lanes & of_type(material, MaterialType::translucent);
@@ -342,7 +342,6 @@ KR_LANES ScatterLanes scatter_lanes(const Material* const (&material)[4], v4l la
     out.direction = direction;
     const v4d cos_out = dot(direction, ns);
     out.ok = specular | (reflect_branch ? v4l(cos_out > 0) : v4l(cos_out < 0));
-    const V3 rho = gather(material, &Material::rho);
     out.weight = rho;
     if (any_lane(dielectric))
         out.weight = select(dielectric,
@@ -569,7 +568,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         V3 light_centre{};
         const AreaLight* area[4];
         const SphereGeom* geom[4];
-        if (lane_lights && !scene.area_lights.empty()) {
+        if (lane_lights && !scene.area_lights.empty() && any_lane(diffuse)) {
             const v4l area_index = diffuse ? area_choice_lanes(scene, u_pick) : v4l{} - 1;
             for (int k = 0; k < 4; ++k) {
                 area[k] = &scene.area_lights[area_index[k] >= 0 ? size_t(area_index[k]) : 0];
@@ -672,7 +671,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const v4l other = paths.alive & ~diffuse;
         if (any_lane(other)) {
             const ScatterLanes scatter =
-                scatter_lanes(lane_material, other, paths.d, ns, front,
+                scatter_lanes(lane_material, rho, other, paths.d, ns, front,
                               sobol_lanes ? sobol.lobe : gather(numbers, &Numbers::lobe), u_bsdf_x, u_bsdf_y);
             next_dir = scatter.direction;
             weight = scatter.weight;
