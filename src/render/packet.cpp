@@ -362,6 +362,7 @@ struct Paths {
     V3 last_p;
     v4l last_sphere;
     v4d primary_distance;
+    v4w sobol_key, sobol_index, sobol_dimension;  // Sobol samplers' state (sobol_lanes)
     uint64_t rays[4] = {};
 };
 
@@ -480,6 +481,15 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             paths.last_p = select(start, zero, paths.last_p);
             paths.last_sphere = start ? v4l{} - 1 : paths.last_sphere;
             paths.primary_distance = select(start, splat(kMissDepth), paths.primary_distance);
+            if (sobol_lanes) {
+                // The samplers' state moves into the lanes; the vertices below advance it there.
+                for (int k = 0; k < 4; ++k) {
+                    if (!start[k]) continue;
+                    paths.sobol_key[k] = lane_sampler[k]->sobol_key();
+                    paths.sobol_index[k] = lane_sampler[k]->index_reversed();
+                    paths.sobol_dimension[k] = lane_sampler[k]->dimension();
+                }
+            }
         }
         if (!any_lane(paths.alive)) break;
 
@@ -536,29 +546,29 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         }
         // has_smooth_lobe, lane-wise.
         const v4l diffuse = paths.alive & of_type(lane_material, MaterialType::diffuse);
+        // The vertex's numbers, lane-wise: Sobol ones drawn in lanes (each lane reads those its
+        // `use` names), the others drawn one lane at a time and gathered.
         using Numbers = Sampler::VertexNumbers;
-        Numbers numbers[4];  // per lane: those its vertex reads, 0 for the others, as next_vertex gives
-        VertexLanes sobol;
+        VertexLanes u;
         v4d u_pick;
         if (sobol_lanes) {
-            v4w key{}, index_reversed{}, dimension{};
-            for (int k = 0; k < 4; ++k) {
-                if (!paths.alive[k]) continue;
-                key[k] = lane_sampler[k]->sobol_key();
-                index_reversed[k] = lane_sampler[k]->index_reversed();
-                dimension[k] = lane_sampler[k]->dimension();
-                lane_sampler[k]->skip_dimensions(5);
-            }
-            sobol = sobol_vertex_lanes(key, index_reversed, dimension, use_any & Sampler::use_lobe);
+            u = sobol_vertex_lanes(paths.sobol_key, paths.sobol_index, paths.sobol_dimension,
+                                   use_any & Sampler::use_lobe);
+            paths.sobol_dimension += 5;
             const v4l pick_read = v4l{-int64_t((use[0] & Sampler::use_light_pick) != 0),
                                       -int64_t((use[1] & Sampler::use_light_pick) != 0),
                                       -int64_t((use[2] & Sampler::use_light_pick) != 0),
                                       -int64_t((use[3] & Sampler::use_light_pick) != 0)};
-            u_pick = select(pick_read, sobol.light_pick, v4d{});
+            u_pick = select(pick_read, u.light_pick, v4d{});
         } else {
+            Numbers numbers[4];  // 0 for those a vertex does not read, as next_vertex gives
             for (int k = 0; k < 4; ++k)
                 if (paths.alive[k]) numbers[k] = lane_sampler[k]->next_vertex(use[k]);
-            u_pick = gather(numbers, &Numbers::light_pick);
+            u = {gather(numbers, &Numbers::light_pick), gather_x(numbers, &Numbers::light),
+                 gather_y(numbers, &Numbers::light),    gather(numbers, &Numbers::lobe),
+                 gather_x(numbers, &Numbers::bsdf),     gather_y(numbers, &Numbers::bsdf),
+                 gather(numbers, &Numbers::roulette)};
+            u_pick = u.light_pick;
         }
 
         // Diffuse vertices whose chosen light is an area light seen from outside (not the hit
@@ -595,17 +605,15 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             LaneVertex vertex[4] = {};
             for (int k = 0; k < 4; ++k) {
                 if (!per_lane[k]) continue;
-                Numbers& u = numbers[k];
-                if (sobol_lanes) {
-                    if (use[k] & Sampler::use_light_pick) u.light_pick = sobol.light_pick[k];
-                    if (use[k] & Sampler::use_light) u.light = {sobol.light_x[k], sobol.light_y[k]};
-                }
+                Numbers lane_u;  // the lane's record, 0 for the numbers it does not read
+                if (use[k] & Sampler::use_light_pick) lane_u.light_pick = u.light_pick[k];
+                if (use[k] & Sampler::use_light) lane_u.light = {u.light_x[k], u.light_y[k]};
                 const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
                 const SurfacePoint sp{hit.n, front[k] != 0};
                 Ray shadow;
                 Color light;
                 LaneVertex& v = vertex[k];
-                if (sample_one_light(scene, settings, *lane_material[k], hit, sp, u.light_pick, u.light, shadow,
+                if (sample_one_light(scene, settings, *lane_material[k], hit, sp, lane_u.light_pick, lane_u.light, shadow,
                                      light)) {
                     v.shadow = true;
                     v.shadow_d = shadow.d;
@@ -621,9 +629,6 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
             direct = gather(vertex, &LaneVertex::direct);
         }
-        // The numbers the lane-wise steps read: Sobol ones as drawn (each such lane reads them),
-        // the others from the lanes' records.
-        const v4d u_roulette = sobol_lanes ? sobol.roulette : gather(numbers, &Numbers::roulette);
         const V3 rho = gather(lane_material, &Material::rho);
         const V3 shadow_o = p;
         const v4l shadow_from = id;
@@ -632,10 +637,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // towards it (eval_smooth, pdf_smooth) and the power heuristic.
         if (any_lane(light_lane)) {
             const V3 light_radiance = gather(area, &AreaLight::radiance);
-            const v4d u_light_x = sobol_lanes ? sobol.light_x : gather_x(numbers, &Numbers::light);
-            const v4d u_light_y = sobol_lanes ? sobol.light_y : gather_y(numbers, &Numbers::light);
-            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre, light_radius, p, u_light_x,
-                                                     u_light_y, light_lane);
+            const LightLanes ls = sample_light_lanes(settings.light_sampling, light_centre, light_radius, p, u.light_x,
+                                                     u.light_y, light_lane);
             const v4d cos_o = dot(ns, ls.wi);
             const v4d lambert = select(cos_o > 0, kInvPi * cos_o, v4d{});
             const V3 f_cos = rho * lambert;
@@ -663,8 +666,6 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
 
         // The next direction: the diffuse bounce (sample_material's diffuse case) and the other
         // materials' scattering, lane-wise.
-        const v4d u_bsdf_x = sobol_lanes ? sobol.bsdf_x : gather_x(numbers, &Numbers::bsdf);
-        const v4d u_bsdf_y = sobol_lanes ? sobol.bsdf_y : gather_y(numbers, &Numbers::bsdf);
         V3 next_dir{}, weight{};
         v4d pdf{};
         v4l ok{};
@@ -672,13 +673,13 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         if (any_lane(other)) {
             const ScatterLanes scatter =
                 scatter_lanes(lane_material, rho, other, paths.d, ns, front,
-                              sobol_lanes ? sobol.lobe : gather(numbers, &Numbers::lobe), u_bsdf_x, u_bsdf_y);
+                              u.lobe, u.bsdf_x, u.bsdf_y);
             next_dir = scatter.direction;
             weight = scatter.weight;
             ok = other & scatter.ok;
         }
         if (any_lane(diffuse)) {
-            const V3 local = cosine_hemisphere_lanes(u_bsdf_x, u_bsdf_y);
+            const V3 local = cosine_hemisphere_lanes(u.bsdf_x, u.bsdf_y);
             const v4d cos_pdf = select(local.z > 0, local.z * kInvPi, v4d{});
             next_dir = select(diffuse, to_world_lanes(ns, local), next_dir);
             weight = select(diffuse, rho, weight);
@@ -704,7 +705,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             const v4d y_or_z = select(th.y < th.z, th.z, th.y);
             const v4d largest = select(th.x < y_or_z, y_or_z, th.x);
             const v4d q = select(largest < 1.0, largest, splat(1.0));
-            paths.alive &= ~roulette | (u_roulette < q);
+            paths.alive &= ~roulette | (u.roulette < q);
             paths.throughput = select(paths.alive, select(roulette, paths.throughput * (1.0 / q), paths.throughput),
                                       V3{v4d{}, v4d{}, v4d{}});
         }
