@@ -21,7 +21,7 @@ using kr::select;  // lanes.h's, beside the three-vector one below
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // A one-leaf scene has at most 16 spheres, so at most 16 materials are used.
-constexpr size_t kMaxPacketMaterials = 16;
+constexpr size_t kMaxPacketSpheres = 16, kMaxPacketMaterials = 16;
 
 KR_LANES v4d abs_lanes(v4d x) { return select(x < 0, -x, x); }
 KR_LANES v4l sign_bit(v4d x) {  // all ones where x is negative (-0 included)
@@ -414,7 +414,7 @@ KR_LANES v4l occluded_lanes(const RenderScene& scene, const V3& o, const V3& d, 
 // the plain path. Embree's scenes and our trees cast rays one by one.
 bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
     return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets() &&
-           scene.materials.size() <= kMaxPacketMaterials;
+           scene.spheres.size() <= kMaxPacketSpheres && scene.materials.size() <= kMaxPacketMaterials;
 }
 
 }  // namespace
@@ -438,11 +438,20 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     bool sobol_lanes = true;
     for (int k = 0; k < count; ++k) sobol_lanes &= samplers[k]->sobol();
 
-    // The numbers a vertex reads on each material (vertex_numbers_used, less Russian roulette,
-    // which goes by depth alone).
+    // Per sphere: its material, the numbers a vertex on it reads (vertex_numbers_used, less
+    // Russian roulette, which goes by depth alone), and (a bit each) whether it is a light's.
     unsigned numbers_used[kMaxPacketMaterials];
     for (size_t i = 0; i < scene.materials.size(); ++i)
         numbers_used[i] = vertex_numbers_used(scene, scene.materials[i], 0, kMaxDepth + 2);
+    const Material* sphere_material[kMaxPacketSpheres];
+    unsigned sphere_use[kMaxPacketSpheres];
+    int64_t emitters = 0;
+    for (size_t s = 0; s < scene.spheres.size(); ++s) {
+        const size_t material = size_t(scene.sphere_material[s]);
+        sphere_material[s] = &scene.materials[material];
+        sphere_use[s] = numbers_used[material];
+        if (scene.sphere_light[s] >= 0) emitters |= int64_t(1) << s;
+    }
     for (;;) {
         // Lanes whose path has ended hand in its result and start the next sample's. The new
         // paths' state is blended in lane-wise: stores into single lanes would stall the
@@ -503,8 +512,9 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         paths.primary_distance = select(paths.alive & (paths.depth == 0), t, paths.primary_distance);
 
         // Hit records (RenderScene::hit_at): the point projected back onto its sphere.
+        const v4l hit_id = paths.alive ? id : v4l{};  // sphere 0 stands in for ended paths
         const SphereGeom* hit_sphere[4];
-        for (int k = 0; k < 4; ++k) hit_sphere[k] = &scene.spheres[paths.alive[k] ? size_t(id[k]) : 0];
+        for (int k = 0; k < 4; ++k) hit_sphere[k] = &scene.spheres[size_t(hit_id[k])];
         const V3 centre = gather(hit_sphere, &SphereGeom::centre);
         const v4d radius = gather(hit_sphere, &SphereGeom::radius);
         const V3 offset = (paths.o + paths.d * t) - centre;
@@ -513,11 +523,10 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const V3 p = centre + n * radius;
 
         // Emission seen along the path (rare: per lane).
-        for (int k = 0; k < 4; ++k) {
-            if (!paths.alive[k]) continue;
-            const int light_index = scene.sphere_light[size_t(id[k])];
-            if (light_index < 0) continue;
-            const AreaLight& light = scene.area_lights[size_t(light_index)];
+        const v4l emits = paths.alive & ((((v4l{} + emitters) >> hit_id) & 1) != 0);
+        for (int k = 0; k < 4 && any_lane(emits); ++k) {
+            if (!emits[k]) continue;
+            const AreaLight& light = scene.area_lights[size_t(scene.sphere_light[size_t(id[k])])];
             const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
             const PathHistory history{paths.full_emission[k] != 0, paths.last_bsdf_pdf[k], lane(paths.last_p, k),
                                       int(paths.last_sphere[k])};
@@ -538,10 +547,9 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         unsigned use[4] = {}, use_any = 0;
         for (int k = 0; k < 4; ++k) {
             if (!paths.alive[k]) continue;
-            const size_t material = size_t(scene.sphere_material[size_t(id[k])]);
-            lane_material[k] = &scene.materials[material];
+            lane_material[k] = sphere_material[size_t(id[k])];
             const bool roulette = paths.depth[k] + 1 >= settings.rr_depth;
-            use[k] = numbers_used[material] | (roulette ? Sampler::use_roulette : 0u);
+            use[k] = sphere_use[size_t(id[k])] | (roulette ? Sampler::use_roulette : 0u);
             use_any |= use[k];
         }
         // has_smooth_lobe, lane-wise.
