@@ -363,7 +363,7 @@ struct Paths {
     v4l last_sphere;
     v4d primary_distance;
     v4w sobol_key, sobol_index, sobol_dimension;  // Sobol samplers' state (sobol_lanes)
-    uint64_t rays[4] = {};
+    v4l rays;  // cast so far per path (masks are -1 where set, so subtracting one counts it)
 };
 
 // choose_light (integrator.cpp) lane-wise, for next-event estimation (not naive): the area
@@ -464,7 +464,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                 SampleResult& r = results[lane_sample[k]];
                 r.radiance = lane(paths.L, k);
                 r.primary_distance = paths.primary_distance[k];
-                r.rays = paths.rays[k];
+                r.rays = uint64_t(paths.rays[k]);
                 lane_sample[k] = -1;
             }
             if (next_sample == count) continue;
@@ -472,7 +472,6 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             lane_sampler[k] = samplers[next_sample];
             start_ray[k] = &rays[next_sample];
             start[k] = -1;
-            paths.rays[k] = 0;
             ++next_sample;
         }
         if (any_lane(start)) {
@@ -480,6 +479,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
             paths.o = select(start, gather(start_ray, &Ray::o), paths.o);
             paths.d = select(start, gather(start_ray, &Ray::d), paths.d);
             paths.alive |= start;
+            paths.rays = start ? v4l{} : paths.rays;
             paths.depth = start ? v4l{} : paths.depth;
             paths.from = start ? v4l{} - 1 : paths.from;
             paths.into = start ? v4l{} : paths.into;
@@ -503,7 +503,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         if (!any_lane(paths.alive)) break;
 
         // Closest hits; a path whose ray leaves the scene ends.
-        for (int k = 0; k < 4; ++k) paths.rays[k] += paths.alive[k] != 0;
+        paths.rays -= paths.alive;
         v4d t;
         v4l id;
         closest_lanes(scene, paths, t, id);
@@ -665,7 +665,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
 
         // The light samples' shadow rays, together; each clear one adds its light.
         if (any_lane(shadow_cast)) {
-            for (int k = 0; k < 4; ++k) paths.rays[k] += shadow_cast[k] != 0;
+            paths.rays -= shadow_cast;
             const v4l clear =
                 shadow_cast & ~occluded_lanes(scene, shadow_o, shadow_d, shadow_from, shadow_into, shadow_tmax,
                                               shadow_to, shadow_cast);
