@@ -90,11 +90,15 @@ KR_LANES V3 to_world_lanes(const V3& n, const V3& local) {
 // target sphere; closest-hit rays have neither. Where q = 0 the roots come out as +-inf, NaN
 // and 0, none of which is accepted, as accepted_root rejects that case; where disc < 0 the
 // square root is NaN and the lane is rejected too.
+// A sphere as the ray tests read it: the centre and the squared radius.
+struct TestSphere {
+    double x, y, z, r2;
+};
 template <bool kShadow>
-KR_LANES v4d sphere_lanes(const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to, const SphereGeom& sphere,
+KR_LANES v4d sphere_lanes(const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to, const TestSphere& sphere,
                         int64_t id) {
-    const double r2 = sphere.radius * sphere.radius;
-    const V3 f{o.x - sphere.centre.x, o.y - sphere.centre.y, o.z - sphere.centre.z};
+    const double r2 = sphere.r2;
+    const V3 f{o.x - sphere.x, o.y - sphere.y, o.z - sphere.z};
     const v4d b = dot(f, d);
     const V3 p{f.x - b * d.x, f.y - b * d.y, f.z - b * d.z};
     const v4d disc = r2 - dot(p, p);
@@ -388,12 +392,12 @@ KR_LANES v4l area_choice_lanes(const RenderScene& scene, v4d u) {
 }
 
 // The closest sphere of each live lane's ray (its index and distance; -1 where none).
-KR_LANES void closest_lanes(const RenderScene& scene, const Paths& paths, v4d& best, v4l& best_id) {
+KR_LANES void closest_lanes(const TestSphere* spheres, size_t count, const Paths& paths, v4d& best, v4l& best_id) {
     best = splat(kInf);
     best_id = v4l{} - 1;
-    for (size_t s = 0; s < scene.spheres.size(); ++s) {
-        const v4d t = sphere_lanes<false>(paths.o, paths.d, paths.from, paths.into, v4d{}, v4l{},
-                                          scene.spheres[s], int64_t(s));
+    for (size_t s = 0; s < count; ++s) {
+        const v4d t = sphere_lanes<false>(paths.o, paths.d, paths.from, paths.into, v4d{}, v4l{}, spheres[s],
+                                          int64_t(s));
         const v4l nearer = t < best;  // ties keep the lower index, as the linear scan does
         best = select(nearer, t, best);
         best_id = nearer ? v4l{} + int64_t(s) : best_id;
@@ -402,11 +406,11 @@ KR_LANES void closest_lanes(const RenderScene& scene, const Paths& paths, v4d& b
 }
 
 // Whether anything blocks each shadow segment (lanes outside `cast` are left unblocked).
-KR_LANES v4l occluded_lanes(const RenderScene& scene, const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to,
-                          v4l cast) {
+KR_LANES v4l occluded_lanes(const TestSphere* spheres, size_t count, const V3& o, const V3& d, v4l from, v4l into,
+                          v4d tmax, v4l to, v4l cast) {
     v4l blocked = v4l{};
-    for (size_t s = 0; s < scene.spheres.size(); ++s)
-        blocked |= sphere_lanes<true>(o, d, from, into, tmax, to, scene.spheres[s], int64_t(s)) < kInf;
+    for (size_t s = 0; s < count; ++s)
+        blocked |= sphere_lanes<true>(o, d, from, into, tmax, to, spheres[s], int64_t(s)) < kInf;
     return blocked & cast;
 }
 
@@ -443,10 +447,13 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
     unsigned numbers_used[kMaxPacketMaterials];
     for (size_t i = 0; i < scene.materials.size(); ++i)
         numbers_used[i] = vertex_numbers_used(scene, scene.materials[i], 0, kMaxDepth + 2);
+    TestSphere test_spheres[kMaxPacketSpheres];
     const Material* sphere_material[kMaxPacketSpheres];
     unsigned sphere_use[kMaxPacketSpheres];
     int64_t emitters = 0;
     for (size_t s = 0; s < scene.spheres.size(); ++s) {
+        const SphereGeom& geom = scene.spheres[s];
+        test_spheres[s] = {geom.centre.x, geom.centre.y, geom.centre.z, geom.radius * geom.radius};
         const size_t material = size_t(scene.sphere_material[s]);
         sphere_material[s] = &scene.materials[material];
         sphere_use[s] = numbers_used[material];
@@ -506,7 +513,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         paths.rays -= paths.alive;
         v4d t;
         v4l id;
-        closest_lanes(scene, paths, t, id);
+        closest_lanes(test_spheres, scene.spheres.size(), paths, t, id);
         paths.alive &= id >= 0;
         if (!any_lane(paths.alive)) continue;
         paths.primary_distance = select(paths.alive & (paths.depth == 0), t, paths.primary_distance);
@@ -667,7 +674,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         if (any_lane(shadow_cast)) {
             paths.rays -= shadow_cast;
             const v4l clear =
-                shadow_cast & ~occluded_lanes(scene, shadow_o, shadow_d, shadow_from, shadow_into, shadow_tmax,
+                shadow_cast & ~occluded_lanes(test_spheres, scene.spheres.size(), shadow_o, shadow_d, shadow_from, shadow_into, shadow_tmax,
                                               shadow_to, shadow_cast);
             paths.L = select(clear, paths.L + direct, paths.L);
         }
