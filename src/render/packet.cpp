@@ -85,15 +85,16 @@ KR_LANES V3 to_world_lanes(const V3& n, const V3& local) {
     return s * local.x + t * local.y + n * local.z;
 }
 
+// A sphere as the ray tests read it (trace_packet's table): the centre and the squared radius.
+struct TestSphere {
+    double x, y, z, r2;
+};
+
 // accepted_root (render_scene.cpp) of four rays against one sphere: the distance per lane, or
 // +inf. The rays start at tmin = 0 (trace_packet checks). kShadow: segments with an end and a
 // target sphere; closest-hit rays have neither. Where q = 0 the roots come out as +-inf, NaN
 // and 0, none of which is accepted, as accepted_root rejects that case; where disc < 0 the
 // square root is NaN and the lane is rejected too.
-// A sphere as the ray tests read it: the centre and the squared radius.
-struct TestSphere {
-    double x, y, z, r2;
-};
 template <bool kShadow>
 KR_LANES v4d sphere_lanes(const V3& o, const V3& d, v4l from, v4l into, v4d tmax, v4l to, const TestSphere& sphere,
                         int64_t id) {
@@ -529,18 +530,20 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const V3 n = select(offset_length > 0, offset * (1.0 / offset_length), -paths.d);
         const V3 p = centre + n * radius;
 
-        // Emission seen along the path (rare: per lane).
+        // Emission seen along the path (rare: per lane, where a lane has hit a light).
         const v4l emits = paths.alive & ((((v4l{} + emitters) >> hit_id) & 1) != 0);
-        for (int k = 0; k < 4 && any_lane(emits); ++k) {
-            if (!emits[k]) continue;
-            const AreaLight& light = scene.area_lights[size_t(scene.sphere_light[size_t(id[k])])];
-            const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
-            const PathHistory history{paths.full_emission[k] != 0, paths.last_bsdf_pdf[k], lane(paths.last_p, k),
-                                      int(paths.last_sphere[k])};
-            const Color add = lane(paths.throughput, k) * light.radiance *
-                              emission_weight(scene, settings.light_sampling, light, hit, lane(paths.d, k), history);
-            set_lane(paths.L, k, lane(paths.L, k) + add);
-        }
+        if (any_lane(emits))
+            for (int k = 0; k < 4; ++k) {
+                if (!emits[k]) continue;
+                const AreaLight& light = scene.area_lights[size_t(scene.sphere_light[size_t(id[k])])];
+                const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
+                const PathHistory history{paths.full_emission[k] != 0, paths.last_bsdf_pdf[k], lane(paths.last_p, k),
+                                          int(paths.last_sphere[k])};
+                const double weight =
+                    emission_weight(scene, settings.light_sampling, light, hit, lane(paths.d, k), history);
+                const Color add = lane(paths.throughput, k) * light.radiance * weight;
+                set_lane(paths.L, k, lane(paths.L, k) + add);
+            }
         paths.alive &= paths.depth < settings.max_depth;
         if (!any_lane(paths.alive)) continue;
 
@@ -628,8 +631,8 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                 Ray shadow;
                 Color light;
                 LaneVertex& v = vertex[k];
-                if (sample_one_light(scene, settings, *lane_material[k], hit, sp, lane_u.light_pick, lane_u.light, shadow,
-                                     light)) {
+                if (sample_one_light(scene, settings, *lane_material[k], hit, sp, lane_u.light_pick, lane_u.light,
+                                     shadow, light)) {
                     v.shadow = true;
                     v.shadow_d = shadow.d;
                     v.shadow_tmax = shadow.tmax;
@@ -673,9 +676,9 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // The light samples' shadow rays, together; each clear one adds its light.
         if (any_lane(shadow_cast)) {
             paths.rays -= shadow_cast;
-            const v4l clear =
-                shadow_cast & ~occluded_lanes(test_spheres, scene.spheres.size(), shadow_o, shadow_d, shadow_from, shadow_into, shadow_tmax,
-                                              shadow_to, shadow_cast);
+            const v4l clear = shadow_cast & ~occluded_lanes(test_spheres, scene.spheres.size(), shadow_o, shadow_d,
+                                                            shadow_from, shadow_into, shadow_tmax, shadow_to,
+                                                            shadow_cast);
             paths.L = select(clear, paths.L + direct, paths.L);
         }
 
