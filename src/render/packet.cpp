@@ -550,8 +550,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const v4l front = dot(paths.d, n) < 0;
         const V3 ns = select(front, n, -n);
 
-        // Each vertex's material and the numbers it reads (vertex_numbers_used), and Sobol
-        // samplers' numbers in lanes.
+        // Each vertex's material and the numbers it reads (vertex_numbers_used, from the tables).
         const Material* lane_material[4] = {&scene.materials[0], &scene.materials[0], &scene.materials[0],
                                             &scene.materials[0]};
         unsigned use[4] = {}, use_any = 0;
