@@ -564,10 +564,10 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         // has_smooth_lobe, lane-wise.
         const v4l diffuse = paths.alive & of_type(lane_material, MaterialType::diffuse);
         // The vertex's numbers, lane-wise: Sobol ones drawn in lanes (each lane reads those its
-        // `use` names), the others drawn one lane at a time and gathered.
+        // `use` names; the light choice is 0 where unread, as next_vertex gives), the others
+        // drawn one lane at a time and gathered.
         using Numbers = Sampler::VertexNumbers;
         VertexLanes u;
-        v4d u_pick;
         if (sobol_lanes) {
             u = sobol_vertex_lanes(paths.sobol_key, paths.sobol_index, paths.sobol_dimension,
                                    use_any & Sampler::use_lobe);
@@ -576,7 +576,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                                       -int64_t((use[1] & Sampler::use_light_pick) != 0),
                                       -int64_t((use[2] & Sampler::use_light_pick) != 0),
                                       -int64_t((use[3] & Sampler::use_light_pick) != 0)};
-            u_pick = select(pick_read, u.light_pick, v4d{});
+            u.light_pick = select(pick_read, u.light_pick, v4d{});
         } else {
             Numbers numbers[4];  // 0 for those a vertex does not read, as next_vertex gives
             for (int k = 0; k < 4; ++k)
@@ -585,7 +585,6 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
                  gather_y(numbers, &Numbers::light),    gather(numbers, &Numbers::lobe),
                  gather_x(numbers, &Numbers::bsdf),     gather_y(numbers, &Numbers::bsdf),
                  gather(numbers, &Numbers::roulette)};
-            u_pick = u.light_pick;
         }
 
         // Diffuse vertices whose chosen light is an area light seen from outside (not the hit
@@ -596,7 +595,7 @@ KR_CLONES void trace_packet(const RenderScene& scene, const RenderSettings& sett
         const AreaLight* area[4];
         const SphereGeom* geom[4];
         if (lane_lights && !scene.area_lights.empty() && any_lane(diffuse)) {
-            const v4l area_index = diffuse ? area_choice_lanes(scene, u_pick) : v4l{} - 1;
+            const v4l area_index = diffuse ? area_choice_lanes(scene, u.light_pick) : v4l{} - 1;
             for (int k = 0; k < 4; ++k) {
                 area[k] = &scene.area_lights[area_index[k] >= 0 ? size_t(area_index[k]) : 0];
                 geom[k] = &scene.spheres[size_t(area[k]->sphere)];
