@@ -41,14 +41,21 @@ std::shared_ptr<const RenderScene> small_scene(int n, int width, int height) {
     return std::make_shared<const RenderScene>(prepare_scene(authored));
 }
 
-// Waits for a finished frame of `generation`; null if none comes before the deadline.
+// Waits for a finished frame of `generation` (and of `target_spp`, when given: a job
+// resubmitted under the same generation with a new target may still publish the old
+// job's finished frame first); null if none comes before the deadline.
 std::shared_ptr<const Snapshot> wait_finished(const RenderWorker& worker, uint64_t generation,
+                                              int target_spp = 0,
                                               std::chrono::seconds limit = std::chrono::seconds(300)) {
+    auto wanted = [&](const std::shared_ptr<const Snapshot>& f) {
+        return f && f->generation == generation && f->finished &&
+               (target_spp == 0 || f->target_spp == target_spp);
+    };
     const auto deadline = Clock::now() + limit;
     std::shared_ptr<const Snapshot> f = worker.latest();
-    while (!(f && f->generation == generation && f->finished) && Clock::now() < deadline)
+    while (!wanted(f) && Clock::now() < deadline)
         f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(200));
-    return f && f->generation == generation && f->finished ? f : nullptr;
+    return wanted(f) ? f : nullptr;
 }
 
 void expect_valid_final(const Snapshot& f, uint64_t generation, int width, int height, int spp) {
@@ -198,11 +205,12 @@ TEST(WorkerStress, SceneReloadWhileRendering) {
             }));
             submit();
         }
-    // Ends on scene 6, whose file the model loaded last.
+    // Ends on scene 6, whose file the model loaded last. The same generation as the last
+    // 1-spp job, so that job's finished frame may come first: wait for the 2-spp one.
     RenderSettings s = model.settings().render;
     s.target_spp = 2;
     worker.submit({model.generation(), model.prepared(), s});
-    const auto f = wait_finished(worker, model.generation());
+    const auto f = wait_finished(worker, model.generation(), 2);
     ASSERT_TRUE(f);
     expect_valid_final(*f, model.generation(), w, h, 2);
 }
