@@ -1,10 +1,14 @@
 // Paths in lanes (render/packet.cpp) against one path at a time: the same samples, so the
 // same images. Each sample of a batch traced together must give what trace_sample gives it
-// with the same sampler: its radiance, its first hit's distance and its ray count.
+// with the same sampler: its radiance, its first hit's distance and its ray count. Every test
+// runs twice: with the kernels for any x86-64 CPU, and with the CPU's best (the x86-64-v3
+// ones where it has AVX2 and FMA), so both builds of the kernels are checked on one machine.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <optional>
+#include <ostream>
 #include <vector>
 
 #include "render/render.h"
@@ -12,6 +16,10 @@
 #include "test_util.h"
 
 using namespace kr;
+
+namespace kr {
+void PrintTo(PacketIsa isa, std::ostream* out) { *out << (isa == PacketIsa::best ? "best" : "any_x86_64"); }
+}  // namespace kr
 
 namespace {
 
@@ -68,12 +76,33 @@ RenderScene brief_scene(int n) {
         load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
 }
 
+// The kernels a test runs with, set for its duration.
+class Packet : public ::testing::TestWithParam<PacketIsa> {
+protected:
+    void SetUp() override { set_packet_isa(GetParam()); }
+    void TearDown() override { set_packet_isa(PacketIsa::best); }
+};
+
 }  // namespace
+
+INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any_x86_64, PacketIsa::best),
+                         [](const ::testing::TestParamInfo<PacketIsa>& info) {
+                             return info.param == PacketIsa::best ? std::string("best") : std::string("any_x86_64");
+                         });
+
+// The switch itself: the kernels for any CPU never use x86-64-v3 instructions; the best
+// ones do where the CPU has them (said, not asserted: a CI machine may lack them).
+TEST(PacketIsaSwitch, AnyX86_64NeverRunsTheV3Kernels) {
+    set_packet_isa(PacketIsa::any_x86_64);
+    EXPECT_FALSE(packet_isa_v3());
+    set_packet_isa(PacketIsa::best);
+    std::printf("x86-64-v3 kernels on this CPU: %s\n", packet_isa_v3() ? "yes" : "no");
+}
 
 // The brief's path-traced scenes, with every estimator and light strategy, and naive PT.
 // The lanes round like one path except where fused multiply-adds land differently, which can
 // only turn a path that grazes a sphere: at most one sample in 500 may differ.
-TEST(Packet, SameSamplesAsOneByOne) {
+TEST_P(Packet, SameSamplesAsOneByOne) {
     for (int n : {3, 4, 5, 6, 8}) {
         const RenderScene scene = brief_scene(n);
         ASSERT_TRUE(scene.bvh.packets()) << "scene " << n;
@@ -102,7 +131,7 @@ TEST(Packet, SameSamplesAsOneByOne) {
 // A scene with what the brief's lack: point lights beside area lights (so the light choice
 // goes both ways), a black area light, every material, shading points inside a light, and
 // batches of one to five samples (fewer than the lanes, and one more) and of a hundred.
-TEST(Packet, PointLightsEveryMaterialAndPartialPackets) {
+TEST_P(Packet, PointLightsEveryMaterialAndPartialPackets) {
     test::SceneBuilder b;
     b.scene.renderer.width = b.scene.renderer.height = 32;
     const int grey = b.material(MaterialType::diffuse, Color(0.7));
@@ -150,7 +179,7 @@ TEST(Packet, PointLightsEveryMaterialAndPartialPackets) {
 
 // Whole passes: the image of render_pass (which traces batches of samples in lanes) equals the image
 // of the same samples traced one by one, on scenes 3 and 8 at 64x64.
-TEST(Packet, RenderPassImageIsOneByOnes) {
+TEST_P(Packet, RenderPassImageIsOneByOnes) {
     for (int n : {3, 8}) {
         const RenderScene scene = brief_scene(n);
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
@@ -190,7 +219,7 @@ TEST(Packet, RenderPassImageIsOneByOnes) {
 // Camera rays four at a time (Sobol samplers and a pinhole; otherwise one by one) against one
 // by one: the same rays, and every sampler left where the one-by-one sampler is. Seven
 // samples, so the last group is partial; scene 3 also through its thin lens.
-TEST(Packet, CameraRaysAreOneByOnes) {
+TEST_P(Packet, CameraRaysAreOneByOnes) {
     RenderScene scene = brief_scene(3);
     const int width = scene.renderer.width, height = scene.renderer.height;
     for (double lens_radius : {0.0, 0.2})

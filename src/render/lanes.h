@@ -1,6 +1,7 @@
 // Four lanes of doubles (GCC vector extensions) and the few operations on them that the BVH's
 // block test (accel.cpp) and the four-path tracer (packet.cpp) share; and KR_CLONES, which
-// compiles a function twice, for x86-64-v3 and for any x86-64.
+// compiles a function twice, for x86-64-v3 and for any x86-64 (packet.cpp does the same for
+// its kernels by including them twice, where KR_X86_64_V3 is defined).
 #pragma once
 
 #include <cmath>
@@ -13,8 +14,8 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
 typedef uint64_t v4u __attribute__((vector_size(32)));  // bits, shifted without sign
 
-// Every helper taking or returning lanes is forced inline into its KR_CLONES caller: a call
-// would pass them by the default clone's ABI, not the AVX2 one. So no lane crosses a
+// Every helper taking or returning lanes is forced inline into its KR_CLONES caller (or
+// packet.cpp's kernels): a call would pass them by the default clone's ABI, not the AVX2 one. So no lane crosses a
 // non-inlined call, and GCC's note on the vector ABI does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define KR_LANES inline __attribute__((always_inline))
@@ -47,6 +48,7 @@ KR_LANES bool any_lane(v4l mask) {
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
     !defined(__SANITIZE_THREAD__)
 #define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define KR_X86_64_V3 1  // packet.cpp's kernels are compiled for x86-64-v3 too, and picked at run time
 #else
 #define KR_CLONES
 #endif

@@ -158,4 +158,11 @@ inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);
 
+// Which build of the SIMD kernels camera_rays and trace_samples run (packet.cpp): the best
+// the CPU has (x86-64-v3 where it has AVX2 and FMA), or the one for any x86-64 CPU, for
+// tests and comparisons on a machine that has both. Process-wide.
+enum class PacketIsa { best, any_x86_64 };
+void set_packet_isa(PacketIsa isa);
+bool packet_isa_v3();  // whether the x86-64-v3 kernels run now
+
 }  // namespace kr

@@ -107,23 +107,34 @@ KR_SOBOL_INLINE U hash32(U x) {
     return x ^ (x >> 16);
 }
 
+// reverse_bits as SobolDimension's default way to reverse; packet.cpp's x86-64-v3 kernels
+// pass one with instructions of their own.
+struct BitReverse {
+    template <class U>
+    static KR_SOBOL_INLINE U apply(U x) {
+        return reverse_bits(x);
+    }
+};
+
 // One dimension of one Sobol sample: the sample index shuffled and the point scrambled by
 // seeds of their own for each (pixel, dimension). The index is shuffled first so that
 // different dimensions are not correlated through it; an Owen scramble of the index keeps
 // every aligned block of 2^k indices together, so prefixes stay nets. Its two coordinates
 // (x, y) are Sobol dimensions 0 and 1, Owen-scrambled; `key` is the pixel's, from its seed.
-template <class U>
+template <class U, class Reverse = BitReverse>
 struct SobolDimension {
     U index, seed;
     KR_SOBOL_INLINE SobolDimension(U key, U index_reversed, U dimension) {
         const U h = hash32(key ^ (dimension * 0x9e3779b9u));
-        index = reverse_bits(laine_karras(index_reversed, h));
+        index = Reverse::apply(laine_karras(index_reversed, h));
         seed = hash32(h + 0x632be5abu);
     }
     // owen_scramble(sobol_dimension0(index)): the two bit reversals in between cancel.
-    KR_SOBOL_INLINE U x() const { return reverse_bits(laine_karras(index, seed)); }
+    KR_SOBOL_INLINE U x() const { return Reverse::apply(laine_karras(index, seed)); }
     // owen_scramble(sobol_dimension1(index)), its inner reversal left out of the matrix.
-    KR_SOBOL_INLINE U y() const { return reverse_bits(laine_karras(sobol_dimension1_reversed(index), seed ^ 0xb5297a4du)); }
+    KR_SOBOL_INLINE U y() const {
+        return Reverse::apply(laine_karras(sobol_dimension1_reversed(index), seed ^ 0xb5297a4du));
+    }
 };
 #pragma GCC diagnostic pop
 
