@@ -18,7 +18,7 @@
 using namespace kr;
 
 namespace kr {
-void PrintTo(PacketIsa isa, std::ostream* out) { *out << (isa == PacketIsa::best ? "best" : "any_x86_64"); }
+void PrintTo(PacketIsa isa, std::ostream* out) { *out << packet_isa_names.name(isa); }
 }  // namespace kr
 
 namespace {
@@ -85,18 +85,22 @@ protected:
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any_x86_64, PacketIsa::best),
+INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, PacketIsa::best),
                          [](const ::testing::TestParamInfo<PacketIsa>& info) {
-                             return info.param == PacketIsa::best ? std::string("best") : std::string("any_x86_64");
+                             return ::testing::PrintToString(info.param);
                          });
 
-// The switch itself: the kernels for any CPU never use x86-64-v3 instructions; the best
-// ones do where the CPU has them (said, not asserted: a CI machine may lack them).
-TEST(PacketIsaSwitch, AnyX86_64NeverRunsTheV3Kernels) {
-    set_packet_isa(PacketIsa::any_x86_64);
-    EXPECT_FALSE(packet_isa_v3());
+// The switch itself. `best` is the x86-64-v3 lanes where the CPU has them, else one path at
+// a time, never the lanes for any CPU (slower than one path); which of the two this CPU
+// gets is printed, not asserted: a CI machine may lack AVX2.
+TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
+    set_packet_isa(PacketIsa::any);
+    EXPECT_EQ(packet_kernels(), PacketKernels::x86_64);
+    set_packet_isa(PacketIsa::one_path);
+    EXPECT_EQ(packet_kernels(), PacketKernels::one_path);
     set_packet_isa(PacketIsa::best);
-    std::printf("x86-64-v3 kernels on this CPU: %s\n", packet_isa_v3() ? "yes" : "no");
+    EXPECT_NE(packet_kernels(), PacketKernels::x86_64);
+    std::printf("best on this CPU: %s\n", std::string(packet_kernels_names.name(packet_kernels())).c_str());
 }
 
 // The brief's path-traced scenes, with every estimator and light strategy, and naive PT.

@@ -26,6 +26,7 @@ namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
+                 [--kernels best|any|off]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
@@ -36,6 +37,10 @@ constexpr const char* kBenchUsage = R"(Usage:
               the seconds the file's full sample count takes at that speed, and the median
               time of one full-resolution 1-spp pass.
 --linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
+--kernels     how paths are traced: best (default: four at a time in SIMD lanes with the
+              AVX2/FMA kernels where the CPU has them, else one at a time), any (in
+              lanes with the kernels for any x86-64 CPU, SSE2) or off (one at a time),
+              to measure what each buys.
 --stress      generated scenes of N random spheres under a sphere light, path traced at
               W x W (default 256) with 4 spp: ns per ray and ns per ray / log2(N).
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
@@ -120,6 +125,7 @@ struct BenchOptions {
     std::vector<fs::path> scenes;
     double fraction = 1.0 / 32;
     int runs = 3, threads = 0, size = 256;
+    PacketIsa kernels = PacketIsa::best;
 };
 
 BenchOptions parse(int argc, char** argv) {
@@ -133,6 +139,7 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--runs") o.runs = int(parse_number(arg, value(), 1, 1000));
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
         else if (arg == "--size") o.size = int(parse_number(arg, value(), 1, 8192));
+        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
         else if (arg == "--stress") {
             for (const std::string& item : split_list(value()))
                 o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
@@ -197,9 +204,10 @@ int bench_throughput(const BenchOptions& o) {
                     median(mrays), estimate, median(pass_ms));
         std::fflush(stdout);
     }
-    std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s).\n", total_estimate,
+    std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s, %s).\n", total_estimate,
                 omp_get_max_threads(),
-                o.linear ? "linear scan" : ("BVH " + std::string(accel_backend_names.name(o.accel.front()))).c_str());
+                o.linear ? "linear scan" : ("BVH " + std::string(accel_backend_names.name(o.accel.front()))).c_str(),
+                std::string(packet_kernels_names.name(packet_kernels())).c_str());
     return 0;
 }
 
@@ -258,6 +266,7 @@ int run_bench(int argc, char** argv) {
         return report_usage(e, kBenchUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
+    set_packet_isa(o.kernels);
     if (o.write_stress > 0) {
         std::error_code ec;
         if (fs::exists(o.write_path, ec)) {

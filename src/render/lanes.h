@@ -15,8 +15,8 @@ typedef int64_t v4l __attribute__((vector_size(32)));
 typedef uint64_t v4u __attribute__((vector_size(32)));  // bits, shifted without sign
 
 // Every helper taking or returning lanes is forced inline into its KR_CLONES caller (or
-// packet.cpp's kernels): a call would pass them by the default clone's ABI, not the AVX2 one. So no lane crosses a
-// non-inlined call, and GCC's note on the vector ABI does not apply.
+// packet.cpp's kernels): a call would pass them by the default clone's ABI, not the AVX2
+// one. So no lane crosses a non-inlined call, and GCC's note on the vector ABI does not apply.
 #pragma GCC diagnostic ignored "-Wpsabi"
 #define KR_LANES inline __attribute__((always_inline))
 

@@ -8,7 +8,10 @@
 //
 // The kernels are in packet_lanes.inc, compiled twice: for any x86-64 CPU and for x86-64-v3
 // (AVX2, FMA). The v3 ones run where the CPU has those (the CPU is asked once, at the first
-// call), or never when set_packet_isa asks for the others.
+// call). Elsewhere paths are traced one at a time: GCC lowers the lanes to SSE2 so poorly
+// (64-bit compares, shifts and conversions one lane at a time) that the kernels for any CPU
+// are 2.5 times slower than one path at a time (docs/performance.md); they run only when
+// set_packet_isa asks for them, for tests and comparisons.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -37,6 +40,22 @@ bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
            scene.spheres.size() <= kMaxPacketSpheres && scene.materials.size() <= kMaxPacketMaterials;
 }
 
+// One sample's camera ray (CameraModel::generate), its sampler giving the sub-pixel position
+// and the lens numbers (skipped for a pinhole).
+Ray camera_ray(const RenderScene& scene, int width, int height, int x, int y, Sampler& sampler) {
+    const CameraModel& camera = scene.camera;
+    const Vec2 sub = sampler.pixel();
+    Vec2 lens;
+    if (camera.lens_radius > 0) lens = sampler.next_2d();
+    else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
+    const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+    const CameraRay cr = camera.generate(film.x, film.y, lens.x, lens.y);
+    Ray ray;
+    ray.o = cr.origin;
+    ray.d = cr.direction;
+    return ray;
+}
+
 }  // namespace
 
 namespace packet_any {
@@ -58,14 +77,13 @@ namespace {
 
 std::atomic<PacketIsa> packet_isa{PacketIsa::best};
 
-// Whether the x86-64-v3 kernels run.
-bool use_v3() {
+bool cpu_has_v3() {
 #ifdef KR_X86_64_V3
-    static const bool cpu_has_v3 = [] {
+    static const bool has = [] {
         __builtin_cpu_init();
         return __builtin_cpu_supports("x86-64-v3") != 0;
     }();
-    return cpu_has_v3 && packet_isa.load(std::memory_order_relaxed) == PacketIsa::best;
+    return has;
 #else
     return false;
 #endif
@@ -75,14 +93,25 @@ bool use_v3() {
 
 void set_packet_isa(PacketIsa isa) { packet_isa.store(isa); }
 
-bool packet_isa_v3() { return use_v3(); }
+PacketKernels packet_kernels() {
+    switch (packet_isa.load(std::memory_order_relaxed)) {
+    case PacketIsa::best: return cpu_has_v3() ? PacketKernels::x86_64_v3 : PacketKernels::one_path;
+    case PacketIsa::any: return PacketKernels::x86_64;
+    case PacketIsa::one_path: return PacketKernels::one_path;
+    }
+    return PacketKernels::one_path;
+}
 
 void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
                  Sampler* const* samplers, int count, Ray* rays) {
+    switch (packet_kernels()) {
 #ifdef KR_X86_64_V3
-    if (use_v3()) return packet_v3::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
+    case PacketKernels::x86_64_v3: return packet_v3::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
 #endif
-    packet_any::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
+    case PacketKernels::x86_64: return packet_any::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
+    default:
+        for (int k = 0; k < count; ++k) rays[k] = camera_ray(scene, width, height, xs[k], ys[k], *samplers[k]);
+    }
 }
 
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
@@ -91,9 +120,11 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
     for (int k = 0; k < count; ++k)
         camera_rays &=
             rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
-    if (packets_apply(scene, settings) && camera_rays && count > 1) {
+    const PacketKernels kernels = packet_kernels();
+    if (packets_apply(scene, settings) && camera_rays && count > 1 && kernels != PacketKernels::one_path) {
 #ifdef KR_X86_64_V3
-        if (use_v3()) return packet_v3::trace_packet(scene, settings, rays, samplers, count, results);
+        if (kernels == PacketKernels::x86_64_v3)
+            return packet_v3::trace_packet(scene, settings, rays, samplers, count, results);
 #endif
         packet_any::trace_packet(scene, settings, rays, samplers, count, results);
     } else {

@@ -158,11 +158,16 @@ inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);
 
-// Which build of the SIMD kernels camera_rays and trace_samples run (packet.cpp): the best
-// the CPU has (x86-64-v3 where it has AVX2 and FMA), or the one for any x86-64 CPU, for
-// tests and comparisons on a machine that has both. Process-wide.
-enum class PacketIsa { best, any_x86_64 };
+// How camera_rays and trace_samples trace (packet.cpp), process-wide. `best`: in SIMD lanes
+// with the kernels built for x86-64-v3 where the CPU has AVX2 and FMA, else one path at a
+// time (the kernels built for any x86-64 CPU are slower than that). `any`: in lanes with the
+// kernels for any CPU; `one_path`: one at a time. The last two are for tests and comparisons.
+enum class PacketIsa { best, any, one_path };
+inline constexpr EnumNames<PacketIsa, 3> packet_isa_names{{"best", "any", "off"}};
 void set_packet_isa(PacketIsa isa);
-bool packet_isa_v3();  // whether the x86-64-v3 kernels run now
+// What runs now, as set_packet_isa and the CPU decide.
+enum class PacketKernels { x86_64_v3, x86_64, one_path };
+inline constexpr EnumNames<PacketKernels, 3> packet_kernels_names{{"x86-64-v3 lanes", "x86-64 lanes", "one path"}};
+PacketKernels packet_kernels();
 
 }  // namespace kr
