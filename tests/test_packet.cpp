@@ -2,7 +2,8 @@
 // same images. Each sample of a batch traced together must give what trace_sample gives it
 // with the same sampler: its radiance, its first hit's distance and its ray count. Every test
 // runs twice: with the kernels for any x86-64 CPU, and with the CPU's best (the x86-64-v3
-// ones where it has AVX2 and FMA), so both builds of the kernels are checked on one machine.
+// ones where it has AVX2 and FMA, else one path, which these tests then compare with itself),
+// so both builds of the kernels are checked on a machine that has both.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -144,15 +144,16 @@ SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settin
                           Sampler& sampler);
 // The camera rays of `count` samples of pixels (xs[i], ys[i]) of a width x height image, each
 // sampler having given nothing yet: it gives the sub-pixel position and the lens numbers
-// (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp) for Sobol samplers and a
-// pinhole, each ray as one at a time gives it up to rounding.
+// (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp, where packet_kernels()
+// below has lanes) for Sobol samplers and a pinhole, each ray as one at a time gives it up
+// to rounding.
 void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
                  Sampler* const* samplers, int count, Ray* rays);
 
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
 // camera rays four paths at a time in SIMD lanes (packet.cpp), a lane starting the next sample
-// as its path ends, where the scene is one leaf of our BVH; anything else goes one by one
-// through trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less
+// as its path ends, where the scene is one leaf of our BVH and packet_kernels() below has
+// lanes; anything else goes one by one through trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less
 // time lanes idle at the batch's end.
 inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
