@@ -8,9 +8,9 @@
 //
 // The kernels are in packet_lanes.inc, compiled twice: for any x86-64 CPU and for x86-64-v3
 // (AVX2, FMA). The v3 ones run where the CPU has those (the CPU is asked once, at the first
-// call). Elsewhere paths are traced one at a time: GCC lowers the lanes to SSE2 so poorly
-// (64-bit compares, shifts and conversions one lane at a time) that the kernels for any CPU
-// are 2.5 times slower than one path at a time (docs/performance.md); they run only when
+// call). Elsewhere paths are traced one at a time: GCC emulates what SSE2 lacks (64-bit
+// compares, per-lane shifts, 32-bit multiplies) lane by lane, so the kernels for any CPU are
+// 2.5 times slower than one path at a time (docs/performance.md); they run only when
 // set_packet_isa asks for them, for tests and comparisons.
 #include <algorithm>
 #include <atomic>
