@@ -36,22 +36,10 @@ KR_SOBOL_INLINE U reverse_bits(U x) {
     if constexpr (std::is_integral_v<U>) {
         x = __builtin_bswap32(x);  // bytes by one instruction
     } else {
-        // Bytes by one shuffle of each word's four (a byte shuffle where the CPU has one).
-        typedef uint8_t Bytes16 __attribute__((vector_size(16)));
-        typedef uint8_t Bytes32 __attribute__((vector_size(32)));
-        static_assert(sizeof(U) == 16 || sizeof(U) == 32);
-        if constexpr (sizeof(U) == 16) {
-            Bytes16 b;
-            __builtin_memcpy(&b, &x, sizeof x);
-            b = __builtin_shufflevector(b, b, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12);
-            __builtin_memcpy(&x, &b, sizeof x);
-        } else {
-            Bytes32 b;
-            __builtin_memcpy(&b, &x, sizeof x);
-            b = __builtin_shufflevector(b, b, 3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 19, 18, 17, 16, 23,
-                                        22, 21, 20, 27, 26, 25, 24, 31, 30, 29, 28);
-            __builtin_memcpy(&x, &b, sizeof x);
-        }
+        // Bytes by two swap steps. The x86-64-v3 kernels reverse lanes with byte shuffles
+        // of their own (packet_lanes.inc); these serve the kernels for any CPU.
+        x = (x >> 16) | (x << 16);
+        x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
     }
     // then the bits within each byte by three swap steps
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
