@@ -205,15 +205,28 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("| scene |"), std::string::npos);
     EXPECT_NE(r.out.find("Mrays/s"), std::string::npos);
-    r = run("bench --throughput '" + scene.string() + "' --runs 1 --fraction 1 --kernels any");
+    EXPECT_NE(r.out.find("| one path |"), std::string::npos) << r.out;  // Whitted: never in lanes
+    // The same scene path traced: the kernels each --kernels names, in the table's last column.
+    std::string text = read_file(scene);
+    text.replace(text.find("\"WRT\""), 5, "\"PT\"");
+    std::ofstream(dir / "pt.json") << text;
+    const std::string pt = (dir / "pt.json").string();
+    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels any");
     EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_NE(r.out.find(", x86-64 lanes)"), std::string::npos) << r.out;  // never the v3 ones
-    r = run("bench --throughput '" + scene.string() + "' --runs 1 --fraction 1 --kernels off");
+    EXPECT_NE(r.out.find("| x86-64 lanes |"), std::string::npos) << r.out;  // never the v3 ones
+    EXPECT_NE(r.out.find("--kernels any)"), std::string::npos) << r.out;
+    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels off");
     EXPECT_EQ(r.status, 0) << r.err;
-    EXPECT_NE(r.out.find(", one path)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("| one path |"), std::string::npos) << r.out;
+    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels double");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("float lanes"), std::string::npos) << r.out;
+    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("| x86-64 lanes |"), std::string::npos) << r.out;
     r = run("bench --throughput --kernels avx9");
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.err.find("\"best\", \"any\" or \"off\""), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"best\", \"double\", \"any\" or \"off\""), std::string::npos) << r.err;
     r = run("bench --stress 20 --runs 1 --size 16");
     EXPECT_EQ(r.status, 0) << r.err;
     // One row per BVH: ours, and Embree's where the build has it.

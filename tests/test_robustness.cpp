@@ -543,9 +543,13 @@ TEST(RobustMaterials, RhoZeroAndOneFurnaces) {
         b.point_light({0, 0, 0}, Color(I));
         b.scene.cameras[0].position = {0.3, 0.2, -0.5};
         b.scene.cameras[0].target = {0, 0, 1};
-        const RenderState state = render(b.build(), settings_for(Integrator::pt, kMaxDepth, 4), 6, 6, 4);
+        const RenderScene scene = b.build();
+        const RenderSettings settings = settings_for(Integrator::pt, kMaxDepth, 4);
+        const RenderState state = render(scene, settings, 6, 6, 4);
         ASSERT_TRUE(all_finite(state));
-        for (const Color& c : state.radiance().pixels) EXPECT_NEAR(c.x, kMaxDepth * I / (kPi * R * R), 1e-9);
+        const double expected = kMaxDepth * I / (kPi * R * R);
+        for (const Color& c : state.radiance().pixels)
+            EXPECT_NEAR(c.x, expected, test::analytic_tolerance(scene, settings) * expected);
     }
     {
         test::SceneBuilder b;
@@ -648,8 +652,10 @@ TEST(RobustRenderer, DepthZeroOneTwentyAndAbove) {
     const RenderScene scene = b.build();
     const double direct = 4 / (kPi * 4);
     for (int depth : {0, 1, 2, 20}) {
-        const RenderState s = render(scene, settings_for(Integrator::pt, depth, 1), 4, 4, 1);
-        for (const Color& c : s.radiance().pixels) EXPECT_NEAR(c.x, depth * direct, 1e-9) << depth;
+        const RenderSettings settings = settings_for(Integrator::pt, depth, 1);
+        const RenderState s = render(scene, settings, 4, 4, 1);
+        const double tolerance = test::analytic_tolerance(scene, settings) * std::max(1.0, depth * direct);
+        for (const Color& c : s.radiance().pixels) EXPECT_NEAR(c.x, depth * direct, tolerance) << depth;
     }
     // From the scene file: 25 becomes 20 (with a warning), and so does the default settings.
     const LoadedScene loaded = parse_scene(edit(scene_json(), "\"depth\": 4", "\"depth\": 25"), "deep.json");

@@ -26,7 +26,7 @@ namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
-                 [--kernels best|any|off]
+                 [--kernels best|double|any|off]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
@@ -37,10 +37,12 @@ constexpr const char* kBenchUsage = R"(Usage:
               the seconds the file's full sample count takes at that speed, and the median
               time of one full-resolution 1-spp pass.
 --linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
---kernels     how paths are traced: best (default: four at a time in SIMD lanes with the
-              AVX2/FMA kernels where the CPU has them, else one at a time), any (in
-              lanes with the kernels for any x86-64 CPU, SSE2) or off (one at a time),
-              to measure what each buys.
+--kernels     how paths are traced: best (default: in SIMD lanes with the AVX2/FMA
+              kernels where the CPU has them, eight in single precision where the
+              scene's sizes allow, else four in double; one at a time without AVX2),
+              double (always the four double lanes), any (in lanes with the kernels for
+              any x86-64 CPU, SSE2) or off (one at a time), to measure what each buys.
+              The table's last column says which ran for each scene.
 --stress      generated scenes of N random spheres under a sphere light, path traced at
               W x W (default 256) with 4 spp: ns per ray and ns per ray / log2(N).
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
@@ -170,8 +172,8 @@ BenchOptions parse(int argc, char** argv) {
 
 int bench_throughput(const BenchOptions& o) {
     std::vector<fs::path> scenes = o.scenes.empty() ? default_scenes() : o.scenes;
-    std::printf("| scene | renderer | spp run | median s | Mrays/s | est. s at file spp | 1-spp pass ms |\n");
-    std::printf("|---|---|---|---|---|---|---|\n");
+    std::printf("| scene | renderer | spp run | median s | Mrays/s | est. s at file spp | 1-spp pass ms | paths |\n");
+    std::printf("|---|---|---|---|---|---|---|---|\n");
     double total_estimate = 0;
     for (const fs::path& file : scenes) {
         RenderScene scene;
@@ -199,15 +201,16 @@ int bench_throughput(const BenchOptions& o) {
         }
         const double s = median(seconds), estimate = s * settings.target_spp / spp;
         total_estimate += estimate;
-        std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f |\n", file.stem().string().c_str(),
+        std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f | %s |\n", file.stem().string().c_str(),
                     std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
-                    median(mrays), estimate, median(pass_ms));
+                    median(mrays), estimate, median(pass_ms),
+                    std::string(packet_kernels_names.name(packet_kernels(scene, settings))).c_str());
         std::fflush(stdout);
     }
-    std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s, %s).\n", total_estimate,
-                omp_get_max_threads(),
+    std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s, --kernels %s).\n",
+                total_estimate, omp_get_max_threads(),
                 o.linear ? "linear scan" : ("BVH " + std::string(accel_backend_names.name(o.accel.front()))).c_str(),
-                std::string(packet_kernels_names.name(packet_kernels())).c_str());
+                std::string(packet_isa_names.name(o.kernels)).c_str());
     return 0;
 }
 

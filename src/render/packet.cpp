@@ -1,21 +1,27 @@
-// Path tracing of four samples at once, their paths in the lanes of SIMD registers (AVX2 where
-// the CPU has it). Casting rays, hit records, Sobol numbers, the light choice, the `brief`
-// and `cone` light samples, every material's scattering, throughput and Russian roulette
-// run lane-wise, as copies of the one-path routines, operation for operation; the other
-// light samples, emission weights and other estimators' numbers run per lane through the
-// same functions as one path (path.h). So every path is the one trace_sample gives, up to
-// rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
+// Path tracing of several samples at once, their paths in the lanes of SIMD registers (AVX2
+// where the CPU has it). Casting rays, hit records, Sobol numbers, the light choice, the
+// `brief` and `cone` light samples, every material's scattering, throughput and Russian
+// roulette run lane-wise, as copies of the one-path routines, operation for operation; the
+// other light samples, emission weights and other estimators' numbers run per lane through
+// the same functions as one path (path.h). So every path is the one trace_sample gives, up
+// to rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
 //
-// The kernels are in packet_lanes.inc, compiled twice: for any x86-64 CPU and for x86-64-v3
-// (AVX2, FMA). The v3 ones run where the CPU has those (the CPU is asked once, at the first
-// call). Elsewhere paths are traced one at a time: GCC emulates what SSE2 lacks (64-bit
-// compares, per-lane shifts, 32-bit multiplies) lane by lane, so the kernels for any CPU are
-// 2.5 times slower than one path at a time (docs/performance.md); they run only when
-// set_packet_isa asks for them, for tests and comparisons.
+// The kernels are in packet_lanes.inc, compiled three times: four double lanes for any
+// x86-64 CPU and for x86-64-v3 (AVX2, FMA), and eight single-precision lanes for x86-64-v3.
+// The v3 ones run where the CPU has those (the CPU is asked once, at the first call): the
+// single-precision lanes where float_lanes_fit says the scene's sizes and radiances keep
+// their rounding far below what an image shows (they then agree with one path to about 1e-6
+// per step; tests/test_packet.cpp), the double ones elsewhere. Without AVX2 paths are traced
+// one at a time: GCC emulates what SSE2 lacks (64-bit compares, per-lane shifts, 32-bit
+// multiplies) lane by lane, so the kernels for any CPU are 2.5 times slower than one path at
+// a time (docs/performance.md); they run only when set_packet_isa asks for them, for tests
+// and comparisons.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <type_traits>
+#include <utility>
 
 #include "core/sampling.h"
 #include "render/lanes.h"
@@ -69,6 +75,11 @@ namespace packet_any {
 namespace packet_v3 {
 #include "render/packet_lanes.inc"
 }  // namespace packet_v3
+#define KR_PACKET_FLOAT8
+namespace packet_f8 {
+#include "render/packet_lanes.inc"
+}  // namespace packet_f8
+#undef KR_PACKET_FLOAT8
 #undef KR_PACKET_TARGET_V3
 #pragma GCC pop_options
 #endif
@@ -89,23 +100,57 @@ bool cpu_has_v3() {
 #endif
 }
 
-}  // namespace
-
-void set_packet_isa(PacketIsa isa) { packet_isa.store(isa); }
-
-PacketKernels packet_kernels() {
+// The kernels the CPU and set_packet_isa pick, before a scene has a say (camera rays are the
+// double lanes' in both kinds of v3 lanes).
+PacketKernels isa_kernels() {
     switch (packet_isa.load(std::memory_order_relaxed)) {
-    case PacketIsa::best: return cpu_has_v3() ? PacketKernels::x86_64_v3 : PacketKernels::one_path;
+    case PacketIsa::best: return cpu_has_v3() ? PacketKernels::x86_64_v3_float : PacketKernels::one_path;
+    case PacketIsa::double_lanes: return cpu_has_v3() ? PacketKernels::x86_64_v3 : PacketKernels::one_path;
     case PacketIsa::any: return PacketKernels::x86_64;
     case PacketIsa::one_path: return PacketKernels::one_path;
     }
     return PacketKernels::one_path;
 }
 
+}  // namespace
+
+void set_packet_isa(PacketIsa isa) { packet_isa.store(isa); }
+
+bool float_lanes_fit(const RenderScene& scene) {
+    // Geometry: the largest distance is bounded by the camera's and the spheres' distances
+    // from the origin, as rays start at the camera or on a sphere.
+    double largest = length(scene.camera.position), smallest_radius = kInf;
+    for (const SphereGeom& s : scene.spheres) {
+        largest = std::max(largest, length(s.centre) + s.radius);
+        smallest_radius = std::min(smallest_radius, s.radius);
+    }
+    if (!(std::isfinite(largest) && smallest_radius > 0 && largest <= 0x1.0p12 * smallest_radius)) return false;
+    // Light: every nonzero radiance and intensity within 2^-60..2^60, which leaves single
+    // precision's range (2^-126..2^128) room for the factors a light sample multiplies in.
+    const auto in_range = [](const Color& c) {
+        for (int k = 0; k < 3; ++k)
+            if (c[k] != 0 && !(std::abs(c[k]) >= 0x1.0p-60 && std::abs(c[k]) <= 0x1.0p60)) return false;
+        return true;
+    };
+    for (const AreaLight& light : scene.area_lights)
+        if (!in_range(light.radiance)) return false;
+    for (const PointLight& light : scene.point_lights)
+        if (!in_range(light.intensity)) return false;
+    return true;
+}
+
+PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
+    if (!packets_apply(scene, settings)) return PacketKernels::one_path;
+    const PacketKernels kernels = isa_kernels();
+    if (kernels == PacketKernels::x86_64_v3_float && !float_lanes_fit(scene)) return PacketKernels::x86_64_v3;
+    return kernels;
+}
+
 void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
                  Sampler* const* samplers, int count, Ray* rays) {
-    switch (packet_kernels()) {
+    switch (isa_kernels()) {
 #ifdef KR_X86_64_V3
+    case PacketKernels::x86_64_v3_float:
     case PacketKernels::x86_64_v3: return packet_v3::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
 #endif
     case PacketKernels::x86_64: return packet_any::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
@@ -120,9 +165,11 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
     for (int k = 0; k < count; ++k)
         camera_rays &=
             rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
-    const PacketKernels kernels = packet_kernels();
-    if (packets_apply(scene, settings) && camera_rays && count > 1 && kernels != PacketKernels::one_path) {
+    const PacketKernels kernels = packet_kernels(scene, settings);
+    if (camera_rays && count > 1 && kernels != PacketKernels::one_path) {
 #ifdef KR_X86_64_V3
+        if (kernels == PacketKernels::x86_64_v3_float)
+            return packet_f8::trace_packet(scene, settings, rays, samplers, count, results);
         if (kernels == PacketKernels::x86_64_v3)
             return packet_v3::trace_packet(scene, settings, rays, samplers, count, results);
 #endif

@@ -161,14 +161,22 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
 
 // How camera_rays and trace_samples trace (packet.cpp), process-wide. `best`: in SIMD lanes
 // with the kernels built for x86-64-v3 where the CPU has AVX2 and FMA, else one path at a
-// time (the kernels built for any x86-64 CPU are slower than that). `any`: in lanes with the
-// kernels for any CPU; `one_path`: one at a time. The last two are for tests and comparisons.
-enum class PacketIsa { best, any, one_path };
-inline constexpr EnumNames<PacketIsa, 3> packet_isa_names{{"best", "any", "off"}};
+// time (the kernels built for any x86-64 CPU are slower than that); eight paths in single
+// precision where the scene's sizes fit it (float_lanes_fit), else four in double. `double`:
+// always the four double lanes where the CPU has them; `any`: in lanes with the kernels for
+// any CPU; `one_path`: one at a time. The last three are for tests and comparisons.
+enum class PacketIsa { best, double_lanes, any, one_path };
+inline constexpr EnumNames<PacketIsa, 4> packet_isa_names{{"best", "double", "any", "off"}};
 void set_packet_isa(PacketIsa isa);
-// What runs now, as set_packet_isa and the CPU decide.
-enum class PacketKernels { x86_64_v3, x86_64, one_path };
-inline constexpr EnumNames<PacketKernels, 3> packet_kernels_names{{"x86-64-v3 lanes", "x86-64 lanes", "one path"}};
-PacketKernels packet_kernels();
+// What trace_samples runs for path tracing with these settings on this scene, as
+// set_packet_isa, the CPU and the scene decide.
+enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path };
+inline constexpr EnumNames<PacketKernels, 4> packet_kernels_names{
+    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path"}};
+PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
+// Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
+// distance a sphere test meets, stays below 2^-12 of the smallest radius, and its lights'
+// radiance stays far inside their range (2^-60 to 2^60; a light of 1e30 is double's).
+bool float_lanes_fit(const RenderScene& scene);
 
 }  // namespace kr
