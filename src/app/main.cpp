@@ -66,6 +66,10 @@ Options:
   --blur R              box blur of radius R pixels on the radiance (default: 0)
   --seed N              random seed (default: 0); same seed, same image
   --threads N           worker threads (default: all cores)
+  --kernels NAME        how paths are traced: best | double | any | off (default: best,
+                        in SIMD lanes where the CPU has AVX2: eight in single precision
+                        where the scene's sizes allow, else four in double; double keeps
+                        the four double lanes; docs/performance.md)
   -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
                         (only with a single scene); OUT.png writes PNGs instead
   -q, --quiet           no progress bar
@@ -91,6 +95,7 @@ struct Options {
     std::optional<fs::path> output;
     bool quiet = false;
     bool gl = false;  // tone map on the viewer's display path (OSMesa)
+    PacketIsa kernels = PacketIsa::best;
 };
 
 Options parse_options(int argc, char** argv) {
@@ -103,6 +108,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--noise") o.noise = parse_positive(arg, value());
         else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, 1000));
         else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, 4096));
+        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, 4096));
         else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, (1ll << 62)));
         else if (arg == "--integrator") o.integrator = parse_name(arg, value(), integrator_names);
@@ -292,6 +298,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
+    set_packet_isa(opt.kernels);
     if (opt.scenes.empty()) {
         opt.scenes = default_scenes();
         if (opt.scenes.empty()) {
