@@ -308,3 +308,56 @@ TEST_P(Packet, CameraRaysAreOneByOnes) {
             }
         }
 }
+
+// Camera samples traced from pixel positions (trace_camera_samples: with Sobol samplers and a
+// pinhole, the single-precision lanes make the camera rays themselves) against camera_ray and
+// trace_sample one by one: counts below, at and above a lane group and a batch, and the thin
+// lens, which always takes camera_rays' rays.
+TEST_P(Packet, CameraSamplesAreOneByOnes) {
+    RenderScene scene = brief_scene(3);
+    const int width = scene.renderer.width, height = scene.renderer.height;
+    for (double lens_radius : {0.0, 0.2})
+        for (Estimator estimator : {Estimator::sobol, Estimator::uniform})
+            for (int count : {1, 3, 9, 64, 130}) {
+                scene.camera.lens_radius = lens_radius;
+                RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+                settings.estimator = estimator;
+                const double tolerance = lane_tolerance(scene, settings);
+                const size_t n = static_cast<size_t>(count);
+                std::vector<std::optional<Sampler>> together(n), alone(n);
+                std::vector<Sampler*> samplers(n);
+                std::vector<int> xs(n), ys(n);
+                for (int k = 0; k < count; ++k) {
+                    xs[size_t(k)] = (k * 37) % width, ys[size_t(k)] = (k * 101) % height;
+                    const uint64_t pixel = uint64_t(ys[size_t(k)]) * uint64_t(width) + uint64_t(xs[size_t(k)]);
+                    together[size_t(k)].emplace(estimator, 4, pixel, uint32_t(k % 7), 16);
+                    alone[size_t(k)].emplace(estimator, 4, pixel, uint32_t(k % 7), 16);
+                    samplers[size_t(k)] = &*together[size_t(k)];
+                }
+                std::vector<SampleResult> results(n);
+                trace_camera_samples(scene, settings, width, height, xs.data(), ys.data(), samplers.data(), count,
+                                     results.data());
+                int mismatches = 0;
+                for (int k = 0; k < count; ++k) {
+                    Sampler& sampler = *alone[size_t(k)];
+                    const Vec2 sub = sampler.pixel();
+                    Vec2 lens;
+                    if (lens_radius > 0) lens = sampler.next_2d();
+                    else sampler.skip_2d();
+                    const Vec2 film = raster_to_camera(xs[size_t(k)] + sub.x, ys[size_t(k)] + sub.y, width, height);
+                    const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+                    Ray ray;
+                    ray.o = cr.origin;
+                    ray.d = cr.direction;
+                    const SampleResult one = trace_sample(scene, settings, ray, sampler);
+                    const SampleResult& r = results[size_t(k)];
+                    mismatches += !(close(r.radiance.x, one.radiance.x, tolerance) &&
+                                    close(r.radiance.y, one.radiance.y, tolerance) &&
+                                    close(r.radiance.z, one.radiance.z, tolerance) && r.rays == one.rays &&
+                                    close(r.primary_distance, one.primary_distance, tolerance));
+                }
+                EXPECT_LE(mismatches, count / 100) << estimator_names.name(estimator) << " lens " << lens_radius
+                                                   << ", " << count << " samples";
+            }
+}
+

@@ -179,4 +179,21 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
     }
 }
 
+void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                          const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results) {
+#ifdef KR_X86_64_V3
+    bool pinhole_sobol = scene.camera.lens_radius <= 0 && count > 1;
+    for (int k = 0; k < count && pinhole_sobol; ++k)
+        pinhole_sobol = samplers[k]->sobol() && samplers[k]->dimension() == 0;
+    if (pinhole_sobol && packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float)
+        return packet_f8::trace_pinhole_samples(scene, settings, width, height, xs, ys, samplers, count, results);
+#endif
+    Ray rays[kSampleBatch];
+    for (int first = 0; first < count; first += kSampleBatch) {
+        const int n = std::min(kSampleBatch, count - first);
+        camera_rays(scene, width, height, xs + first, ys + first, samplers + first, n, rays);
+        trace_samples(scene, settings, rays, samplers + first, n, results + first);
+    }
+}
+
 }  // namespace kr

@@ -238,12 +238,10 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         Sampler* batch_samplers[kSampleBatch];
         int batch_x[kSampleBatch], batch_y[kSampleBatch];
         size_t batch_pixels[kSampleBatch];
-        Ray batch_rays[kSampleBatch];
         SampleResult results[kSampleBatch];
         int pending = 0;
         auto flush = [&] {
-            camera_rays(scene, width, height, batch_x, batch_y, batch_samplers, pending, batch_rays);
-            trace_samples(scene, settings, batch_rays, batch_samplers, pending, results);
+            trace_camera_samples(scene, settings, width, height, batch_x, batch_y, batch_samplers, pending, results);
             for (int k = 0; k < pending; ++k) {
                 const SampleResult& r = results[k];
                 const size_t pixel = batch_pixels[k];

@@ -159,6 +159,12 @@ inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);
 
+// camera_rays, then trace_samples: `count` camera samples at pixels (xs, ys). The
+// single-precision lanes make a pinhole's camera rays themselves, eight at a time, for
+// Sobol samplers (the same samples; packet.cpp).
+void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                          const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
+
 // How camera_rays and trace_samples trace (packet.cpp), process-wide. `best`: in SIMD lanes
 // with the kernels built for x86-64-v3 where the CPU has AVX2 and FMA, else one path at a
 // time (the kernels built for any x86-64 CPU are slower than that); eight paths in single
