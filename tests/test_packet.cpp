@@ -114,6 +114,9 @@ TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
     const RenderScene brief = brief_scene(6);
     const RenderSettings settings = RenderSettings::from_scene(brief.renderer);
     EXPECT_TRUE(float_lanes_fit(brief));
+    RenderScene wide_lens = brief;  // rays from up to 1e4 away: beyond 4096 radii of 0.5
+    wide_lens.camera.lens_radius = 1e4;
+    EXPECT_FALSE(float_lanes_fit(wide_lens));
     set_packet_isa(PacketIsa::any);
     EXPECT_EQ(packet_kernels(brief, settings), PacketKernels::x86_64);
     set_packet_isa(PacketIsa::one_path);

@@ -117,9 +117,9 @@ PacketKernels isa_kernels() {
 void set_packet_isa(PacketIsa isa) { packet_isa.store(isa); }
 
 bool float_lanes_fit(const RenderScene& scene) {
-    // Geometry: the largest distance is bounded by the camera's and the spheres' distances
-    // from the origin, as rays start at the camera or on a sphere.
-    double largest = length(scene.camera.position), smallest_radius = kInf;
+    // Geometry: the largest distance is bounded by the camera's (its lens included) and the
+    // spheres' distances from the origin, as rays start at the camera or on a sphere.
+    double largest = length(scene.camera.position) + std::max(scene.camera.lens_radius, 0.0), smallest_radius = kInf;
     for (const SphereGeom& s : scene.spheres) {
         largest = std::max(largest, length(s.centre) + s.radius);
         smallest_radius = std::min(smallest_radius, s.radius);
