@@ -85,6 +85,21 @@ Agreement compare(const RenderScene& scene, const RenderSettings& settings, int 
     return a;
 }
 
+// A camera sample's ray as camera_ray draws it, one by one: the sub-pixel position, then the
+// lens's numbers (skipped for a pinhole), raster_to_camera and CameraModel::generate.
+Ray camera_ray_one_by_one(const RenderScene& scene, int width, int height, int x, int y, Sampler& sampler) {
+    const Vec2 sub = sampler.pixel();
+    Vec2 lens;
+    if (scene.camera.lens_radius > 0) lens = sampler.next_2d();
+    else sampler.skip_2d();
+    const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+    const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+    Ray ray;
+    ray.o = cr.origin;
+    ray.d = cr.direction;
+    return ray;
+}
+
 RenderScene brief_scene(int n) {
     return prepare_scene(
         load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
@@ -294,17 +309,12 @@ TEST_P(Packet, CameraRaysAreOneByOnes) {
             camera_rays(scene, width, height, xs, ys, samplers.data(), kCount, rays);
             for (int k = 0; k < kCount; ++k) {
                 Sampler& sampler = *alone[size_t(k)];
-                const Vec2 sub = sampler.pixel();
-                Vec2 lens;
-                if (lens_radius > 0) lens = sampler.next_2d();
-                else sampler.skip_2d();
-                const Vec2 film = raster_to_camera(xs[k] + sub.x, ys[k] + sub.y, width, height);
-                const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
+                const Ray one = camera_ray_one_by_one(scene, width, height, xs[k], ys[k], sampler);
                 const std::string where = std::string(estimator_names.name(estimator)) + " lens " +
                                           std::to_string(lens_radius) + " sample " + std::to_string(k);
                 for (int axis = 0; axis < 3; ++axis) {
-                    EXPECT_TRUE(close(rays[k].o[axis], cr.origin[axis])) << where;
-                    EXPECT_TRUE(close(rays[k].d[axis], cr.direction[axis])) << where;
+                    EXPECT_TRUE(close(rays[k].o[axis], one.o[axis])) << where;
+                    EXPECT_TRUE(close(rays[k].d[axis], one.d[axis])) << where;
                 }
                 EXPECT_EQ(rays[k].tmin, 0.0);
                 EXPECT_EQ(together[size_t(k)]->next_1d(), sampler.next_1d()) << where;
@@ -343,15 +353,7 @@ TEST_P(Packet, CameraSamplesAreOneByOnes) {
                 int mismatches = 0;
                 for (int k = 0; k < count; ++k) {
                     Sampler& sampler = *alone[size_t(k)];
-                    const Vec2 sub = sampler.pixel();
-                    Vec2 lens;
-                    if (lens_radius > 0) lens = sampler.next_2d();
-                    else sampler.skip_2d();
-                    const Vec2 film = raster_to_camera(xs[size_t(k)] + sub.x, ys[size_t(k)] + sub.y, width, height);
-                    const CameraRay cr = scene.camera.generate(film.x, film.y, lens.x, lens.y);
-                    Ray ray;
-                    ray.o = cr.origin;
-                    ray.d = cr.direction;
+                    const Ray ray = camera_ray_one_by_one(scene, width, height, xs[size_t(k)], ys[size_t(k)], sampler);
                     const SampleResult one = trace_sample(scene, settings, ray, sampler);
                     const SampleResult& r = results[size_t(k)];
                     mismatches += !(close(r.radiance.x, one.radiance.x, tolerance) &&
