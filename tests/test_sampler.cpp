@@ -247,3 +247,20 @@ TEST(Sobol, VertexNumbersLeftOutDoNotShiftOthers) {
             EXPECT_EQ(a.y, b.y);
         }
 }
+
+// render_pass keeps each pixel's Sobol key (Sampler::pixel_key) and builds its samplers from
+// it: the same numbers as the sampler built from the seed and the pixel.
+TEST(Sobol, SamplerFromThePixelKeyIsTheSame) {
+    for (uint64_t seed : {0ull, 7ull, 1ull << 40})
+        for (uint64_t pixel : {0ull, 1ull, 262143ull, 1ull << 33})
+            for (uint32_t index : {0u, 1u, 5u, 4095u}) {
+                Sampler from_seed(Estimator::sobol, seed, pixel, index, 16);
+                Sampler from_key(Sampler::pixel_key(seed, pixel), index);
+                EXPECT_EQ(from_key.sobol_key(), from_seed.sobol_key());
+                EXPECT_EQ(from_key.index_reversed(), from_seed.index_reversed());
+                const Vec2 a = from_seed.pixel(), b = from_key.pixel();
+                EXPECT_EQ(a.x, b.x);
+                EXPECT_EQ(a.y, b.y);
+                for (int d = 0; d < 12; ++d) EXPECT_EQ(from_seed.next_1d(), from_key.next_1d()) << d;
+            }
+}

@@ -32,6 +32,7 @@ void RenderState::reset(int w, int h) {
     pass_samples.clear();
     sample_credit.clear();
     for (auto& scratch : allocation_scratch) scratch.clear();
+    sobol_keys.clear();
 }
 
 Image RenderState::radiance() const {
@@ -224,6 +225,15 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     const int width = state.width, height = state.height;
     uint64_t rays = 0, nonfinite = 0;
     bool stopped = false;
+    const bool sobol = settings.estimator == Estimator::sobol;
+    const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    if (sobol && (state.sobol_keys.size() != pixels || state.sobol_keys_seed != settings.seed)) {
+        state.sobol_keys.resize(pixels);
+        state.sobol_keys_seed = settings.seed;
+        const long n = long(pixels);
+#pragma omp parallel for schedule(static)
+        for (long i = 0; i < n; ++i) state.sobol_keys[size_t(i)] = Sampler::pixel_key(settings.seed, uint64_t(i));
+    }
     // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, nonfinite) reduction(|| : stopped)
     for (int y = 0; y < height; ++y) {
@@ -247,8 +257,9 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 const size_t pixel = batch_pixels[k];
                 rays += r.rays;
                 // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
-                // would overflow the pixel's sum.
-                if (!is_finite(r.radiance) || !is_finite(state.radiance_sum[pixel] + r.radiance)) {
+                // would overflow the pixel's sum. The sums stay finite, so a sum plus a sample
+                // is finite only where the sample is too: one test covers both.
+                if (!is_finite(state.radiance_sum[pixel] + r.radiance)) {
                     ++nonfinite;
                     continue;
                 }
@@ -267,7 +278,8 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             for (int k = 0; k < samples; ++k) {
                 const uint32_t index = state.sample_index[pixel]++;
                 batch_samplers[pending] =
-                    &samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+                    sobol ? &samplers[pending].emplace(state.sobol_keys[pixel], index)
+                          : &samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
                 batch_x[pending] = x;
                 batch_y[pending] = y;
                 batch_pixels[pending] = pixel;

@@ -61,6 +61,10 @@ struct RenderState {
     std::vector<uint8_t> pass_samples;
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
     std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's and update_adaptive's buffers
+    // The Sobol samplers' per-pixel keys (Sampler::pixel_key) for sobol_keys_seed: the same in
+    // every pass, so render_pass works them out once (empty until a Sobol pass).
+    std::vector<uint32_t> sobol_keys;
+    uint64_t sobol_keys_seed = 0;
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }

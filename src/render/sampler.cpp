@@ -7,7 +7,7 @@ namespace kr {
 
 Sampler::Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target)
     : estimator_(estimator),
-      sobol_key_(uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)))),
+      sobol_key_(pixel_key(seed, pixel)),
       index_(index),
       index_reversed_(reverse_bits(index)),
       target_(std::max(target, 1)) {

@@ -133,6 +133,14 @@ class Sampler {
 public:
     // `target` is the sample count the stratified estimator divides the pixel for.
     Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target);
+    // The Sobol estimator's sampler from its pixel's key (pixel_key), which render_pass keeps
+    // per pixel: the same sampler as the constructor above gives.
+    Sampler(uint32_t sobol_key, uint32_t index)
+        : estimator_(Estimator::sobol), sobol_key_(sobol_key), index_(index), index_reversed_(reverse_bits(index)) {}
+    // The Sobol numbers' key of a pixel for a seed: two SplitMix64 hashes.
+    static uint32_t pixel_key(uint64_t seed, uint64_t pixel) {
+        return uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)));
+    }
     // For tools and tests that trace rays by hand: the uniform estimator on one RNG stream.
     explicit Sampler(const Rng& rng) : estimator_(Estimator::uniform), rng_(rng) {}
 
