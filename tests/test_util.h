@@ -38,14 +38,14 @@ inline CommandResult run_command(const std::string& command, const std::filesyst
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
 }
 
-// Upper critical value of the chi-square distribution with `dof` degrees of freedom at
-// significance `alpha` (Wilson-Hilferty; accurate to a few percent for dof >= 10).
 // The relative tolerance of a render's analytic value: the rounding of the single-precision
 // lanes where they trace the scene (packet_kernels), else double's.
 inline double analytic_tolerance(const RenderScene& scene, const RenderSettings& settings) {
     return packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float ? 1e-6 : 1e-9;
 }
 
+// Upper critical value of the chi-square distribution with `dof` degrees of freedom at
+// significance `alpha` (Wilson-Hilferty; accurate to a few percent for dof >= 10).
 inline double chi_square_critical(int dof, double z_alpha = 3.719 /* alpha = 1e-4 */) {
     const double k = dof;
     const double a = 2.0 / (9.0 * k);

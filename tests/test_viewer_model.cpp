@@ -229,7 +229,10 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
 // sees exactly 0.1 in every sample. In double: the single-precision lanes would hand in
 // float(0.1), and the accumulation is what this checks.
 TEST(Accumulation, RenderPassPathStaysExact) {
-    set_packet_isa(PacketIsa::double_lanes);
+    struct DoubleLanes {  // for this test only, whichever way it ends
+        DoubleLanes() { set_packet_isa(PacketIsa::double_lanes); }
+        ~DoubleLanes() { set_packet_isa(PacketIsa::best); }
+    } double_lanes;
     test::SceneBuilder b;
     b.scene.renderer.width = b.scene.renderer.height = 1;
     b.emitter({0, 0, 0}, 100, Color(0.1, 0.3, 0.7), b.material(MaterialType::diffuse));
@@ -244,7 +247,6 @@ TEST(Accumulation, RenderPassPathStaysExact) {
     EXPECT_NEAR(mean.x, 0.1, 1e-12 * 0.1);
     EXPECT_NEAR(mean.y, 0.3, 1e-12 * 0.3);
     EXPECT_NEAR(mean.z, 0.7, 1e-12 * 0.7);
-    set_packet_isa(PacketIsa::best);
 }
 
 // The accumulator draws exactly the core renderer's samples: same RNG streams.
