@@ -27,5 +27,15 @@ if [ ${#missing[@]} -gt 0 ]; then
     { "${sudo_cmd[@]}" apt-get update && "${sudo_cmd[@]}" apt-get install -y --no-install-recommends "${missing[@]}"; }
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+# Configure quietly, but never hide what CMake warns about (e.g. Embree missing): on a
+# warning or an error the whole configure log is shown.
+configure_log=$(mktemp)
+trap 'rm -f "$configure_log"' EXIT
+if ! cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "$@" >"$configure_log" 2>&1; then
+  cat "$configure_log" >&2
+  exit 1
+fi
+if grep -qE "CMake (Warning|Deprecation Warning)|^WARNING" "$configure_log"; then
+  cat "$configure_log" >&2
+fi
 cmake --build build -j"$(nproc)"

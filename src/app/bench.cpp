@@ -156,7 +156,7 @@ BenchOptions parse(int argc, char** argv) {
             o.write_stress = int(parse_number(arg, value(), 1, 1e7));
             o.write_path = value();
         } else if (arg == "-h" || arg == "--help") throw UsageError{""};
-        else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
+        else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
         else o.scenes.emplace_back(arg);
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)

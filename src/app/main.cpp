@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <new>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,9 @@
 #include "app/progress.h"
 #include "core/args.h"
 #include "core/image.h"
+#include "core/limits.h"
+#include "core/memory.h"
+#include "core/text.h"
 #include "render/render.h"
 #include "scene/load.h"
 #include "viewer/files.h"
@@ -41,11 +45,13 @@ With no SCENE, renders every *.json in res/scenes/. Defaults come from each scen
 file's renderer block; the options below override them.
 
 Options:
-  --spp N               samples per pixel (default: the file's "samples"; with --time
-                        or --noise, an upper bound, unlimited if not given)
-  --time SECONDS        render as many passes as fit in SECONDS (checked between passes)
+  --spp N               samples per pixel, 1..16777216 (default: the file's "samples";
+                        with --time or --noise, an upper bound, else at most 65536 passes)
+  --time SECONDS        render as many passes as fit in SECONDS, in (0, 1e6] (checked
+                        between passes)
   --noise X             stop when the estimated relative RMS error of the image falls
-                        below X (e.g. 0.01); adaptive: passes go to the noisiest pixels
+                        below X, in [1e-4, 1] (e.g. 0.01); adaptive: passes go to the
+                        noisiest pixels
   --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
                         pt-naive samples no area light, only point lights)
   --estimator NAME      where samples come from: uniform | stratified | sobol
@@ -63,9 +69,9 @@ Options:
   --tonemap NAME        sigmoid | linear (default: sigmoid)
   --gl                  tone map through the viewer's GLSL display shaders in an
                         offscreen OSMesa framebuffer (no display, no GPU needed)
-  --blur R              box blur of radius R pixels on the radiance (default: 0)
-  --seed N              random seed (default: 0); same seed, same image
-  --threads N           worker threads (default: all cores)
+  --blur R              box blur of radius R pixels on the radiance, 0..4096 (default: 0)
+  --seed N              random seed, 0..2^62 (default: 0); same seed, same image
+  --threads N           worker threads, 1..4096 (default: all cores)
   --kernels NAME        how paths are traced: best | double | any | off (default: best,
                         in SIMD lanes where the CPU has AVX2: eight in single precision
                         where the scene's sizes allow, else four in double; double keeps
@@ -78,6 +84,8 @@ Options:
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
 (1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per
 scene on stdout: spp, seconds, Mrays/s.
+A render whose memory estimate exceeds the machine's (or ulimit -v's) memory is refused;
+scene files are at most 64 MiB (README.md, "Limits").
 Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
 )";
 
@@ -103,14 +111,14 @@ Options parse_options(int argc, char** argv) {
     for (ArgCursor args(argc, argv); args.next();) {
         const std::string& arg = args.arg();
         auto value = [&] { return args.value(); };
-        if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, 1 << 24));
-        else if (arg == "--time") o.time_limit = parse_positive(arg, value());
-        else if (arg == "--noise") o.noise = parse_positive(arg, value());
-        else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, 1000));
-        else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, 4096));
+        if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, kMaxSamples));
+        else if (arg == "--time") o.time_limit = parse_number(arg, value(), 0, kMaxSeconds, true);
+        else if (arg == "--noise") o.noise = parse_number(arg, value(), kMinNoise, kMaxNoise);
+        else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, kMaxDepth));
+        else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, kMaxThreads));
         else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
-        else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, 4096));
-        else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, (1ll << 62)));
+        else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, kMaxBlur));
+        else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, kMaxSeed));
         else if (arg == "--integrator") o.integrator = parse_name(arg, value(), integrator_names);
         else if (arg == "--estimator") o.estimator = parse_name(arg, value(), estimator_names);
         else if (arg == "--allocation") o.allocation = parse_name(arg, value(), allocation_names);
@@ -119,7 +127,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "-o" || arg == "--output") o.output = value();
         else if (arg == "-q" || arg == "--quiet") o.quiet = true;
         else if (arg == "--gl") o.gl = true;
-        else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
+        else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
         else o.scenes.emplace_back(arg);
     }
     if (o.output && o.scenes.size() != 1)
@@ -142,14 +150,28 @@ bool same_file(const fs::path& a, const fs::path& b) {
     return resolved(a) == resolved(b);
 }
 
+// A file path in a message: as it is, or quoted and escaped when it holds control
+// characters, bytes that are not UTF-8 or too many of them (core/text.h).
+std::string shown(const fs::path& path) { return show_user_text(path.string()); }
+
+// Whether an allocation failed: new's bad_alloc, or a container asked for more elements than
+// it can hold (length_error, e.g. vector::_M_default_append).
+bool out_of_memory(const std::exception& e) {
+    return dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e);
+}
+
 // Loads, renders and writes one scene. Returns false (after printing why) on failure.
-bool render_scene_file(const fs::path& scene_file, const Options& opt) {
+// `stage` says what the work in progress needs memory for, for the caller's message.
+bool render_scene_file(const fs::path& scene_file, const Options& opt, std::string& stage) {
+    const std::string file = shown(scene_file);
     LoadedScene loaded;
     RenderScene scene;
     std::vector<std::string> warnings;
     try {
+        stage = "the scene";
         loaded = load_scene_file(scene_file);
         warnings = loaded.warnings;
+        stage = "the prepared scene and its BVH";
         scene = prepare_scene(loaded.scene, &warnings);
     } catch (const SceneError& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
@@ -164,12 +186,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     if (opt.estimator) settings.estimator = *opt.estimator;
     if (opt.allocation) settings.allocation = *opt.allocation;
     if (opt.light_sampling) settings.light_sampling = *opt.light_sampling;
-    if (opt.depth) {
-        if (*opt.depth > kMaxDepth)
-            std::fprintf(stderr, "warning: --depth %d is above the maximum %d; clamped to %d\n", *opt.depth,
-                         kMaxDepth, kMaxDepth);
-        settings.max_depth = std::min(*opt.depth, kMaxDepth);
-    }
+    if (opt.depth) settings.max_depth = *opt.depth;
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
     const fs::path depth_output = depth_path_for(output);
@@ -179,19 +196,25 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
         for (const fs::path& written : {output, depth_output})
             if (same_file(written, input)) {
                 std::fprintf(stderr, "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
-                             scene_file.string().c_str(), written.string().c_str(), input.string().c_str(),
+                             file.c_str(), shown(written).c_str(), shown(input).c_str(),
                              same_file(input, scene_file) ? " itself" : "");
                 return false;
             }
 
-    RenderState state;
-    try {
-        state.reset(scene.renderer.width, scene.renderer.height);
-    } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "error: %s: not enough memory for the render state of a %dx%d image\n",
-                     scene_file.string().c_str(), scene.renderer.width, scene.renderer.height);
+    // Refused before allocating when the render cannot fit in the memory the process may use
+    // (core/memory.h): better at once than after hours, or by the kernel's OOM killer.
+    const int width = scene.renderer.width, height = scene.renderer.height;
+    const std::string image = std::to_string(width) + "x" + std::to_string(height) + " image";
+    const uint64_t needed = render_memory_bytes(width, height, opt.blur > 0);
+    if (const MemoryLimit limit = memory_limit(); needed > limit.bytes) {
+        std::fprintf(stderr, "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)\n",
+                     file.c_str(), image.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
+                     format_bytes(limit.bytes).c_str());
         return false;
     }
+    stage = "the render state of a " + image;
+    RenderState state;
+    state.reset(width, height);
     const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -200,7 +223,11 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     rule.seconds = opt.time_limit;
     rule.noise = opt.noise;
     const bool open_ended = opt.time_limit > 0 || opt.noise > 0;
-    rule.max_passes = open_ended && !opt.spp ? (1 << 24) : settings.target_spp;
+    // Without --spp an open-ended render still ends: a noise target the scene cannot reach
+    // in reasonable time stops at the cap (core/limits.h).
+    const bool capped = open_ended && !opt.spp;
+    rule.max_passes = capped ? kMaxOpenEndedPasses : settings.target_spp;
+    stage = "rendering a " + image;
     const StopReason reason = render_until(scene, settings, state, rule, [&](const RenderState& s) {
         if (show_progress && elapsed() - last_draw > 0.1) {
             if (open_ended) {
@@ -216,30 +243,36 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
         return true;
     });
     const double seconds = elapsed();
-    if (open_ended)
+    if (open_ended) {
+        const std::string by = reason == StopReason::noise ? "--noise"
+                               : reason == StopReason::time ? "--time"
+                               : capped ? "the cap of " + std::to_string(kMaxOpenEndedPasses) + " passes (no --spp)"
+                                        : "--spp";
         std::fprintf(stderr, "%s%s: stopped by %s after %d passes, estimated relative error %.4f\n",
-                     show_progress ? "\n" : "", scene_file.filename().string().c_str(),
-                     reason == StopReason::noise ? "--noise" : reason == StopReason::time ? "--time" : "--spp",
-                     state.passes, state.relative_error());
+                     show_progress ? "\n" : "", shown(scene_file.filename()).c_str(), by.c_str(), state.passes,
+                     state.relative_error());
+    }
     if (show_progress) std::fprintf(stderr, "\n");
 
+    stage = "the output images of a " + image;
     try {
         const Image radiance = box_blur(state.radiance(), opt.blur);
         viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
                                            : tonemap(radiance, opt.tonemap));
         viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
+        if (out_of_memory(e)) throw;
+        std::fprintf(stderr, "error: %s: %s\n", file.c_str(), e.what());
         return false;
     }
     if (state.nonfinite_samples > 0)
-        std::fprintf(stderr, "warning: %s: %llu non-finite samples were dropped\n", scene_file.string().c_str(),
+        std::fprintf(stderr, "warning: %s: %llu non-finite samples were dropped\n", file.c_str(),
                      static_cast<unsigned long long>(state.nonfinite_samples));
     std::printf("%s: %dx%d %s %d spp, %.2f s, %.1f Mrays/s (%.1f M rays) -> %s\n",
-                scene_file.filename().string().c_str(), state.width, state.height,
+                shown(scene_file.filename()).c_str(), state.width, state.height,
                 std::string(integrator_names.name(settings.integrator)).c_str(), state.passes, seconds,
                 seconds > 0 ? double(state.rays) / seconds * 1e-6 : 0.0, double(state.rays) * 1e-6,
-                output.string().c_str());
+                shown(output).c_str());
     std::fflush(stdout);
     return true;
 }
@@ -270,7 +303,15 @@ int main(int argc, char** argv) {
         std::fputs(kUsage, stdout);
         return 0;
     }
-    if (command == "bench") return run_bench(argc, argv);
+    if (command == "bench") {
+        try {
+            return run_bench(argc, argv);
+        } catch (const std::exception& e) {
+            if (!out_of_memory(e)) throw;
+            std::fprintf(stderr, "error: bench: not enough memory for the benchmark's scenes and images\n");
+            return 1;
+        }
+    }
     if (command == "psnr") {
         if (argc != 4) {
             std::fprintf(stderr, "error: psnr needs two image files (PPM or PNG)\n");
@@ -280,14 +321,18 @@ int main(int argc, char** argv) {
             std::printf("%.2f\n", psnr(viewer::read_image(argv[2]), viewer::read_image(argv[3])));
             return 0;
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "error: %s\n", e.what());
+            if (out_of_memory(e))
+                std::fprintf(stderr, "error: not enough memory for the images %s and %s\n", shown(argv[2]).c_str(),
+                             shown(argv[3]).c_str());
+            else
+                std::fprintf(stderr, "error: %s\n", e.what());
             return 1;
         }
     }
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
-                     command.c_str(), kUsage);
+                     command.empty() ? "" : quote_user_text(command, 40).c_str(), kUsage);
         return 2;
     }
     Options opt;
@@ -308,10 +353,14 @@ int main(int argc, char** argv) {
     }
     bool ok = true;
     for (const fs::path& scene : opt.scenes) {
+        std::string stage;
         try {
-            ok = render_scene_file(scene, opt) && ok;
-        } catch (const std::exception& e) {  // e.g. out of memory tone mapping a huge image
-            std::fprintf(stderr, "error: %s: %s\n", scene.string().c_str(), e.what());
+            ok = render_scene_file(scene, opt, stage) && ok;
+        } catch (const std::exception& e) {
+            if (out_of_memory(e))
+                std::fprintf(stderr, "error: %s: not enough memory for %s\n", shown(scene).c_str(), stage.c_str());
+            else
+                std::fprintf(stderr, "error: %s: %s\n", shown(scene).c_str(), e.what());
             ok = false;
         }
     }

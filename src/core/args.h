@@ -1,11 +1,15 @@
 // Command-line value parsing shared by `keithray render`, `bench` and `view`: the whole
-// text must be the value, and a bad one becomes a UsageError naming the flag.
+// text must be the value, and a bad one becomes a UsageError naming the flag, its range and
+// the text given (quoted and bounded: core/text.h).
 #pragma once
 
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "core/text.h"
 
 namespace kr {
 
@@ -26,7 +30,7 @@ public:
     }
     const std::string& arg() const { return arg_; }
     std::string value() {
-        if (index_ + 1 >= argc_) throw UsageError{arg_ + " needs a value"};
+        if (index_ + 1 >= argc_) throw UsageError{show_user_text(arg_, 40) + " needs a value"};
         return argv_[++index_];
     }
 
@@ -45,44 +49,50 @@ inline int report_usage(const UsageError& e, const char* usage) {
     return e.message.empty() ? 0 : 2;
 }
 
-// True if all of `text` reads as a number (stored in `value`).
+inline UsageError unknown_option(const std::string& arg) { return {"unknown option " + quote_user_text(arg, 40)}; }
+
+// A range bound as people write it: 4096, 1e+06, 0.0001.
+inline std::string bound_text(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.10g", v);
+    return text;
+}
+
+// True if all of `text` reads as a decimal number (stored in `value`): no leading blanks,
+// no hexadecimal, no "nan" or "inf".
 inline bool read_number(const std::string& text, double& value) {
+    if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos) return false;
     size_t used = 0;
     try {
         value = std::stod(text, &used);
-    } catch (const std::exception&) {
+    } catch (const std::exception&) {  // not a number, or out of double's range
         return false;
     }
-    return !text.empty() && used == text.size();
+    return used == text.size();
 }
 
-inline double parse_number(const std::string& flag, const std::string& text, double lo, double hi) {
+// A number in [lo, hi], or (lo, hi] when lo_open.
+inline double parse_number(const std::string& flag, const std::string& text, double lo, double hi,
+                           bool lo_open = false) {
     double v = 0;
-    if (!read_number(text, v) || !(v >= lo && v <= hi))
-        throw UsageError{flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                         "], got \"" + text + "\""};
-    return v;
-}
-
-// A number in (0, 1e9): durations and error targets.
-inline double parse_positive(const std::string& flag, const std::string& text) {
-    double v = 0;
-    if (!read_number(text, v) || !(v > 0 && v < 1e9))
-        throw UsageError{flag + " expects a positive number, got \"" + text + "\""};
+    if (!read_number(text, v) || !((lo_open ? v > lo : v >= lo) && v <= hi))
+        throw UsageError{flag + " expects a number in " + (lo_open ? "(" : "[") + bound_text(lo) + ", " +
+                         bound_text(hi) + "], got " + quote_user_text(text, 40)};
     return v;
 }
 
 inline long long parse_integer(const std::string& flag, const std::string& text, long long lo, long long hi) {
     size_t used = 0;
     long long value = 0;
+    const bool digits = !text.empty() && text.find_first_not_of("0123456789+-") == std::string::npos;
     try {
-        value = std::stoll(text, &used);
-    } catch (const std::exception&) {
+        if (digits) value = std::stoll(text, &used);
+    } catch (const std::exception&) {  // out of long long's range
         used = 0;
     }
-    if (used != text.size() || text.empty() || value < lo || value > hi)
+    if (!digits || used != text.size() || value < lo || value > hi)
         throw UsageError{flag + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                         "], got \"" + text + "\""};
+                         "], got " + quote_user_text(text, 40)};
     return value;
 }
 
@@ -100,7 +110,7 @@ inline std::vector<std::string> split_list(const std::string& text) {
 template <typename Names>
 auto parse_name(const std::string& flag, const std::string& text, const Names& names) {
     const auto value = names.parse(text);
-    if (!value) throw UsageError{flag + " expects " + names.list() + ", got \"" + text + "\""};
+    if (!value) throw UsageError{flag + " expects " + names.list() + ", got " + quote_user_text(text, 40)};
     return *value;
 }
 

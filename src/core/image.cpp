@@ -9,6 +9,8 @@
 
 #include <unistd.h>
 
+#include "core/text.h"
+
 namespace kr {
 
 uint8_t quantize_unit(double v) {
@@ -37,23 +39,76 @@ Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure) {
     return out;
 }
 
+namespace {
+
+// One channel's running sum over a sliding window, with Neumaier's compensation: radiance
+// spans many orders of magnitude (a firefly of 1e20 beside pixels of 0.5), and a plain
+// running sum would lose the small values added while the large one was in the window once
+// it leaves. Non-finite values are counted instead of summed (inf - inf would be NaN).
+struct WindowSum {
+    double sum = 0, compensation = 0;
+    int nonfinite = 0;
+    void add(double x) {
+        if (!std::isfinite(x)) {
+            ++nonfinite;
+            return;
+        }
+        const double t = sum + x;
+        compensation += std::abs(sum) >= std::abs(x) ? (sum - t) + x : (x - t) + sum;
+        sum = t;
+    }
+    void remove(double x) {
+        if (!std::isfinite(x)) --nonfinite;
+        else add(-x);
+    }
+};
+
+// Blurs one line of `n` colours (3 doubles each) from `in` into `out`: the mean over
+// [i - r, i + r] clamped to [0, n - 1], in O(n) whatever r.
+void blur_line(const double* in, double* out, int n, int radius) {
+    WindowSum window[3];
+    for (int j = 0; j <= std::min(n - 1, radius); ++j)
+        for (int k = 0; k < 3; ++k) window[k].add(in[3 * j + k]);
+    for (int i = 0; i < n; ++i) {
+        const int lo = std::max(0, i - radius), hi = std::min(n - 1, i + radius);
+        const double count = hi - lo + 1;
+        for (int k = 0; k < 3; ++k) {
+            if (window[k].nonfinite == 0) {
+                out[3 * i + k] = (window[k].sum + window[k].compensation) / count;
+            } else {  // an inf or NaN in the window: the direct sum says which (rare)
+                double direct = 0;
+                for (int j = lo; j <= hi; ++j) direct += in[3 * j + k];
+                out[3 * i + k] = direct / count;
+            }
+        }
+        // Slide the window to i + 1: the pixel at i + r + 1 enters, the one at i - r leaves.
+        if (i + radius + 1 < n)
+            for (int k = 0; k < 3; ++k) window[k].add(in[3 * (i + radius + 1) + k]);
+        if (i - radius >= 0)
+            for (int k = 0; k < 3; ++k) window[k].remove(in[3 * (i - radius) + k]);
+    }
+}
+
+}  // namespace
+
 Image box_blur(const Image& src, int radius) {
     if (radius <= 0 || src.pixels.empty()) return src;
-    // Two 1-D passes of a running sum; at the borders the box shrinks to the image.
+    // Two 1-D passes (rows, then columns), each a running sum over a line copied into a
+    // contiguous buffer; at the borders the box shrinks to the image.
     auto pass = [radius](const Image& in, bool horizontal) {
         Image out(in.width, in.height);
         const int n = horizontal ? in.width : in.height;
         const int lines = horizontal ? in.height : in.width;
+        std::vector<double> line_in(3 * size_t(n)), line_out(3 * size_t(n));
         for (int line = 0; line < lines; ++line) {
-            auto px = [&](int i) -> const Color& {
-                return horizontal ? in.at(i, line) : in.at(line, i);
-            };
             for (int i = 0; i < n; ++i) {
-                const int lo = std::max(0, i - radius), hi = std::min(n - 1, i + radius);
-                Color sum;
-                for (int j = lo; j <= hi; ++j) sum += px(j);
-                (horizontal ? out.at(i, line) : out.at(line, i)) = sum / double(hi - lo + 1);
+                const Color& c = horizontal ? in.at(i, line) : in.at(line, i);
+                line_in[3 * size_t(i)] = c.x, line_in[3 * size_t(i) + 1] = c.y, line_in[3 * size_t(i) + 2] = c.z;
             }
+            blur_line(line_in.data(), line_out.data(), n, radius);
+            for (int i = 0; i < n; ++i)
+                (horizontal ? out.at(i, line) : out.at(line, i)) =
+                    Color{line_out[3 * size_t(i)], line_out[3 * size_t(i) + 1], line_out[3 * size_t(i) + 2]};
         }
         return out;
     };
@@ -79,19 +134,19 @@ void write_file_atomic(const std::filesystem::path& path, const std::string& byt
         path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
     {
         std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) throw std::runtime_error("cannot write " + tmp.string());
+        if (!f) throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
         f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         f.flush();
         if (!f) {
             f.close();
             std::filesystem::remove(tmp, ec);
-            throw std::runtime_error("cannot write " + tmp.string());
+            throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
         }
     }
     std::filesystem::rename(tmp, path, ec);
     if (ec) {
         std::filesystem::remove(tmp, ec);
-        throw std::runtime_error("cannot rename temporary file onto " + path.string());
+        throw std::runtime_error("cannot rename temporary file onto " + show_user_text(path.string()));
     }
 }
 

@@ -43,7 +43,8 @@ inline double sigmoid_tonemap(double v) { return std::isinf(v) && v > 0 ? 1.0 : 
 uint8_t quantize_unit(double v);  // clamp to [0,1], x255, round
 
 // Box blur of half-width `radius` pixels (a (2r+1)^2 box, clamped at the borders),
-// separable, applied to radiance. radius 0 returns the input.
+// separable, applied to radiance, in O(pixels) whatever the radius (a compensated running sum
+// per line). radius 0 returns the input.
 Image box_blur(const Image& src, int radius);
 
 // The brief's depth map: each pixel shows 1 - d/(1+d) as grey.

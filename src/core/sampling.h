@@ -54,8 +54,6 @@ inline void sin_cos_turns(double t, double& sin_out, double& cos_out) {
 // uint64_t) and for SIMD lanes (U: the lanes' bits as unsigned integers) alike: the brief
 // light sampler takes one per shading point, and libm's is a call per lane. Other inputs
 // give garbage: callers check the range (log_positive below).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wpsabi"  // forced inline: lanes never cross a call (render/lanes.h)
 template <class T, class U>
 inline __attribute__((always_inline)) T log_normal_positive(T x) {
     // x = 2^k m with m in [sqrt(1/2), sqrt(2)): offsetting the bits by those of sqrt(1/2)
@@ -82,7 +80,6 @@ inline __attribute__((always_inline)) T log_normal_positive(T x) {
     // 2s = f - s f, so log m = f - s (f - tail): f is exact and the rest a small correction.
     return k * kLn2High + (f - (s * (f - tail) - k * kLn2Low));
 }
-#pragma GCC diagnostic pop
 // log_normal_positive's range.
 inline constexpr double kSmallestNormal = std::numeric_limits<double>::min();
 inline constexpr double kLargestFinite = std::numeric_limits<double>::max();

@@ -16,8 +16,8 @@ typedef uint64_t v4u __attribute__((vector_size(32)));  // bits, shifted without
 
 // Every helper taking or returning lanes is forced inline into its KR_CLONES caller (or
 // packet.cpp's kernels): a call would pass them by the default clone's ABI, not the AVX2
-// one. So no lane crosses a non-inlined call, and GCC's note on the vector ABI does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
+// one. So no lane crosses a non-inlined call, and GCC's note on the vector ABI does not apply
+// (CMakeLists.txt turns it off: -Wno-psabi).
 #define KR_LANES inline __attribute__((always_inline))
 
 KR_LANES v4d splat(double x) { return v4d{} + x; }

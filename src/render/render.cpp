@@ -35,6 +35,11 @@ void RenderState::reset(int w, int h) {
     sobol_keys.clear();
 }
 
+uint64_t render_memory_bytes(int width, int height, bool blurred) {
+    const uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + 2 * 3 + 2 * 3;
+    return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
+}
+
 Image RenderState::radiance() const {
     Image img(width, height);
     for (size_t i = 0; i < img.pixels.size(); ++i)

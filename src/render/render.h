@@ -96,6 +96,18 @@ struct RenderState {
     void plan_pass(const RenderSettings& settings);
 };
 
+// The bytes per pixel a RenderState holds once every buffer is in use: the five sums and
+// counts, the adaptive mask, the pass plan and its credit, the three allocation buffers and
+// the Sobol keys.
+inline constexpr uint64_t kRenderStateBytesPerPixel =
+    sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
+    3 * sizeof(double) + sizeof(uint32_t);
+
+// An upper estimate of the memory a render of width x height pixels holds at its peak: the
+// RenderState, then at the end the mean radiance (and, when blurred, two more radiance images),
+// the mean depth, the two 8-bit images and the encoded files' buffers.
+uint64_t render_memory_bytes(int width, int height, bool blurred);
+
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
 inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean
 inline constexpr int kMaxPassSamples = 64;         // per pixel and pass

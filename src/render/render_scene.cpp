@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "core/text.h"
 #include "scene/load.h"
 
 namespace kr {
@@ -94,7 +95,7 @@ bool RenderScene::is_occluded_linear(const Ray& ray) const {
 RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings, const RenderScene* previous) {
     const std::string file = scene.source_file.string();
     auto warn = [&](const std::string& path, const std::string& message) {
-        if (warnings) warnings->push_back(file + ": " + path + ": " + message);
+        if (warnings) warnings->push_back(show_user_text(file) + ": " + path + ": " + message);
     };
     RenderScene rs;
     rs.renderer = scene.renderer;
@@ -128,8 +129,8 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
             const int existing = shape_sphere[prim.shape];
             if (rs.materials[rs.sphere_material[existing]].id != scene.materials[prim.material].id ||
                 (prim.type == PrimitiveType::emissive) != (rs.sphere_light[existing] >= 0))
-                warn(path, "shape \"" + scene.shapes[prim.shape].id +
-                               "\" is already used by an earlier primitive; this one is ignored");
+                warn(path, "shape " + quote_user_text(scene.shapes[prim.shape].id) +
+                               " is already used by an earlier primitive; this one is ignored");
             continue;
         }
         const Shape& shape = scene.shapes[prim.shape];
@@ -142,11 +143,11 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
             light_index = static_cast<int>(rs.area_lights.size());
             rs.area_lights.push_back({static_cast<int>(rs.spheres.size()) - 1, light.power, 0});
             if (!active[size_t(prim.light)])
-                warn(path + "/light", "light \"" + light.id +
-                                          "\" is not listed in /scene/lights; the primitive emits anyway");
+                warn(path + "/light", "light " + quote_user_text(light.id) +
+                                          " is not listed in /scene/lights; the primitive emits anyway");
             if (light.shape != prim.shape)
-                warn(path + "/shape", "differs from the shape of light \"" + light.id +
-                                          "\"; the primitive's shape emits");
+                warn(path + "/shape", "differs from the shape of light " + quote_user_text(light.id) +
+                                          "; the primitive's shape emits");
         }
         rs.sphere_light.push_back(light_index);
     }
@@ -164,9 +165,9 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         }
         if (!carried[size_t(scene.active_lights[k])])
             throw SceneError(file, "/scene/lights/" + std::to_string(k),
-                             "area light \"" + light.id +
-                                 "\" is not carried by any emissive primitive; add one with \"light\": \"" +
-                                 light.id + "\"");
+                             "area light " + quote_user_text(light.id) +
+                                 " is not carried by any emissive primitive; add one with \"light\": " +
+                                 quote_user_text(light.id));
     }
 
     // Light selection probabilities proportional to emitted power (luminance):

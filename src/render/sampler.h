@@ -28,8 +28,6 @@ inline constexpr EnumNames<Estimator, 3> estimator_names{{"uniform", "stratified
 // operations, so both give the same bits. Forced inline: a path vertex draws five
 // dimensions, and lanes must not cross a call (render/lanes.h).
 #define KR_SOBOL_INLINE inline __attribute__((always_inline))
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wpsabi"  // forced inline: lanes never cross a call
 
 template <class U>
 KR_SOBOL_INLINE U reverse_bits(U x) {
@@ -124,7 +122,6 @@ struct SobolDimension {
         return Reverse::apply(laine_karras(sobol_dimension1_reversed(index), seed ^ 0xb5297a4du));
     }
 };
-#pragma GCC diagnostic pop
 
 // The numbers one sample of one pixel consumes, in a fixed order of dimensions: the
 // sub-pixel position, the lens, then per path vertex the light choice, the light point, the

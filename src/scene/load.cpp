@@ -18,6 +18,11 @@
 #include <utility>
 
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
+
+#include "core/limits.h"
+#include "core/memory.h"
+#include "core/text.h"
 
 namespace kr {
 
@@ -25,9 +30,10 @@ namespace {
 
 std::string format_message(const std::string& file, const std::string& json_path,
                            const std::string& message) {
-    // The root pointer is the empty string; "file: : message" would read like a typo.
-    if (json_path.empty()) return file + ": " + message;
-    return file + ": " + json_path + ": " + message;
+    // The root pointer is the empty string; "file: : message" would read like a typo. The
+    // file name and the pointer (whose keys are the file's) are user text.
+    if (json_path.empty()) return show_user_text(file) + ": " + message;
+    return show_user_text(file) + ": " + show_user_text(json_path) + ": " + message;
 }
 
 }  // namespace
@@ -44,10 +50,7 @@ namespace {
 using Json = nlohmann::ordered_json;
 
 constexpr int kMaxNesting = 64;
-constexpr double kMaxDimension = 32768;
-constexpr double kMaxSamples = 1 << 24;
 constexpr size_t kMaxListedIds = 10;
-constexpr size_t kMaxQuotedLength = 40;
 
 // ---------------------------------------------------------------------------------------
 // Small formatting helpers
@@ -67,12 +70,8 @@ std::string child(const std::string& pointer, size_t index) {
     return pointer + '/' + std::to_string(index);
 }
 
-// A JSON string literal; the replace handler keeps a message from throwing on bad UTF-8.
-std::string in_quotes(std::string_view s) {
-    std::string text(s);
-    if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
-    return Json(text).dump(-1, ' ', false, Json::error_handler_t::replace);
-}
+// User text in a message: quoted, escaped and bounded (core/text.h).
+std::string in_quotes(std::string_view s) { return quote_user_text(s); }
 
 // "a", "b", "c": the form used for lists of keys and ids.
 std::string quoted_list(const std::vector<std::string>& items) {
@@ -238,10 +237,39 @@ private:
     std::vector<Level> levels_;
 };
 
+// Frees a DOM without allocating. nlohmann's destructor first moves a container's children
+// onto a heap stack (to avoid recursion); when memory ran out building a huge DOM that
+// allocation fails too, inside a destructor, and the process aborts. Popping children from
+// the back allocates nothing, and check_nesting bounds this recursion to 64 levels.
+void release(Json& j) {
+    if (j.is_array()) {
+        auto& array = j.get_ref<Json::array_t&>();
+        while (!array.empty()) {
+            release(array.back());
+            array.pop_back();
+        }
+    } else if (j.is_object()) {
+        auto& object = j.get_ref<Json::object_t&>();
+        while (!object.empty()) {
+            release(object.back().second);
+            object.pop_back();
+        }
+    }
+}
+
+SceneError out_of_memory(const std::string& file, std::string_view text) {
+    return SceneError(file, "", "not enough memory for the scene (" + format_bytes(text.size()) + " of JSON)");
+}
+
 Json parse_json(std::string_view text, const std::string& file) {
     check_nesting(text, file);
     DomBuilder builder;
-    if (Json::sax_parse(text.begin(), text.end(), &builder)) return std::move(builder.root);
+    try {
+        if (Json::sax_parse(text.begin(), text.end(), &builder)) return std::move(builder.root);
+    } catch (const std::bad_alloc&) {
+        release(builder.root);
+        throw out_of_memory(file, text);
+    }
 
     if (builder.duplicate_key)
         throw SceneError(file, builder.error_pointer,
@@ -255,16 +283,22 @@ Json parse_json(std::string_view text, const std::string& file) {
         const std::string token =
             open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
         throw SceneError(file, builder.error_pointer,
-                         "number " + token + " is not a finite number; expected a finite number");
+                         "number " + show_user_text(token, 40) + " is not a finite number; expected a finite number");
     }
     // nlohmann's text reads "[json.exception.parse_error.101] parse error at line 4, ...".
     std::string detail = builder.error_text;
     const size_t at = detail.find("at line ");
     if (at != std::string::npos) detail = detail.substr(at);
-    // Its "last read" excerpt may hold the very bytes that are not valid UTF-8.
-    for (char& c : detail)
-        if (static_cast<unsigned char>(c) >= 0x80) c = '?';
-    throw SceneError(file, "", "malformed JSON " + detail);
+    // Its "last read" excerpt is the file's text (a whole token: a million-digit number is a
+    // million bytes), so it is quoted and bounded like any user text.
+    const std::string last_read = "; last read: '";
+    if (const size_t from = detail.find(last_read); from != std::string::npos) {
+        const size_t begin = from + last_read.size(), end = detail.rfind('\'');
+        const std::string token = detail.substr(begin, end > begin ? end - begin : std::string::npos);
+        detail = detail.substr(0, from) + "; last read: " + quote_user_text(token, 40) +
+                 (end > begin && end + 1 < detail.size() ? detail.substr(end + 1) : "");
+    }
+    throw SceneError(file, "", "malformed JSON " + show_user_text(detail, 400));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -669,7 +703,7 @@ void Loader::read_renderer(const Json& j, const std::string& pointer) {
                   if (d < 1 || d > kMaxDimension)
                       range_problem(owner, pi, "expected " + dimension_range + ", got " + number_text(v[i]));
                   // Clamped before the cast so an out-of-range double never overflows an int.
-                  *targets[i] = static_cast<int>(std::clamp(d, 1.0, kMaxDimension));
+                  *targets[i] = static_cast<int>(std::clamp(d, 1.0, double(kMaxDimension)));
               }
           }},
          {"samples", samples_range,
@@ -677,7 +711,7 @@ void Loader::read_renderer(const Json& j, const std::string& pointer) {
               const double s = integer(v, p, samples_range);
               if (s < 1 || s > kMaxSamples)
                   range_problem(owner, p, "expected " + samples_range + ", got " + number_text(v));
-              r.samples = static_cast<int>(std::clamp(s, 1.0, kMaxSamples));
+              r.samples = static_cast<int>(std::clamp(s, 1.0, double(kMaxSamples)));
           }},
          {"depth", "an integer >= 0",
           [&](const Json& v, const std::string& p) {
@@ -786,21 +820,46 @@ LoadedScene Loader::load(const Json& root) {
 
 LoadedScene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
     const std::string name = file.string();
-    const Json root = parse_json(json_text, name);
-    LoadedScene loaded = Loader(name).load(root);
-    loaded.scene.source_file = file;
-    return loaded;
+    Json root = parse_json(json_text, name);
+    try {
+        LoadedScene loaded = Loader(name).load(root);
+        loaded.scene.source_file = file;
+        return loaded;
+    } catch (const std::bad_alloc&) {
+        release(root);
+        throw out_of_memory(name, json_text);
+    } catch (const std::length_error&) {
+        release(root);
+        throw out_of_memory(name, json_text);
+    }
 }
 
 LoadedScene load_scene_file(const std::filesystem::path& file) {
     const std::string name = file.string();
+    const std::string limit = std::to_string(kMaxSceneFileBytes) + " bytes (" + format_bytes(kMaxSceneFileBytes) + ")";
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(name.c_str(), "rb"), &std::fclose);
     if (!f) throw SceneError(name, "", "cannot open scene file: " + std::generic_category().message(errno));
+    // A regular file's size is known before reading it; anything else (/dev/zero, a FIFO) is
+    // read only up to the limit.
+    struct stat info {};
+    if (::fstat(::fileno(f.get()), &info) == 0) {
+        if (S_ISDIR(info.st_mode)) throw SceneError(name, "", "cannot read scene file: it is a directory");
+        if (S_ISREG(info.st_mode) && uint64_t(info.st_size) > kMaxSceneFileBytes)
+            throw SceneError(name, "", "scene file of " + std::to_string(info.st_size) +
+                                           " bytes; expected at most " + limit);
+    }
     std::string text;
     char buffer[1 << 16];
     size_t n = 0;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) text.append(buffer, n);
-    // fopen succeeds on a directory on Linux; the read is what fails (EISDIR).
+    while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) {
+        if (text.size() + n > kMaxSceneFileBytes)
+            throw SceneError(name, "", "scene file longer than " + limit + " (reading stopped there)");
+        try {
+            text.append(buffer, n);
+        } catch (const std::bad_alloc&) {
+            throw out_of_memory(name, text);
+        }
+    }
     if (std::ferror(f.get()))
         throw SceneError(name, "", "cannot read scene file: " + std::generic_category().message(errno));
     return parse_scene(text, file);

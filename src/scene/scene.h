@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/limits.h"  // kMaxDepth, kMaxDimension, kMaxSamples
 #include "core/math.h"
 
 namespace kr {
@@ -57,9 +58,6 @@ inline constexpr EnumNames<PrimitiveType, 2> primitive_type_names{{"geometric", 
 
 enum class RendererType { wrt, pt };
 inline constexpr EnumNames<RendererType, 2> renderer_type_names{{"WRT", "PT"}};
-
-// The brief caps the recursion depth at 20 bounces.
-inline constexpr int kMaxDepth = 20;
 
 struct Camera {
     std::string id;

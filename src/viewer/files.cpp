@@ -8,6 +8,8 @@
 
 #include <unistd.h>
 
+#include "core/text.h"
+
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
 #include <stb/stb_image.h>
@@ -24,13 +26,14 @@ void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
     const fs::path tmp = path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
     if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.bytes.data(), image.width * 3)) {
         fs::remove(tmp, ec);
-        throw std::runtime_error("cannot write " + tmp.string());
+        throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
     }
     fs::rename(tmp, path, ec);
     if (ec) {
         const std::string why = ec.message();
         fs::remove(tmp, ec);
-        throw std::runtime_error("cannot rename " + tmp.string() + " to " + path.string() + ": " + why);
+        throw std::runtime_error("cannot rename " + show_user_text(tmp.string()) + " to " + show_user_text(path.string()) +
+                                 ": " + why);
     }
 }
 

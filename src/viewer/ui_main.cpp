@@ -46,13 +46,13 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
 
 int parse_int(const std::string& flag, const std::string& text, int lo, int hi) {
     const double v = parse_number(flag, text, lo, hi);
-    if (v != double(int(v))) throw UsageError{flag + " expects an integer, got \"" + text + "\""};
+    if (v != double(int(v))) throw UsageError{flag + " expects an integer, got " + quote_user_text(text, 40)};
     return int(v);
 }
 
 std::pair<double, double> parse_pair(const std::string& flag, const std::string& text) {
     const size_t comma = text.find(',');
-    if (comma == std::string::npos) throw UsageError{flag + " expects X,Y, got \"" + text + "\""};
+    if (comma == std::string::npos) throw UsageError{flag + " expects X,Y, got " + quote_user_text(text, 40)};
     return {parse_number(flag, text.substr(0, comma), -1e6, 1e6), parse_number(flag, text.substr(comma + 1), -1e6, 1e6)};
 }
 
@@ -63,7 +63,7 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         const std::string& arg = args.arg();
         auto value = [&] { return args.value(); };
         if (arg == "-h" || arg == "--help") help = true;
-        else if (arg == "--spp") o.overrides.spp = parse_int(arg, value(), 1, 1 << 24);
+        else if (arg == "--spp") o.overrides.spp = parse_int(arg, value(), 1, kMaxSamples);
         else if (arg == "--depth") o.overrides.depth = parse_int(arg, value(), 0, kMaxDepth);
         else if (arg == "--seed") o.overrides.seed = uint64_t(parse_number(arg, value(), 0, 9e15));
         else if (arg == "--integrator") o.overrides.integrator = parse_name(arg, value(), integrator_names);
@@ -73,8 +73,8 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--tonemap") o.tone.op = parse_name(arg, value(), tonemap_names);
         else if (arg == "--exposure") o.tone.exposure = parse_number(arg, value(), 1e-6, 1e6);
         else if (arg == "--unlimited") o.unlimited = true;
-        else if (arg == "--time") o.stop_seconds = parse_number(arg, value(), 1e-3, 1e9);
-        else if (arg == "--noise") o.stop_noise = parse_number(arg, value(), 1e-6, 1.0);
+        else if (arg == "--time") o.stop_seconds = parse_number(arg, value(), 0, kMaxSeconds, true);
+        else if (arg == "--noise") o.stop_noise = parse_number(arg, value(), kMinNoise, kMaxNoise);
         else if (arg == "--aperture") o.aperture = parse_number(arg, value(), 0, 1e9);
         else if (arg == "--orbit") o.orbit = parse_pair(arg, value());
         else if (arg == "--click-focus") o.click_focus = parse_pair(arg, value());
@@ -84,8 +84,8 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--window-shot") o.window_shot = value();
         else if (arg == "--measure-latency") o.measure_latency = parse_int(arg, value(), 1, 10000);
         else if (arg == "--timeout") o.timeout = parse_number(arg, value(), 1, 1e7);
-        else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + arg};
-        else if (have_scene) throw UsageError{"view opens one scene; got a second: " + arg};
+        else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
+        else if (have_scene) throw UsageError{"view opens one scene; got a second: " + quote_user_text(arg)};
         else {
             o.scene = arg;
             have_scene = true;
