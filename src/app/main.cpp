@@ -1,5 +1,7 @@
 // keithray: the headless command-line program. A thin loop over the core library.
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -16,9 +18,9 @@
 #include "app/progress.h"
 #include "core/args.h"
 #include "core/image.h"
+#include "core/image_io.h"
 #include "render/render.h"
 #include "scene/load.h"
-#include "viewer/files.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
 
@@ -224,10 +226,17 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     if (show_progress) std::fprintf(stderr, "\n");
 
     try {
+        // The image and its depth map are committed together: both replaced, or neither.
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
-                                           : tonemap(radiance, opt.tonemap));
-        viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+        const Rgb8Image display =
+            opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0}) : tonemap(radiance, opt.tonemap);
+        write_files_atomic(
+            {{output, encode_image(output, display)},
+             {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))}});
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "error: %s: not enough memory for the output images of a %dx%d render\n",
+                     scene_file.string().c_str(), state.width, state.height);
+        return false;
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
         return false;
@@ -244,45 +253,51 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     return true;
 }
 
-}  // namespace
-
-// Every *.json in res/scenes: looked up from the working directory, then the source tree.
-std::vector<fs::path> kr::default_scenes() {
-    std::vector<fs::path> dirs{"res/scenes"};
-#ifdef KEITHRAY_SCENES_DIR
-    dirs.emplace_back(KEITHRAY_SCENES_DIR);
-#endif
-    for (const fs::path& dir : dirs) {
-        std::error_code ec;
-        if (!fs::is_directory(dir, ec)) continue;
-        std::vector<fs::path> found;
-        for (const auto& entry : fs::directory_iterator(dir, ec))
-            if (entry.path().extension() == ".json") found.push_back(entry.path());
-        std::sort(found.begin(), found.end());
-        if (!found.empty()) return found;
-    }
-    return {};
+// Whether everything printed reached standard output: a full disk or /dev/full shows only
+// when the buffer is flushed. Prints the error when not.
+bool stdout_written() {
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return true;
+    const int err = errno;
+    std::fprintf(stderr, "error: cannot write the results to standard output: %s\n",
+                 err ? std::strerror(err) : "write error");
+    return false;
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
     const std::string command = argc > 1 ? argv[1] : "";
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(kUsage, stdout);
-        return 0;
+        return stdout_written() ? 0 : 1;
     }
-    if (command == "bench") return run_bench(argc, argv);
+    if (command == "bench") {
+        const int status = run_bench(argc, argv);
+        return stdout_written() ? status : 1;
+    }
     if (command == "psnr") {
         if (argc != 4) {
             std::fprintf(stderr, "error: psnr needs two image files (PPM or PNG)\n");
             return 2;
         }
         try {
-            std::printf("%.2f\n", psnr(viewer::read_image(argv[2]), viewer::read_image(argv[3])));
-            return 0;
+            const Rgb8Image image = read_image(argv[2]), reference = read_image(argv[3]);
+            if (image.width != reference.width || image.height != reference.height) {
+                std::fprintf(stderr, "error: %s is %dx%d but %s is %dx%d; psnr needs two images of one size\n",
+                             quoted_path(argv[2]).c_str(), image.width, image.height, quoted_path(argv[3]).c_str(),
+                             reference.width, reference.height);
+                return 1;
+            }
+            std::printf("%.2f\n", psnr(image, reference));
+        } catch (const std::bad_alloc&) {
+            std::fprintf(stderr, "error: not enough memory for %s and %s\n", quoted_path(argv[2]).c_str(),
+                         quoted_path(argv[3]).c_str());
+            return 1;
         } catch (const std::exception& e) {
             std::fprintf(stderr, "error: %s\n", e.what());
             return 1;
         }
+        return stdout_written() ? 0 : 1;
     }
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
@@ -315,5 +330,5 @@ int main(int argc, char** argv) {
             ok = false;
         }
     }
-    return ok ? 0 : 1;
+    return stdout_written() && ok ? 0 : 1;
 }
