@@ -144,6 +144,16 @@ Target check_target(const fs::path& requested) {
         throw file_error(requested, "the path is " + std::to_string(requested.native().size()) +
                                         " bytes; the limit is " + std::to_string(PATH_MAX - 1));
 
+    // Every name in the path within the file system's limit (that of the nearest existing
+    // folder), checked first: lstat would only say "File name too long".
+    fs::path existing = requested.parent_path();
+    while (!existing.empty() && ::access(existing.c_str(), F_OK) != 0) existing = existing.parent_path();
+    const long name_max = name_max_in(existing.empty() ? fs::path(".") : existing);
+    for (const fs::path& part : requested)
+        if (long(part.native().size()) > name_max)
+            throw file_error(requested, "the name " + quoted_path(part) + " is " + std::to_string(part.native().size()) +
+                                            " bytes; this file system allows " + std::to_string(name_max));
+
     t.path = requested;
     struct stat st {};
     if (::lstat(t.path.c_str(), &st) == 0 && S_ISLNK(st.st_mode)) {
@@ -170,7 +180,7 @@ Target check_target(const fs::path& requested) {
     // The folder: every existing ancestor must be a folder; the missing ones are created.
     fs::path folder = t.path.parent_path();
     if (folder.empty()) folder = ".";
-    fs::path existing = folder;
+    existing = folder;
     for (;;) {
         struct stat dir_stat {};
         if (::stat(existing.c_str(), &dir_stat) == 0) {
@@ -184,11 +194,6 @@ Target check_target(const fs::path& requested) {
         const fs::path up = existing.parent_path();
         existing = up.empty() || up == existing ? fs::path(".") : up;
     }
-    const long name_max = name_max_in(existing);
-    for (const fs::path& part : t.path)
-        if (long(part.native().size()) > name_max)
-            throw file_error(requested, "the name " + quoted_path(part) + " is " + std::to_string(part.native().size()) +
-                                            " bytes; this file system allows " + std::to_string(name_max));
 
     // The temporary: hidden, beside the target, unique by process and call, and short
     // enough for the file system however long the target's name is.
