@@ -526,9 +526,14 @@ int bench_convergence(int argc, char** argv) {
         std::fflush(stdout);
         csv += r.csv;
         md += r.markdown;
-        // Written after every scene, so an interrupted run keeps what it measured.
-        write_file_atomic(o.out_dir / "convergence.csv", csv);
-        write_file_atomic(o.out_dir / "convergence.md", md);
+        // Written after every scene, so an interrupted run keeps what it measured; the table
+        // and its Markdown always agree.
+        try {
+            write_files_atomic({{o.out_dir / "convergence.csv", csv}, {o.out_dir / "convergence.md", md}});
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
+            return 1;
+        }
     }
     std::printf("Wrote %s, %s and one PNG plot per scene.\n", (o.out_dir / "convergence.csv").string().c_str(),
                 (o.out_dir / "convergence.md").string().c_str());

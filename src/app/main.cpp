@@ -78,9 +78,11 @@ Options:
   -h, --help            this text
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
-(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per
-scene on stdout: spp, seconds, Mrays/s.
-Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
+(1 - d/(1+d)) as NAME-depth.ppm (or .png), both replaced together or neither (a
+read-only file, a folder or a device as output is refused). One summary line per scene
+on stdout: spp, seconds, Mrays/s.
+Exit status: 0 on success, 1 if a scene failed to load, render or be written (or stdout
+could not be written), 2 on bad usage.
 )";
 
 struct Options {
@@ -131,7 +133,7 @@ Options parse_options(int argc, char** argv) {
 
 // Whether writing path `a` would replace the existing file `b`: the same file under another
 // name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
-// through a folder x that does not exist yet (write_ppm would create it).
+// through a folder x that does not exist yet (the writer would create it).
 bool same_file(const fs::path& a, const fs::path& b) {
     std::error_code ec;
     if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
