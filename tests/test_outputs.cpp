@@ -330,6 +330,10 @@ TEST_F(Outputs, ImageHeadersAreCheckedAgainstTheFile) {
     write_ppm(dir / "ok.ppm", small);
     EXPECT_EQ(read_image(dir / "ok.png").bytes, small.bytes);
     EXPECT_EQ(read_image(dir / "ok.ppm").bytes, small.bytes);
+    // A black image compresses as well as PNG can and still passes the ratio bound.
+    Rgb8Image black{1024, 1024, std::vector<uint8_t>(1024 * 1024 * 3, 0)};
+    write_png(dir / "black.png", black);
+    EXPECT_EQ(read_image(dir / "black.png").bytes, black.bytes);
     const std::string whole = test::read_file(dir / "ok.ppm");
     write("cut.ppm", whole.substr(0, whole.size() - 1));
     EXPECT_NE(message(dir / "cut.ppm").find("truncated"), std::string::npos);

@@ -280,6 +280,7 @@ void write_files_atomic(const std::vector<FileOutput>& files) {
 
     install_cleanup_handlers();
     Undo undo;
+    undo.temps.reserve(targets.size());
     // 2. Missing folders.
     for (const Target& t : targets)
         for (const fs::path& folder : t.missing_folders) {
@@ -291,9 +292,15 @@ void write_files_atomic(const std::vector<FileOutput>& files) {
         const Target& t = targets[i];
         const int slot = register_temp(t.temp.native());
         if (slot < 0) throw file_error(t.shown, "too many files are being written at once");
-        undo.temps.emplace_back(t.temp, slot);
+        // Registered before it exists, so no moment leaves it unlisted; a name that could not
+        // be created (taken) is not ours to remove.
         const int fd = ::open(t.temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0) throw file_error(t.shown, "cannot create a file beside it: " + errno_text(errno));
+        if (fd < 0) {
+            const int err = errno;
+            release_temp(slot);
+            throw file_error(t.shown, "cannot create a file beside it: " + errno_text(err));
+        }
+        undo.temps.emplace_back(t.temp, slot);
         try {
             if (t.replaces && ::fchmod(fd, t.mode) != 0)
                 throw file_error(t.shown, "cannot keep its permissions: " + errno_text(errno));
