@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/image_io.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/image_io.h"
 #include "render/render.h"
 #include "scene/load.h"
 

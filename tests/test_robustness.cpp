@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/image_io.h"
 #include "render/camera.h"
 #include "render/render.h"
 #include "scene/load.h"

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/image_io.h"
 #include "scene/load.h"
 #include "test_util.h"
 

@@ -15,6 +15,7 @@
 #include <omp.h>
 
 #include "core/args.h"
+#include "core/file_write.h"
 #include "render/render.h"
 #include "scene/load.h"
 
@@ -276,10 +277,10 @@ int run_bench(int argc, char** argv) {
             std::fprintf(stderr, "error: %s exists; not overwriting it\n", o.write_path.string().c_str());
             return 1;
         }
-        std::ofstream out(o.write_path);
-        out << stress_scene_json(o.write_stress, 1).dump(1) << "\n";
-        if (!out) {
-            std::fprintf(stderr, "error: cannot write %s\n", o.write_path.string().c_str());
+        try {
+            write_file_atomic(o.write_path, stress_scene_json(o.write_stress, 1).dump(1) + "\n");
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
             return 1;
         }
         std::printf("wrote %s (%d spheres)\n", o.write_path.string().c_str(), o.write_stress);

@@ -20,9 +20,9 @@
 #include "app/plot.h"
 #include "app/progress.h"
 #include "core/args.h"
+#include "core/image_io.h"
 #include "render/render.h"
 #include "scene/load.h"
-#include "viewer/files.h"
 
 namespace fs = std::filesystem;
 
@@ -386,7 +386,7 @@ struct Bench {
             if (references.count(key)) continue;
             if (!o.reference_file.empty()) {
                 Reference ref;
-                ref.display = viewer::read_image(o.reference_file);
+                ref.display = read_image(o.reference_file);
                 if (ref.display.width != width || ref.display.height != height)
                     throw std::runtime_error(o.reference_file.string() + " is " + std::to_string(ref.display.width) +
                                              "x" + std::to_string(ref.display.height) + ", the renders " +
@@ -445,7 +445,7 @@ struct Bench {
             }
             plot.series.push_back(line);
         }
-        viewer::write_png(o.out_dir / (stem + ".png"), plot_loglog(plot));
+        write_png(o.out_dir / (stem + ".png"), plot_loglog(plot));
 
         // Time for each configuration to reach, at full spp, the error of its baseline: the
         // first configuration converging to the same image (with a given 8-bit reference, the
@@ -526,9 +526,14 @@ int bench_convergence(int argc, char** argv) {
         std::fflush(stdout);
         csv += r.csv;
         md += r.markdown;
-        // Written after every scene, so an interrupted run keeps what it measured.
-        write_file_atomic(o.out_dir / "convergence.csv", csv);
-        write_file_atomic(o.out_dir / "convergence.md", md);
+        // Written after every scene, so an interrupted run keeps what it measured; the table
+        // and its Markdown always agree.
+        try {
+            write_files_atomic({{o.out_dir / "convergence.csv", csv}, {o.out_dir / "convergence.md", md}});
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
+            return 1;
+        }
     }
     std::printf("Wrote %s, %s and one PNG plot per scene.\n", (o.out_dir / "convergence.csv").string().c_str(),
                 (o.out_dir / "convergence.md").string().c_str());

@@ -1,5 +1,7 @@
 // keithray: the headless command-line program. A thin loop over the core library.
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -20,9 +22,9 @@
 #include "core/limits.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "core/image_io.h"
 #include "render/render.h"
 #include "scene/load.h"
-#include "viewer/files.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
 
@@ -82,11 +84,13 @@ Options:
   -h, --help            this text
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
-(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per
-scene on stdout: spp, seconds, Mrays/s.
+(1 - d/(1+d)) as NAME-depth.ppm (or .png), both replaced together or neither (a
+read-only file, a folder or a device as output is refused). One summary line per scene
+on stdout: spp, seconds, Mrays/s.
 A render whose memory estimate exceeds the machine's (or ulimit -v's) memory is refused;
 scene files are at most 64 MiB (README.md, "Limits").
-Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
+Exit status: 0 on success, 1 if a scene failed to load, render or be written (or stdout
+could not be written), 2 on bad usage.
 )";
 
 struct Options {
@@ -137,7 +141,7 @@ Options parse_options(int argc, char** argv) {
 
 // Whether writing path `a` would replace the existing file `b`: the same file under another
 // name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
-// through a folder x that does not exist yet (write_ppm would create it).
+// through a folder x that does not exist yet (the writer would create it).
 bool same_file(const fs::path& a, const fs::path& b) {
     std::error_code ec;
     if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
@@ -256,10 +260,13 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
 
     stage = "the output images of a " + image;
     try {
+        // The image and its depth map are committed together: both replaced, or neither.
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
-                                           : tonemap(radiance, opt.tonemap));
-        viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+        const Rgb8Image display =
+            opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0}) : tonemap(radiance, opt.tonemap);
+        write_files_atomic(
+            {{output, encode_image(output, display)},
+             {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))}});
     } catch (const std::exception& e) {
         if (out_of_memory(e)) throw;
         std::fprintf(stderr, "error: %s: %s\n", file.c_str(), e.what());
@@ -277,35 +284,28 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     return true;
 }
 
-}  // namespace
-
-// Every *.json in res/scenes: looked up from the working directory, then the source tree.
-std::vector<fs::path> kr::default_scenes() {
-    std::vector<fs::path> dirs{"res/scenes"};
-#ifdef KEITHRAY_SCENES_DIR
-    dirs.emplace_back(KEITHRAY_SCENES_DIR);
-#endif
-    for (const fs::path& dir : dirs) {
-        std::error_code ec;
-        if (!fs::is_directory(dir, ec)) continue;
-        std::vector<fs::path> found;
-        for (const auto& entry : fs::directory_iterator(dir, ec))
-            if (entry.path().extension() == ".json") found.push_back(entry.path());
-        std::sort(found.begin(), found.end());
-        if (!found.empty()) return found;
-    }
-    return {};
+// Whether everything printed reached standard output: a full disk or /dev/full shows only
+// when the buffer is flushed. Prints the error when not.
+bool stdout_written() {
+    if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return true;
+    const int err = errno;
+    std::fprintf(stderr, "error: cannot write the results to standard output: %s\n",
+                 err ? std::strerror(err) : "write error");
+    return false;
 }
+
+}  // namespace
 
 int main(int argc, char** argv) {
     const std::string command = argc > 1 ? argv[1] : "";
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(kUsage, stdout);
-        return 0;
+        return stdout_written() ? 0 : 1;
     }
     if (command == "bench") {
         try {
-            return run_bench(argc, argv);
+            const int status = run_bench(argc, argv);
+            return stdout_written() ? status : 1;
         } catch (const std::exception& e) {
             if (!out_of_memory(e)) throw;
             std::fprintf(stderr, "error: bench: not enough memory for the benchmark's scenes and images\n");
@@ -318,8 +318,14 @@ int main(int argc, char** argv) {
             return 2;
         }
         try {
-            std::printf("%.2f\n", psnr(viewer::read_image(argv[2]), viewer::read_image(argv[3])));
-            return 0;
+            const Rgb8Image image = read_image(argv[2]), reference = read_image(argv[3]);
+            if (image.width != reference.width || image.height != reference.height) {
+                std::fprintf(stderr, "error: %s is %dx%d but %s is %dx%d; psnr needs two images of one size\n",
+                             quoted_path(argv[2]).c_str(), image.width, image.height, quoted_path(argv[3]).c_str(),
+                             reference.width, reference.height);
+                return 1;
+            }
+            std::printf("%.2f\n", psnr(image, reference));
         } catch (const std::exception& e) {
             if (out_of_memory(e))
                 std::fprintf(stderr, "error: not enough memory for the images %s and %s\n", shown(argv[2]).c_str(),
@@ -328,6 +334,7 @@ int main(int argc, char** argv) {
                 std::fprintf(stderr, "error: %s\n", e.what());
             return 1;
         }
+        return stdout_written() ? 0 : 1;
     }
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
@@ -364,5 +371,5 @@ int main(int argc, char** argv) {
             ok = false;
         }
     }
-    return ok ? 0 : 1;
+    return stdout_written() && ok ? 0 : 1;
 }

@@ -1,13 +1,7 @@
 #include "core/image.h"
 
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
-#include <system_error>
-
-#include <unistd.h>
 
 #include "core/text.h"
 
@@ -123,79 +117,6 @@ Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height)
         out.bytes[3 * i] = out.bytes[3 * i + 1] = out.bytes[3 * i + 2] = g;
     }
     return out;
-}
-
-void write_file_atomic(const std::filesystem::path& path, const std::string& bytes) {
-    const std::filesystem::path dir = path.parent_path();
-    std::error_code ec;
-    if (!dir.empty()) std::filesystem::create_directories(dir, ec);
-    // Unique temporary name beside the target, so the rename is atomic on one file system.
-    const std::filesystem::path tmp =
-        path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
-        f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        f.flush();
-        if (!f) {
-            f.close();
-            std::filesystem::remove(tmp, ec);
-            throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
-        }
-    }
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw std::runtime_error("cannot rename temporary file onto " + show_user_text(path.string()));
-    }
-}
-
-void write_ppm(const std::filesystem::path& path, const Rgb8Image& image) {
-    if (image.bytes.size() != static_cast<size_t>(image.width) * image.height * 3)
-        throw std::runtime_error("write_ppm: image size does not match its pixel data");
-    std::string bytes = "P6\n" + std::to_string(image.width) + ' ' + std::to_string(image.height) + "\n255\n";
-    bytes.append(reinterpret_cast<const char*>(image.bytes.data()), image.bytes.size());
-    write_file_atomic(path, bytes);
-}
-
-Rgb8Image read_ppm(const std::filesystem::path& path) {
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw std::runtime_error("cannot open " + path.string());
-    // Header: magic, width, height, maxval, separated by whitespace and comments.
-    auto next_token = [&]() {
-        std::string tok;
-        char c;
-        while (f.get(c)) {
-            if (c == '#') {
-                std::string rest;
-                std::getline(f, rest);
-                continue;
-            }
-            if (std::isspace(static_cast<unsigned char>(c))) {
-                if (!tok.empty()) break;
-                continue;
-            }
-            tok += c;
-        }
-        return tok;
-    };
-    const std::string magic = next_token();
-    Rgb8Image img;
-    int maxval = 0;
-    try {
-        img.width = std::stoi(next_token());
-        img.height = std::stoi(next_token());
-        maxval = std::stoi(next_token());
-    } catch (const std::exception&) {
-        throw std::runtime_error(path.string() + ": malformed PPM header");
-    }
-    if (magic != "P6" || maxval != 255 || img.width <= 0 || img.height <= 0)
-        throw std::runtime_error(path.string() + ": only binary PPM (P6) with maxval 255 is read");
-    img.bytes.resize(static_cast<size_t>(img.width) * img.height * 3);
-    f.read(reinterpret_cast<char*>(img.bytes.data()), static_cast<std::streamsize>(img.bytes.size()));
-    if (f.gcount() != static_cast<std::streamsize>(img.bytes.size()))
-        throw std::runtime_error(path.string() + ": truncated pixel data");
-    return img;
 }
 
 double psnr(const Rgb8Image& a, const Rgb8Image& b) {

@@ -1,13 +1,12 @@
-// Radiance images, tone mapping, blur, and 8-bit PPM files.
+// Radiance images, tone mapping, blur, PSNR. Their files: core/image_io.h.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
-#include <string>
 #include <vector>
 
 #include "core/math.h"
-#include "scene/scene.h"  // EnumNames
+#include "core/enum_names.h"
 
 namespace kr {
 
@@ -49,16 +48,6 @@ Image box_blur(const Image& src, int radius);
 
 // The brief's depth map: each pixel shows 1 - d/(1+d) as grey.
 Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height);
-
-// Writes `bytes` to a temporary file beside `path`, then renames it onto `path`: a reader
-// never sees a partial file, and a failed write leaves any old file intact. Throws
-// std::runtime_error.
-void write_file_atomic(const std::filesystem::path& path, const std::string& bytes);
-
-// Binary PPM (P6, maxval 255). Written to a temporary file beside `path` and renamed,
-// so a reader never sees a partial file. Throws std::runtime_error on failure.
-void write_ppm(const std::filesystem::path& path, const Rgb8Image& image);
-Rgb8Image read_ppm(const std::filesystem::path& path);  // P6 with maxval 255; throws
 
 // Peak signal-to-noise ratio in dB of two same-sized 8-bit images (99 when identical).
 double psnr(const Rgb8Image& a, const Rgb8Image& b);

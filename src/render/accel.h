@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/math.h"
-#include "scene/scene.h"  // EnumNames
+#include "core/enum_names.h"
 
 namespace kr {
 

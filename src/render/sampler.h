@@ -8,7 +8,7 @@
 
 #include "core/rng.h"
 #include "core/sampling.h"
-#include "scene/scene.h"  // EnumNames
+#include "core/enum_names.h"
 
 namespace kr {
 

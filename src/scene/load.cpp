@@ -725,6 +725,9 @@ void Loader::read_renderer(const Json& j, const std::string& pointer) {
          {"output", "a non-empty string (the output PPM path)",
           [&](const Json& v, const std::string& p) {
               r.output = nonempty_string(v, p, "a non-empty string (the output PPM path)");
+              // A path ends at a NUL byte for the operating system: "a\u0000b" would write "a".
+              if (r.output.find('\0') != std::string::npos)
+                  fail(p, "expected a file path without NUL bytes (\\u0000), got " + in_quotes(r.output));
           }}});
 }
 
@@ -863,6 +866,23 @@ LoadedScene load_scene_file(const std::filesystem::path& file) {
     if (std::ferror(f.get()))
         throw SceneError(name, "", "cannot read scene file: " + std::generic_category().message(errno));
     return parse_scene(text, file);
+}
+
+std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& folder) {
+    std::vector<std::filesystem::path> found;
+    std::error_code ec;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
+        if (entry.path().extension() == ".json") found.push_back(entry.path());
+    std::sort(found.begin(), found.end());
+    return found;
+}
+
+std::vector<std::filesystem::path> default_scenes() {
+    std::vector<std::filesystem::path> found = list_scenes("res/scenes");
+#ifdef KEITHRAY_SCENES_DIR
+    if (found.empty()) found = list_scenes(KEITHRAY_SCENES_DIR);
+#endif
+    return found;
 }
 
 }  // namespace kr

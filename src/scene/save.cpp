@@ -1,12 +1,8 @@
 #include "scene/save.h"
 
-#include <fstream>
-#include <stdexcept>
-#include <system_error>
-
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
+
+#include "core/file_write.h"
 
 namespace kr {
 
@@ -128,26 +124,7 @@ void save_scene_json(const Scene& scene, const std::filesystem::path& file) {
         fs::path relative = absolute_target.lexically_relative(base);
         moved.renderer.output = (relative.empty() ? absolute_target : relative).generic_string();
     }
-    const std::string text = scene_to_json(moved);
-    std::error_code ec;
-    if (!dir.empty()) fs::create_directories(dir, ec);
-    const fs::path tmp = file.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
-    {
-        std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-        if (!f) throw std::runtime_error("cannot write " + tmp.string());
-        f << text;
-        f.flush();
-        if (!f) {
-            f.close();
-            fs::remove(tmp, ec);
-            throw std::runtime_error("cannot write " + tmp.string());
-        }
-    }
-    fs::rename(tmp, file, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw std::runtime_error("cannot rename " + tmp.string() + " to " + file.string());
-    }
+    write_file_atomic(file, scene_to_json(moved));
 }
 
 }  // namespace kr

@@ -13,7 +13,7 @@ namespace kr {
 // `output` is written as the scene holds it.
 std::string scene_to_json(const Scene& scene);
 
-// Writes scene_to_json() to `file`, atomically (temporary file + rename). The renderer's
+// Writes scene_to_json() to `file` with write_file_atomic (core/file_write.h). The renderer's
 // `output` is rewritten relative to the new file's folder so that it names the same file
 // as before (Scene::output_path() is unchanged). Overwrites: callers ask first.
 // Throws std::runtime_error on failure.

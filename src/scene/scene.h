@@ -11,33 +11,10 @@
 #include <vector>
 
 #include "core/limits.h"  // kMaxDepth, kMaxDimension, kMaxSamples
+#include "core/enum_names.h"
 #include "core/math.h"
 
 namespace kr {
-
-// One name table per enum, shared by the JSON loader, the CLI and the viewer's combos.
-template <typename Enum, size_t N>
-struct EnumNames {
-    std::array<std::string_view, N> names;
-
-    std::string_view name(Enum e) const { return names[static_cast<size_t>(e)]; }
-    std::optional<Enum> parse(std::string_view s) const {
-        for (size_t i = 0; i < N; ++i)
-            if (names[i] == s) return static_cast<Enum>(i);
-        return std::nullopt;
-    }
-    // "a", "b" or "c": for error messages.
-    std::string list() const {
-        std::string out;
-        for (size_t i = 0; i < N; ++i) {
-            if (i > 0) out += (i + 1 == N) ? " or " : ", ";
-            out += '"';
-            out += names[i];
-            out += '"';
-        }
-        return out;
-    }
-};
 
 enum class CameraType { pinhole, lens };
 inline constexpr EnumNames<CameraType, 2> camera_type_names{{"pinhole", "lens-based"}};

@@ -1,83 +1,8 @@
 #include "viewer/files.h"
 
-#include <algorithm>
-#include <fstream>
-#include <stdexcept>
-#include <string>
 #include <system_error>
 
-#include <unistd.h>
-
-#include "core/text.h"
-
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_PNG
-#include <stb/stb_image.h>
-#include <stb/stb_image_write.h>
-
 namespace kr::viewer {
-
-void write_png(const std::filesystem::path& path, const Rgb8Image& image) {
-    namespace fs = std::filesystem;
-    if (image.bytes.size() != static_cast<size_t>(image.width) * image.height * 3)
-        throw std::runtime_error("write_png: image size does not match its pixel data");
-    std::error_code ec;
-    if (!path.parent_path().empty()) fs::create_directories(path.parent_path(), ec);
-    const fs::path tmp = path.string() + ".tmp" + std::to_string(static_cast<long>(::getpid()));
-    if (!stbi_write_png(tmp.c_str(), image.width, image.height, 3, image.bytes.data(), image.width * 3)) {
-        fs::remove(tmp, ec);
-        throw std::runtime_error("cannot write " + show_user_text(tmp.string()));
-    }
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        const std::string why = ec.message();
-        fs::remove(tmp, ec);
-        throw std::runtime_error("cannot rename " + show_user_text(tmp.string()) + " to " + show_user_text(path.string()) +
-                                 ": " + why);
-    }
-}
-
-namespace {
-bool is_png_path(const std::filesystem::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".png";
-}
-}  // namespace
-
-Rgb8Image read_image(const std::filesystem::path& path) {
-    // By content, not by name: a binary PPM starts with "P6", a PNG with its signature.
-    char magic[2] = {};
-    std::ifstream file(path, std::ios::binary);
-    if (!file) throw std::runtime_error("cannot open " + path.string());
-    file.read(magic, 2);
-    if (magic[0] == 'P' && magic[1] == '6') return read_ppm(path);
-    if (magic[0] != '\x89')
-        throw std::runtime_error("cannot read " + path.string() + ": not a binary PPM (P6) or PNG image");
-    int w = 0, h = 0, channels = 0;
-    unsigned char* pixels = stbi_load(path.string().c_str(), &w, &h, &channels, 3);
-    if (!pixels)
-        throw std::runtime_error("cannot read " + path.string() + " as a PNG image: " + stbi_failure_reason());
-    Rgb8Image img;
-    img.width = w, img.height = h;
-    img.bytes.assign(pixels, pixels + size_t(w) * size_t(h) * 3);
-    stbi_image_free(pixels);
-    return img;
-}
-
-void write_image(const std::filesystem::path& path, const Rgb8Image& image) {
-    if (is_png_path(path)) write_png(path, image);
-    else write_ppm(path, image);
-}
-
-std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir) {
-    std::vector<std::filesystem::path> found;
-    std::error_code ec;
-    for (const auto& entry : std::filesystem::directory_iterator(dir, ec))
-        if (entry.path().extension() == ".json") found.push_back(entry.path());
-    std::sort(found.begin(), found.end());
-    return found;
-}
 
 FileWatch::Stamp FileWatch::stamp() const {
     Stamp s;

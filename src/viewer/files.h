@@ -1,28 +1,12 @@
-// File helpers of the viewer that need no window: PNG input and output, the scene list, and
-// the polling watch on the scene file.
+// The viewer's polling watch on the scene file (needs no window). Image files are in
+// core/image_io.h, the scene list in scene/load.h.
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
-#include <optional>
-#include <vector>
-
-#include "core/image.h"
 
 namespace kr::viewer {
-
-// PNG through stb_image_write (Debian's libstb), written atomically like write_ppm.
-// Throws std::runtime_error.
-void write_png(const std::filesystem::path& path, const Rgb8Image& image);
-
-// An 8-bit RGB image from a binary PPM or a PNG (stb_image), told apart by their first
-// bytes, whatever the file's name. Throws std::runtime_error with the file's name.
-Rgb8Image read_image(const std::filesystem::path& path);
-// PNG when the path ends in .png (any case), otherwise binary PPM; written atomically.
-void write_image(const std::filesystem::path& path, const Rgb8Image& image);
-
-// The *.json files of `dir`, sorted.
-std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir);
 
 // Polls a file's modification time, at most once per `interval`.
 class FileWatch {

@@ -10,6 +10,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
+#include "core/image_io.h"
 #include "scene/load.h"
 #include "scene/save.h"
 #include "viewer/navigation.h"

@@ -9,6 +9,8 @@
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
+#include "core/image_io.h"
+#include "scene/load.h"
 #include "scene/save.h"
 #include "viewer/ui_app.h"
 
@@ -104,10 +106,8 @@ void ViewerApp::panel_scene() {
     ImGui::TextWrapped("%s", current.string().c_str());
     if (ImGui::IsWindowAppearing() || scene_list_.empty()) {
         scene_list_ = list_scenes(current.parent_path().empty() ? fs::path(".") : current.parent_path());
-#ifdef KEITHRAY_SCENES_DIR
-        for (const fs::path& p : list_scenes(KEITHRAY_SCENES_DIR))
+        for (const fs::path& p : default_scenes())
             if (std::find(scene_list_.begin(), scene_list_.end(), p) == scene_list_.end()) scene_list_.push_back(p);
-#endif
     }
     if (ImGui::BeginCombo("open", current.filename().string().c_str())) {
         for (const fs::path& p : scene_list_) {
