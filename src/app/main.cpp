@@ -13,9 +13,12 @@
 #include <unistd.h>
 
 #include "app/bench.h"
+#include "app/compare.h"
 #include "app/progress.h"
 #include "core/args.h"
 #include "core/image.h"
+#include "core/image_hdr.h"
+#include "render/aov.h"
 #include "render/render.h"
 #include "scene/load.h"
 #include "viewer/files.h"
@@ -31,7 +34,10 @@ constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere 
 
 Usage:
   keithray render [SCENE.json ...] [options]
-  keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG)
+  keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG);
+                                            RMSE and relative MSE of two HDR ones (EXR, PFM)
+  keithray compare TEST REFERENCE [options] pass/fail check for CI, thresholds or a
+                                            statistical test ('keithray compare --help')
   keithray bench --throughput|--stress ...  speed figures ('keithray bench --help')
   keithray view [SCENE.json] [options]      interactive viewer (GLFW window; see
                                             'keithray view --help' and README.md)
@@ -71,12 +77,18 @@ Options:
                         where the scene's sizes allow, else four in double; double keeps
                         the four double lanes; docs/performance.md)
   -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
-                        (only with a single scene); OUT.png writes PNGs instead
+                        (only with a single scene); OUT.png writes PNGs instead;
+                        OUT.exr one OpenEXR with the radiance and its layers; OUT.pfm
+                        the radiance and OUT-depth.pfm the distances as float PFMs
   -q, --quiet           no progress bar
   -h, --help            this text
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
-(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. One summary line per
+(1 - d/(1+d)) as NAME-depth.ppm (or .png), each written atomically. NAME.exr holds the
+mean radiance (R, G, B, 32-bit float) and the layers depth.Z (primary hit distance, 1e6
+where the ray missed), albedo.R/G/B and normal.X/Y/Z (first non-specular hit of the
+pixel centre's ray), samples (per pixel) and variance.R/G/B (of the mean; left out with
+--blur); NAME.pfm the radiance and NAME-depth.pfm the distances. One summary line per
 scene on stdout: spp, seconds, Mrays/s.
 Exit status: 0 on success, 1 if a scene failed to load or render, 2 on bad usage.
 )";
@@ -124,6 +136,8 @@ Options parse_options(int argc, char** argv) {
     }
     if (o.output && o.scenes.size() != 1)
         throw UsageError{"-o needs exactly one scene file (it names a single output)"};
+    if (o.gl && o.output && (is_exr_path(*o.output) || is_pfm_path(*o.output)))
+        throw UsageError{"--gl tone maps for an 8-bit output; an .exr or .pfm output is not tone mapped"};
     return o;
 }
 
@@ -172,11 +186,15 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
     }
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
+    // An EXR holds the depth as a layer; every other output has its depth map beside it.
+    const bool exr = is_exr_path(output), pfm = is_pfm_path(output);
     const fs::path depth_output = depth_path_for(output);
+    std::vector<fs::path> outputs{output};
+    if (!exr) outputs.push_back(depth_output);
     // No input of this command is ever overwritten: not this scene file, nor another one
     // still to be rendered (nor one already rendered).
     for (const fs::path& input : opt.scenes)
-        for (const fs::path& written : {output, depth_output})
+        for (const fs::path& written : outputs)
             if (same_file(written, input)) {
                 std::fprintf(stderr, "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
                              scene_file.string().c_str(), written.string().c_str(), input.string().c_str(),
@@ -225,9 +243,20 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt) {
 
     try {
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
-                                           : tonemap(radiance, opt.tonemap));
-        viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+        if (exr) {
+            write_file_atomic(output, encode_exr(hdr_from_render(scene, state, radiance, opt.blur == 0)));
+        } else if (pfm) {
+            const std::vector<double> depth = state.mean_depth();
+            const std::string radiance_bytes = encode_pfm_rgb(hdr_from_radiance(radiance));
+            const std::string depth_bytes =
+                encode_pfm_gray(std::vector<float>(depth.begin(), depth.end()), state.width, state.height);
+            write_file_atomic(output, radiance_bytes);
+            write_file_atomic(depth_output, depth_bytes);
+        } else {
+            viewer::write_image(output, opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0})
+                                               : tonemap(radiance, opt.tonemap));
+            viewer::write_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height));
+        }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s: %s\n", scene_file.string().c_str(), e.what());
         return false;
@@ -271,19 +300,8 @@ int main(int argc, char** argv) {
         return 0;
     }
     if (command == "bench") return run_bench(argc, argv);
-    if (command == "psnr") {
-        if (argc != 4) {
-            std::fprintf(stderr, "error: psnr needs two image files (PPM or PNG)\n");
-            return 2;
-        }
-        try {
-            std::printf("%.2f\n", psnr(viewer::read_image(argv[2]), viewer::read_image(argv[3])));
-            return 0;
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "error: %s\n", e.what());
-            return 1;
-        }
-    }
+    if (command == "psnr") return run_psnr(argc, argv);
+    if (command == "compare") return run_compare(argc, argv);
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",

@@ -49,6 +49,7 @@ struct RenderState {
     std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
     std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
     std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
+    std::vector<Color> radiance_sq_sum;   // per pixel and channel, sum of squared sample radiance
     std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
     std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
     int passes = 0;                       // completed passes
@@ -71,6 +72,9 @@ struct RenderState {
     void reset(int w, int h);
     Image radiance() const;                  // per-pixel mean radiance
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
+    // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
+    // over the count (infinite below two samples). What `keithray compare --statistical` tests.
+    std::vector<Color> variance_of_mean() const;
 
     // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
     double sample_variance(size_t i) const;
