@@ -445,6 +445,9 @@ TEST_F(HdrCli, CompareExitStatusVerdictAndDiffImage) {
     EXPECT_EQ(r.out.rfind("rmse ", 0), 0u) << r.out;
     EXPECT_EQ(run("compare a.exr b.exr").status, 2);  // no criterion
     EXPECT_EQ(run("compare a.exr --statistical").status, 2);
+    EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff ./b.exr").status, 2);  // never over an input
+    EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff d.exr").status, 2);    // 8-bit picture only
+    EXPECT_GT(read_hdr(dir / "b.exr").rgb.size(), 0u);
 }
 
 TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {

@@ -3,6 +3,7 @@
 #include "app/compare.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 #include <string>
 
@@ -100,6 +101,21 @@ CompareOptions parse_compare(int argc, char** argv) {
         throw UsageError{"compare needs a criterion: --min-psnr, --max-rmse, --max-relmse or --statistical"};
     o.test = files[0];
     o.reference = files[1];
+    if (o.diff) {
+        const std::string ext = std::filesystem::path(*o.diff).extension().string();
+        if (ext != ".png" && ext != ".PNG" && ext != ".ppm" && ext != ".PPM")
+            throw UsageError{"--diff writes an 8-bit picture: give it a name ending in .png or .ppm"};
+        // The picture never replaces an image being compared.
+        for (const std::string& input : files) {
+            std::error_code ec;
+            const auto resolved = [](const std::filesystem::path& p) {
+                std::error_code e;
+                return std::filesystem::weakly_canonical(std::filesystem::absolute(p, e), e);
+            };
+            if (std::filesystem::equivalent(*o.diff, input, ec) || resolved(*o.diff) == resolved(input))
+                throw UsageError{"--diff " + *o.diff + " would overwrite the input " + input};
+        }
+    }
     return o;
 }
 

@@ -17,6 +17,8 @@
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
+#include <OpenEXR/ImfThreading.h>
+#include <omp.h>
 
 namespace kr {
 
@@ -147,6 +149,12 @@ std::vector<float>* float_layer(HdrImage& image, int layer) {
 
 std::string encode_exr(const HdrImage& image) {
     check_image(image);
+    // OpenEXR compresses its line blocks on a thread pool: one thread per OpenMP worker.
+    static const bool pool_started = [] {
+        Imf::setGlobalThreadCount(std::max(1, omp_get_max_threads()));
+        return true;
+    }();
+    (void)pool_started;
     HdrImage& layers = const_cast<HdrImage&>(image);  // Imf::Slice takes char*; nothing is written
     Imf::Header header(image.width, image.height);
     header.compression() = Imf::ZIP_COMPRESSION;
