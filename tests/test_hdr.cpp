@@ -85,6 +85,31 @@ TEST(HdrFiles, ExrRoundTripsEveryLayerExactly) {
     EXPECT_TRUE(back.depth.empty() && back.variance.empty() && back.samples.empty() && back.albedo.empty());
 }
 
+// Another writer's EXR whose data window does not start at (0, 0): its pixels, in order.
+TEST(HdrFiles, ExrWithAnOffsetDataWindowReads) {
+    const Imath::Box2i display(Imath::V2i(0, 0), Imath::V2i(7, 7)), data(Imath::V2i(2, 3), Imath::V2i(5, 6));
+    Imf::Header header(display, data);
+    std::vector<float> rgb(4 * 4 * 3);
+    for (size_t i = 0; i < rgb.size(); ++i) rgb[i] = float(i) * 0.5f;
+    const fs::path file = fs::temp_directory_path() / ("keithray_window_" + std::to_string(::getpid()) + ".exr");
+    {
+        Imf::FrameBuffer frame;
+        for (int k = 0; k < 3; ++k) {
+            header.channels().insert(std::string(1, "RGB"[k]), Imf::Channel(Imf::FLOAT));
+            frame.insert(std::string(1, "RGB"[k]),
+                         Imf::Slice::Make(Imf::FLOAT, rgb.data() + k, data, 3 * sizeof(float), 12 * sizeof(float)));
+        }
+        Imf::OutputFile out(file.c_str(), header);
+        out.setFrameBuffer(frame);
+        out.writePixels(4);
+    }
+    const HdrImage img = read_hdr(file);
+    fs::remove(file);
+    EXPECT_EQ(img.width, 4);
+    EXPECT_EQ(img.height, 4);
+    EXPECT_EQ(img.rgb, rgb);
+}
+
 TEST(HdrFiles, PfmRoundTripsRadianceAndDepthExactly) {
     const HdrImage img = layered_image(6, 4);
     EXPECT_EQ(decode_pfm(encode_pfm_rgb(img), "mem.pfm").rgb, img.rgb);
@@ -463,6 +488,7 @@ TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {
     std::fill(corrupt.begin() + long(corrupt.size() / 2), corrupt.end(), '\x5a');
     write_bytes(dir / "corrupt.exr", corrupt);
     write_bytes(dir / "truncated.pfm", pfm.substr(0, pfm.size() - 10));
+    write_bytes(dir / "huge.ppm", "P6\n100000 100000\n255\nabc");
     const std::pair<std::string, std::string> cases[] = {
         {"compare truncated.exr a.exr --max-rmse 1", "truncated.exr"},
         {"compare a.exr corrupt.exr --max-rmse 1", "corrupt.exr"},
@@ -472,6 +498,7 @@ TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {
         {"compare a.exr a.pfm --statistical", "a.pfm"},
         {"compare blurred.exr a.exr --statistical", "blurred.exr"},
         {"compare a.exr missing.exr --max-rmse 1", "missing.exr"},
+        {"psnr huge.ppm a.exr", "huge.ppm"},  // a PPM header far larger than its file
     };
     for (const auto& [args, file] : cases) {
         const test::CommandResult r = run(args);

@@ -136,7 +136,17 @@ Rgb8Image read_ppm(const std::filesystem::path& path) {
     }
     if (magic != "P6" || maxval != 255 || img.width <= 0 || img.height <= 0)
         throw std::runtime_error(path.string() + ": only binary PPM (P6) with maxval 255 is read");
-    img.bytes.resize(static_cast<size_t>(img.width) * img.height * 3);
+    // The header's size against the bytes the file has, before taking memory for them.
+    const std::streamoff pixels_at = f.tellg();
+    f.seekg(0, std::ios::end);
+    const std::streamoff available = f.tellg() - pixels_at;
+    f.seekg(pixels_at);
+    const size_t want = static_cast<size_t>(img.width) * static_cast<size_t>(img.height) * 3;
+    if (pixels_at < 0 || available < 0 || want > static_cast<size_t>(available))
+        throw std::runtime_error(path.string() + ": truncated pixel data (the header's " + std::to_string(img.width) +
+                                 "x" + std::to_string(img.height) + " needs " + std::to_string(want) + " bytes, the file has " +
+                                 std::to_string(std::max<std::streamoff>(available, 0)) + ")");
+    img.bytes.resize(want);
     f.read(reinterpret_cast<char*>(img.bytes.data()), static_cast<std::streamsize>(img.bytes.size()));
     if (f.gcount() != static_cast<std::streamsize>(img.bytes.size()))
         throw std::runtime_error(path.string() + ": truncated pixel data");

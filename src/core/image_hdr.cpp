@@ -214,22 +214,20 @@ HdrImage decode_exr(const std::string& bytes, const std::string& name) {
             if (found[layer] != 0 && found[layer] != kLayerChannels[layer])
                 fail(name, std::string("the ") + kLayerNames[layer] + " layer is incomplete");
         Imf::FrameBuffer frame;
-        // Slices are addressed from the data window's origin, which need not be (0, 0).
-        const ptrdiff_t origin = ptrdiff_t(window.min.x) + ptrdiff_t(window.min.y) * ptrdiff_t(w);
+        // Slice::Make addresses the buffers from the data window's origin, which need not be (0, 0).
         for (const ExrChannel& ch : kExrChannels) {
             if (!found[size_t(ch.layer)]) continue;
             const size_t stride = size_t(kLayerChannels[size_t(ch.layer)]);
             if (ch.layer == 4) {
                 out.samples.assign(n, 0);
-                frame.insert(ch.name, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(out.samples.data() - origin),
-                                                 sizeof(uint32_t), sizeof(uint32_t) * size_t(w)));
+                frame.insert(ch.name, Imf::Slice::Make(Imf::UINT, out.samples.data(), window, sizeof(uint32_t),
+                                                       sizeof(uint32_t) * size_t(w)));
                 continue;
             }
             std::vector<float>& data = *float_layer(out, ch.layer);
             data.resize(n * stride, 0.0f);
-            frame.insert(ch.name,
-                         Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(data.data() + ch.offset - origin * ptrdiff_t(stride)),
-                                    sizeof(float) * stride, sizeof(float) * stride * size_t(w)));
+            frame.insert(ch.name, Imf::Slice::Make(Imf::FLOAT, data.data() + ch.offset, window, sizeof(float) * stride,
+                                                   sizeof(float) * stride * size_t(w)));
         }
         file.setFrameBuffer(frame);
         if (!file.isComplete()) fail(name, "the file is truncated (pixel data missing)");
