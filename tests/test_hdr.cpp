@@ -141,24 +141,29 @@ TEST(HdrFiles, BadExrAndPfmBytesGiveOneLineNamingTheFile) {
     std::fill(corrupt.begin() + long(corrupt.size() / 2), corrupt.end(), '\xff');
     EXPECT_EQ(exr_error(corrupt).rfind("bad.exr: ", 0), 0u) << exr_error(corrupt);
 
-    // An EXR without R, G, B (here a luminance Y only).
-    {
+    // An EXR without R, G, B (a luminance Y only), and one with a layer missing channels.
+    const std::pair<std::vector<const char*>, const char*> channel_cases[] = {
+        {{"Y"}, "expected the channels R, G and B"}, {{"R", "G", "B", "variance.R"}, "the variance layer is incomplete"}};
+    for (const auto& [names, expected] : channel_cases) {
         Imf::Header header(4, 4);
-        header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
-        std::vector<float> y(16, 1.0f);
-        const fs::path file = fs::temp_directory_path() / ("keithray_y_" + std::to_string(::getpid()) + ".exr");
+        std::vector<float> values(16, 1.0f);
+        Imf::FrameBuffer frame;
+        for (const char* channel : names) {
+            header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
+            frame.insert(channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(values.data()), sizeof(float),
+                                             4 * sizeof(float)));
+        }
+        const fs::path file = fs::temp_directory_path() / ("keithray_channels_" + std::to_string(::getpid()) + ".exr");
         {
             Imf::OutputFile out(file.c_str(), header);
-            Imf::FrameBuffer frame;
-            frame.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(y.data()), sizeof(float), 4 * sizeof(float)));
             out.setFrameBuffer(frame);
             out.writePixels(4);
         }
         try {
             read_hdr(file);
-            ADD_FAILURE() << "an EXR without R, G, B was read";
+            ADD_FAILURE() << "read an EXR with channels " << names.size();
         } catch (const std::runtime_error& e) {
-            EXPECT_NE(std::string(e.what()).find("expected the channels R, G and B"), std::string::npos) << e.what();
+            EXPECT_EQ(std::string(e.what()), file.string() + ": " + expected + (names.size() == 1 ? " of an RGB radiance image" : ""));
         }
         fs::remove(file);
     }

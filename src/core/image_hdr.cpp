@@ -110,39 +110,44 @@ private:
     size_t pos_ = 0;
 };
 
-// The layers of the EXR file: channel names and where their floats live.
+// The layers of the EXR file, their names for messages and their channels per pixel.
+enum class ExrLayer { radiance, depth, albedo, normal, samples, variance };
+constexpr EnumNames<ExrLayer, 6> exr_layer_names{{"radiance", "depth", "albedo", "normal", "samples", "variance"}};
+constexpr std::array<int, 6> kLayerChannels{3, 1, 3, 3, 1, 3};
+int channels_of(ExrLayer layer) { return kLayerChannels[size_t(layer)]; }
+
+// Each EXR channel: its name, its layer and its place within the layer's pixel.
 struct ExrChannel {
     const char* name;
-    int layer;   // 0 rgb, 1 depth, 2 albedo, 3 normal, 4 samples, 5 variance
-    int offset;  // channel within the layer's pixel
+    ExrLayer layer;
+    int offset;
 };
-constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", 0, 0},
-                                                   {"G", 0, 1},
-                                                   {"B", 0, 2},
-                                                   {"depth.Z", 1, 0},
-                                                   {"albedo.R", 2, 0},
-                                                   {"albedo.G", 2, 1},
-                                                   {"albedo.B", 2, 2},
-                                                   {"normal.X", 3, 0},
-                                                   {"normal.Y", 3, 1},
-                                                   {"normal.Z", 3, 2},
-                                                   {"samples", 4, 0},
-                                                   {"variance.R", 5, 0},
-                                                   {"variance.G", 5, 1},
-                                                   {"variance.B", 5, 2}}};
-constexpr std::array<const char*, 6> kLayerNames{"radiance", "depth", "albedo", "normal", "samples", "variance"};
-constexpr std::array<int, 6> kLayerChannels{3, 1, 3, 3, 1, 3};
+constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", ExrLayer::radiance, 0},
+                                                   {"G", ExrLayer::radiance, 1},
+                                                   {"B", ExrLayer::radiance, 2},
+                                                   {"depth.Z", ExrLayer::depth, 0},
+                                                   {"albedo.R", ExrLayer::albedo, 0},
+                                                   {"albedo.G", ExrLayer::albedo, 1},
+                                                   {"albedo.B", ExrLayer::albedo, 2},
+                                                   {"normal.X", ExrLayer::normal, 0},
+                                                   {"normal.Y", ExrLayer::normal, 1},
+                                                   {"normal.Z", ExrLayer::normal, 2},
+                                                   {"samples", ExrLayer::samples, 0},
+                                                   {"variance.R", ExrLayer::variance, 0},
+                                                   {"variance.G", ExrLayer::variance, 1},
+                                                   {"variance.B", ExrLayer::variance, 2}}};
 
-// The vector holding a layer (samples excepted, which is uint32).
-std::vector<float>* float_layer(HdrImage& image, int layer) {
+// The vector holding a float layer (samples, the one 32-bit unsigned layer, has none).
+std::vector<float>* float_layer(HdrImage& image, ExrLayer layer) {
     switch (layer) {
-        case 0: return &image.rgb;
-        case 1: return &image.depth;
-        case 2: return &image.albedo;
-        case 3: return &image.normal;
-        case 5: return &image.variance;
-        default: return nullptr;
+        case ExrLayer::radiance: return &image.rgb;
+        case ExrLayer::depth: return &image.depth;
+        case ExrLayer::albedo: return &image.albedo;
+        case ExrLayer::normal: return &image.normal;
+        case ExrLayer::variance: return &image.variance;
+        case ExrLayer::samples: return nullptr;
     }
+    return nullptr;
 }
 
 }  // namespace
@@ -164,8 +169,8 @@ std::string encode_exr(const HdrImage& image) {
     Imf::FrameBuffer frame;
     const size_t width = size_t(image.width);
     for (const ExrChannel& ch : kExrChannels) {
-        const int stride = kLayerChannels[size_t(ch.layer)];
-        if (ch.layer == 4) {
+        const int stride = channels_of(ch.layer);
+        if (ch.layer == ExrLayer::samples) {
             if (layers.samples.empty()) continue;
             header.channels().insert(ch.name, Imf::Channel(Imf::UINT));
             frame.insert(ch.name, Imf::Slice(Imf::UINT, reinterpret_cast<char*>(layers.samples.data()),
@@ -197,28 +202,28 @@ HdrImage decode_exr(const std::string& bytes, const std::string& name) {
         if (w <= 0 || h <= 0 || w > kMaxHdrSide || h > kMaxHdrSide || size_t(w) * size_t(h) > kMaxHdrPixels)
             fail(name, "image size " + std::to_string(w) + "x" + std::to_string(h) + " is out of range (at most " +
                            std::to_string(kMaxHdrSide) + " a side and " + std::to_string(kMaxHdrPixels) + " pixels)");
-        // A header whose pixels could not fit the file's bytes even compressed (deflate keeps
-        // at most about 1000:1; 64:1 per 4-byte channel is far beyond any real image's ratio).
-        if (size_t(w) * size_t(h) > bytes.size() * 64)
+        // A header whose pixels could not fit the file's bytes even compressed: deflate keeps
+        // at most about 1000:1, under 200 pixels per byte for three half-float channels.
+        if (size_t(w) * size_t(h) > bytes.size() * 4096)
             fail(name, "the header's size " + std::to_string(w) + "x" + std::to_string(h) +
                            " does not fit the file's " + std::to_string(bytes.size()) + " bytes");
         out.width = int(w);
         out.height = int(h);
         const size_t n = out.pixel_count();
         const Imf::ChannelList& channels = file.header().channels();
-        std::array<int, 6> found{};
+        std::array<int, 6> found{};  // channels present per layer
         for (const ExrChannel& ch : kExrChannels)
             if (channels.findChannel(ch.name)) ++found[size_t(ch.layer)];
-        if (found[0] != 3) fail(name, "expected the channels R, G and B of an RGB radiance image");
-        for (size_t layer = 1; layer < found.size(); ++layer)
+        if (found[size_t(ExrLayer::radiance)] != 3) fail(name, "expected the channels R, G and B of an RGB radiance image");
+        for (size_t layer = 0; layer < found.size(); ++layer)
             if (found[layer] != 0 && found[layer] != kLayerChannels[layer])
-                fail(name, std::string("the ") + kLayerNames[layer] + " layer is incomplete");
+                fail(name, "the " + std::string(exr_layer_names.name(ExrLayer(layer))) + " layer is incomplete");
         Imf::FrameBuffer frame;
         // Slice::Make addresses the buffers from the data window's origin, which need not be (0, 0).
         for (const ExrChannel& ch : kExrChannels) {
             if (!found[size_t(ch.layer)]) continue;
-            const size_t stride = size_t(kLayerChannels[size_t(ch.layer)]);
-            if (ch.layer == 4) {
+            const size_t stride = size_t(channels_of(ch.layer));
+            if (ch.layer == ExrLayer::samples) {
                 out.samples.assign(n, 0);
                 frame.insert(ch.name, Imf::Slice::Make(Imf::UINT, out.samples.data(), window, sizeof(uint32_t),
                                                        sizeof(uint32_t) * size_t(w)));
