@@ -96,6 +96,33 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
         return scale * scale;
     };
 
+    // Each pixel's variance of the mean, its sample variance raised to the mean of its 3x3
+    // neighbourhood's where that is larger, over its count. Adaptive sampling gives a pixel
+    // whose early samples happened to vary little fewer samples, so its own estimate stays low
+    // (measured: uniform samples, adaptive allocation, 16 spp, 4 of 20 same-scene pairs failed
+    // at alpha 0.05); its neighbours' estimates correct that. Needs the samples layer.
+    auto guarded_variance = [&](const HdrImage& image) {
+        std::vector<double> out(image.variance.begin(), image.variance.end());
+        if (image.samples.size() != n) return out;
+        const int w = image.width, h = image.height;
+        std::vector<double> sample_var(3 * n);
+        for (size_t i = 0; i < n; ++i)
+            for (size_t k = 0; k < 3; ++k) sample_var[3 * i + k] = double(image.variance[3 * i + k]) * image.samples[i];
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (size_t k = 0; k < 3; ++k) {
+                    double sum = 0;
+                    int cells = 0;
+                    for (int ny = std::max(0, y - 1); ny <= std::min(h - 1, y + 1); ++ny)
+                        for (int nx = std::max(0, x - 1); nx <= std::min(w - 1, x + 1); ++nx, ++cells)
+                            sum += sample_var[3 * (size_t(ny) * size_t(w) + size_t(nx)) + k];
+                    const size_t i = size_t(y) * size_t(w) + size_t(x);
+                    out[3 * i + k] = std::max(out[3 * i + k], sum / cells / std::max<double>(image.samples[i], 1));
+                }
+        return out;
+    };
+    const std::vector<double> test_var = guarded_variance(test), reference_var = guarded_variance(reference);
+
     StatisticalResult out;
     const int block = std::max(1, settings.block);
     // Per base block and channel: the sums of the differences, of the variances, and
@@ -110,7 +137,7 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
             const size_t i = size_t(y) * size_t(test.width) + size_t(x);
             for (int k = 0; k < 3; ++k) {
                 const size_t j = 3 * i + size_t(k);
-                const double va = test.variance[j], vb = reference.variance[j];
+                const double va = test_var[j], vb = reference_var[j];
                 BlockSums& b = level[(size_t(y / block) * size_t(bx) + size_t(x / block)) * 3 + size_t(k)];
                 b.diff += double(test.rgb[j]) - double(reference.rgb[j]);
                 b.var += va + vb + rounding_floor(test.rgb[j], reference.rgb[j]);
@@ -187,7 +214,7 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
         double worst = 0;
         for (size_t j = 3 * i; j < 3 * i + 3; ++j) {
             const double d = double(test.rgb[j]) - double(reference.rgb[j]);
-            const double v = double(test.variance[j]) + reference.variance[j] + rounding_floor(test.rgb[j], reference.rgb[j]);
+            const double v = test_var[j] + reference_var[j] + rounding_floor(test.rgb[j], reference.rgb[j]);
             worst = std::max(worst, v > 0 ? std::abs(d) / std::sqrt(v) : (d != 0 ? 1e30 : 0.0));
         }
         out.pixel_z[i] = float(std::min(worst, 1e30));

@@ -23,7 +23,8 @@ ImageErrors radiance_errors(const HdrImage& test, const HdrImage& reference);
 ImageErrors rgb8_errors(const Rgb8Image& test, const Rgb8Image& reference);
 
 // The hypothesis that two renders are unbiased estimates of one image, from each pixel's mean
-// and variance of the mean. Per block and channel, the difference of the two block means over
+// and variance of the mean (each pixel's sample variance raised to its 3x3 neighbourhood's mean
+// where that is larger, where the samples layer gives the counts). Per block and channel, the difference of the two block means over
 // its standard error (Welch: the two images' variances add, and Welch-Satterthwaite's degrees
 // of freedom turn the t value into an equivalent normal z), for blocks of `block` pixels a
 // side, then twice that, and so on up to the whole image. The images disagree when the largest
