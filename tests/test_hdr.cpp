@@ -426,6 +426,8 @@ TEST_F(HdrCli, ExrCarriesEveryLayerAndMatchesThePpmAndPfm) {
     ASSERT_EQ(run("render s.json -q -o r.ppm").status, 0);
     ASSERT_EQ(run("render s.json -q -o r.pfm").status, 0);
     EXPECT_FALSE(fs::exists(dir / "r-depth.exr"));  // the depth is a layer of the EXR
+    EXPECT_EQ(run("render s.json -q --gl -o g.exr").status, 2);  // nothing to tone map
+    EXPECT_FALSE(fs::exists(dir / "g.exr"));
     const HdrImage exr = read_hdr(dir / "r.exr");
     ASSERT_EQ(exr.width, 16);
     ASSERT_EQ(exr.height, 12);
