@@ -5,6 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
+          # OpenEXR: HDR output (-o OUT.exr) and reading it back (psnr, compare)
+          libopenexr-dev
           # Embree: ray casting in scenes of more than 32 spheres (optional to CMake)
           libembree-dev
           # PNG reading and writing (src/core/image_io.cpp)

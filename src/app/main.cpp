@@ -16,13 +16,17 @@
 #include <unistd.h>
 
 #include "app/bench.h"
+#include "app/compare.h"
 #include "app/progress.h"
 #include "core/args.h"
 #include "core/image.h"
 #include "core/limits.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "core/file_write.h"
 #include "core/image_io.h"
+#include "core/image_hdr.h"
+#include "render/aov.h"
 #include "render/render.h"
 #include "scene/load.h"
 #include "viewer/gl_offscreen.h"
@@ -37,7 +41,10 @@ constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere 
 
 Usage:
   keithray render [SCENE.json ...] [options]
-  keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG)
+  keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG);
+                                            RMSE and relative MSE of two HDR ones (EXR, PFM)
+  keithray compare TEST REFERENCE [options] pass/fail check for CI, thresholds or a
+                                            statistical test ('keithray compare --help')
   keithray bench --throughput|--stress ...  speed figures ('keithray bench --help')
   keithray view [SCENE.json] [options]      interactive viewer (GLFW window; see
                                             'keithray view --help' and README.md)
@@ -79,14 +86,20 @@ Options:
                         where the scene's sizes allow, else four in double; double keeps
                         the four double lanes; docs/performance.md)
   -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
-                        (only with a single scene); OUT.png writes PNGs instead
+                        (only with a single scene); OUT.png writes PNGs instead;
+                        OUT.exr one OpenEXR with the radiance and its layers; OUT.pfm
+                        the radiance and OUT-depth.pfm the distances as float PFMs
   -q, --quiet           no progress bar
   -h, --help            this text
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
 (1 - d/(1+d)) as NAME-depth.ppm (or .png), both replaced together or neither (a
-read-only file, a folder or a device as output is refused). One summary line per scene
-on stdout: spp, seconds, Mrays/s.
+read-only file, a folder or a device as output is refused). NAME.exr holds the mean
+radiance (R, G, B, 32-bit float) and the layers depth.Z (primary hit distance, 1e6 where
+the ray missed), albedo.R/G/B and normal.X/Y/Z (first non-specular hit of the pixel
+centre's ray), samples (per pixel) and variance.R/G/B (of the mean; left out with
+--blur); NAME.pfm the radiance and NAME-depth.pfm the distances, both or neither.
+One summary line per scene on stdout: spp, seconds, Mrays/s.
 A render whose memory estimate exceeds the machine's (or ulimit -v's) memory is refused;
 scene files are at most 64 MiB (README.md, "Limits").
 Exit status: 0 on success, 1 if a scene failed to load, render or be written (or stdout
@@ -136,6 +149,8 @@ Options parse_options(int argc, char** argv) {
     }
     if (o.output && o.scenes.size() != 1)
         throw UsageError{"-o needs exactly one scene file (it names a single output)"};
+    if (o.gl && o.output && (is_exr_path(*o.output) || is_pfm_path(*o.output)))
+        throw UsageError{"--gl tone maps for an 8-bit output; an .exr or .pfm output is not tone mapped"};
     return o;
 }
 
@@ -193,11 +208,15 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     if (opt.depth) settings.max_depth = *opt.depth;
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
+    // An EXR holds the depth as a layer; every other output has its depth map beside it.
+    const bool exr = is_exr_path(output), pfm = is_pfm_path(output);
     const fs::path depth_output = depth_path_for(output);
+    std::vector<fs::path> outputs{output};
+    if (!exr) outputs.push_back(depth_output);
     // No input of this command is ever overwritten: not this scene file, nor another one
     // still to be rendered (nor one already rendered).
     for (const fs::path& input : opt.scenes)
-        for (const fs::path& written : {output, depth_output})
+        for (const fs::path& written : outputs)
             if (same_file(written, input)) {
                 std::fprintf(stderr, "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
                              file.c_str(), shown(written).c_str(), shown(input).c_str(),
@@ -262,11 +281,22 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     try {
         // The image and its depth map are committed together: both replaced, or neither.
         const Image radiance = box_blur(state.radiance(), opt.blur);
-        const Rgb8Image display =
-            opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0}) : tonemap(radiance, opt.tonemap);
-        write_files_atomic(
-            {{output, encode_image(output, display)},
-             {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))}});
+        std::vector<FileOutput> files;
+        if (exr) {
+            files.push_back({output, encode_exr(hdr_from_render(scene, state, radiance, opt.blur == 0))});
+        } else if (pfm) {
+            const std::vector<double> depth = state.mean_depth();
+            files.push_back({output, encode_pfm_rgb(hdr_from_radiance(radiance))});
+            files.push_back({depth_output, encode_pfm_gray(std::vector<float>(depth.begin(), depth.end()),
+                                                           state.width, state.height)});
+        } else {
+            const Rgb8Image display =
+                opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0}) : tonemap(radiance, opt.tonemap);
+            files.push_back({output, encode_image(output, display)});
+            files.push_back(
+                {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))});
+        }
+        write_files_atomic(files);
     } catch (const std::exception& e) {
         if (out_of_memory(e)) throw;
         std::fprintf(stderr, "error: %s: %s\n", file.c_str(), e.what());
@@ -312,29 +342,16 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (command == "psnr") {
-        if (argc != 4) {
-            std::fprintf(stderr, "error: psnr needs two image files (PPM or PNG)\n");
-            return 2;
-        }
+    if (command == "psnr" || command == "compare") {
         try {
-            const Rgb8Image image = read_image(argv[2]), reference = read_image(argv[3]);
-            if (image.width != reference.width || image.height != reference.height) {
-                std::fprintf(stderr, "error: %s is %dx%d but %s is %dx%d; psnr needs two images of one size\n",
-                             quoted_path(argv[2]).c_str(), image.width, image.height, quoted_path(argv[3]).c_str(),
-                             reference.width, reference.height);
-                return 1;
-            }
-            std::printf("%.2f\n", psnr(image, reference));
+            const int status = command == "psnr" ? run_psnr(argc, argv) : run_compare(argc, argv);
+            return stdout_written() ? status : 1;
         } catch (const std::exception& e) {
-            if (out_of_memory(e))
-                std::fprintf(stderr, "error: not enough memory for the images %s and %s\n", shown(argv[2]).c_str(),
-                             shown(argv[3]).c_str());
-            else
-                std::fprintf(stderr, "error: %s\n", e.what());
+            if (!out_of_memory(e)) throw;
+            std::fprintf(stderr, "error: %s: not enough memory for the images %s and %s\n", command.c_str(),
+                         argc > 2 ? shown(argv[2]).c_str() : "", argc > 3 ? shown(argv[3]).c_str() : "");
             return 1;
         }
-        return stdout_written() ? 0 : 1;
     }
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {

@@ -1,5 +1,6 @@
 #include "render/render.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -23,6 +24,7 @@ void RenderState::reset(int w, int h) {
     radiance_sum.assign(n, Color());
     depth_sum.assign(n, 0.0);
     luminance_sq_sum.assign(n, 0.0);
+    radiance_sq_sum.assign(n, Color());
     sample_count.assign(n, 0);
     sample_index.assign(n, 0);
     passes = 0;
@@ -36,7 +38,8 @@ void RenderState::reset(int w, int h) {
 }
 
 uint64_t render_memory_bytes(int width, int height, bool blurred) {
-    const uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + 2 * 3 + 2 * 3;
+    const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
+    const uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
     return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
 }
 
@@ -52,6 +55,22 @@ std::vector<double> RenderState::mean_depth() const {
     for (size_t i = 0; i < d.size(); ++i)
         if (sample_count[i]) d[i] = depth_sum[i] / double(sample_count[i]);
     return d;
+}
+
+std::vector<Color> RenderState::variance_of_mean() const {
+    std::vector<Color> v(radiance_sum.size(), Color(kInfinity));
+    for (size_t i = 0; i < v.size(); ++i) {
+        const double n = sample_count[i];
+        if (n < 2 || !is_finite(radiance_sq_sum[i])) continue;  // unknown, as sample_variance
+        // The unbiased sample variance of each channel, then over n for the mean's.
+        auto channel = [&](double sum, double sq_sum) {
+            const double mean = sum / n;
+            return std::max(0.0, (sq_sum - n * mean * mean) / (n - 1)) / n;
+        };
+        v[i] = {channel(radiance_sum[i].x, radiance_sq_sum[i].x), channel(radiance_sum[i].y, radiance_sq_sum[i].y),
+                channel(radiance_sum[i].z, radiance_sq_sum[i].z)};
+    }
+    return v;
 }
 
 double RenderState::sample_variance(size_t i) const {
@@ -272,6 +291,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
                 const double lum = luminance(r.radiance);
                 state.luminance_sq_sum[pixel] += lum * lum;
+                state.radiance_sq_sum[pixel] += r.radiance * r.radiance;
                 state.sample_count[pixel] += 1;
             }
             pending = 0;

@@ -49,6 +49,7 @@ struct RenderState {
     std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
     std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
     std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
+    std::vector<Color> radiance_sq_sum;   // per pixel and channel, sum of squared sample radiance
     std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
     std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
     int passes = 0;                       // completed passes
@@ -71,6 +72,9 @@ struct RenderState {
     void reset(int w, int h);
     Image radiance() const;                  // per-pixel mean radiance
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
+    // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
+    // over the count (infinite below two samples). What `keithray compare --statistical` tests.
+    std::vector<Color> variance_of_mean() const;
 
     // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
     double sample_variance(size_t i) const;
@@ -96,16 +100,17 @@ struct RenderState {
     void plan_pass(const RenderSettings& settings);
 };
 
-// The bytes per pixel a RenderState holds once every buffer is in use: the five sums and
+// The bytes per pixel a RenderState holds once every buffer is in use: the six sums and
 // counts, the adaptive mask, the pass plan and its credit, the three allocation buffers and
 // the Sobol keys.
 inline constexpr uint64_t kRenderStateBytesPerPixel =
-    sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
+    2 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
     3 * sizeof(double) + sizeof(uint32_t);
 
 // An upper estimate of the memory a render of width x height pixels holds at its peak: the
 // RenderState, then at the end the mean radiance (and, when blurred, two more radiance images),
-// the mean depth, the two 8-bit images and the encoded files' buffers.
+// the mean depth, and the larger output stage: the two 8-bit images and their encoded bytes,
+// or an EXR's 14 float layers and its encoded bytes.
 uint64_t render_memory_bytes(int width, int height, bool blurred);
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting

@@ -38,6 +38,7 @@ bool Accumulator::render_pass(const RenderScene& scene, const RenderSettings& se
         scratch_.radiance_sum[size_t(i)] = Color();
         scratch_.depth_sum[size_t(i)] = 0.0;
         scratch_.luminance_sq_sum[size_t(i)] = 0.0;
+        scratch_.radiance_sq_sum[size_t(i)] = Color();
         scratch_.sample_count[size_t(i)] = 0u;
     }
     scratch_.rays = 0;
@@ -60,6 +61,7 @@ void Accumulator::add(const RenderState& pass) {
         totals_.radiance_sum[i] = sum + c;
         totals_.depth_sum[i] += pass.depth_sum[i];
         totals_.luminance_sq_sum[i] += pass.luminance_sq_sum[i];
+        totals_.radiance_sq_sum[i] += pass.radiance_sq_sum[i];
         totals_.sample_count[i] += pass.sample_count[i];
     }
     totals_.rays += pass.rays;

@@ -51,7 +51,7 @@ public:
 
 private:
     using Clock = std::chrono::steady_clock;
-    enum class SaveKind { ppm, png, scene };
+    enum class SaveKind { ppm, png, exr, pfm, scene };
 
     // Steps of one UI frame.
     void poll_watch();
@@ -101,7 +101,7 @@ private:
     std::string error_;   // last load/edit failure, shown in red until the next success
     std::string status_;  // last save message
     bool pick_focus_ = false;
-    std::string image_path_, png_path_, scene_path_;
+    std::string image_path_, png_path_, hdr_path_, scene_path_;
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending_save_;
     std::vector<std::filesystem::path> scene_list_;
 

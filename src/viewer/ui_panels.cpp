@@ -11,6 +11,7 @@
 
 #include "core/image_io.h"
 #include "scene/load.h"
+#include "core/image_hdr.h"
 #include "scene/save.h"
 #include "viewer/ui_app.h"
 
@@ -68,6 +69,7 @@ void ViewerApp::reset_save_paths() {
     if (image.empty()) image = "keithray.ppm";
     image_path_ = image.replace_extension(".ppm").string();
     png_path_ = fs::path(image).replace_extension(".png").string();
+    hdr_path_ = fs::path(image).replace_extension(".exr").string();
     const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
     scene_path_ = (source.parent_path() / (source.stem().string() + "-edited.json")).string();
 }
@@ -320,6 +322,13 @@ void ViewerApp::panel_save() {
     ImGui::BeginDisabled(!full);
     if (ImGui::Button("Save PNG")) request_save(SaveKind::png, png_path_);
     ImGui::EndDisabled();
+    // The radiance as floats: OpenEXR (R, G, B) or PFM, the path's extension set to match.
+    ImGui::InputText("hdr", &hdr_path_);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save EXR")) request_save(SaveKind::exr, fs::path(hdr_path_).replace_extension(".exr"));
+    ImGui::SameLine();
+    if (ImGui::Button("Save PFM")) request_save(SaveKind::pfm, fs::path(hdr_path_).replace_extension(".pfm"));
+    ImGui::EndDisabled();
     ImGui::InputText("scene", &scene_path_);
     if (ImGui::Button("Save scene JSON")) request_save(SaveKind::scene, scene_path_);
     if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
@@ -362,6 +371,12 @@ void ViewerApp::save_now(SaveKind kind, const fs::path& path) {
             if (fs::equivalent(path, watch_.file(), ec)) watch_.acknowledge();
         } else {
             if (!shown_ || shown_->scale != 1) throw std::runtime_error("no full-resolution image yet");
+            if (kind == SaveKind::exr || kind == SaveKind::pfm) {
+                const HdrImage hdr = hdr_from_radiance(shown_->radiance);
+                write_file_atomic(path, kind == SaveKind::exr ? encode_exr(hdr) : encode_pfm_rgb(hdr));
+                status_ = "saved " + path.string();
+                return;
+            }
             const ToneSettings& tone = model_.settings().tone;
             const Rgb8Image image = tonemap(shown_->radiance, tone.op, tone.exposure);
             if (kind == SaveKind::ppm) write_ppm(path, image);

@@ -1,0 +1,84 @@
+#include "render/aov.h"
+
+#include <cmath>
+
+#include "render/material.h"
+#include "render/path.h"
+
+namespace kr {
+
+SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int height, int max_chain) {
+    SurfaceLayers out;
+    const size_t n = size_t(width) * size_t(height);
+    out.albedo.assign(n, Color());
+    out.normal.assign(n, Color());
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            // The pixel centre under the references' raster convention, through the lens centre.
+            const Vec2 film = raster_to_camera(x + 0.5, y + 0.5, width, height);
+            const CameraRay cr = scene.camera.generate(film.x, film.y, 0.5, 0.5);
+            Ray ray;
+            ray.o = cr.origin;
+            ray.d = cr.direction;
+            Color tint(1.0);
+            for (int chain = 0; chain <= max_chain; ++chain) {
+                Hit hit;
+                if (!scene.intersects(ray, hit)) break;
+                const Material& m = scene.materials[size_t(scene.sphere_material[size_t(hit.sphere)])];
+                const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
+                const size_t i = size_t(y) * size_t(width) + size_t(x);
+                // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
+                // unless it totally reflects.
+                if (m.type == MaterialType::specular || (m.type == MaterialType::dielectric)) {
+                    Vec3 next;
+                    if (m.type == MaterialType::specular) {
+                        next = ray.d - 2 * dot(ray.d, sp.ns()) * sp.ns();
+                        tint *= m.rho;
+                    } else {
+                        const DielectricSplit split = split_dielectric(m, sp, ray.d);
+                        const bool reflect = split.reflectance >= 1;
+                        next = reflect ? split.reflected : split.transmitted;
+                        tint *= reflect ? m.rho_r : m.rho_t;
+                    }
+                    respawn(ray, hit, normalize(next));
+                    continue;
+                }
+                Color albedo = m.rho;
+                if (m.type == MaterialType::translucent) {
+                    const double r = split_dielectric(m, sp, ray.d).reflectance;
+                    albedo = m.rho_r * r + m.rho_t * (1 - r);
+                }
+                out.albedo[i] = tint * albedo;
+                out.normal[i] = sp.ns();
+                break;
+            }
+        }
+    return out;
+}
+
+HdrImage hdr_from_render(const RenderScene& scene, const RenderState& state, const Image& radiance,
+                         bool with_variance) {
+    HdrImage out = hdr_from_radiance(radiance);
+    const size_t n = out.pixel_count();
+    const std::vector<double> depth = state.mean_depth();
+    out.depth.assign(depth.begin(), depth.end());
+    out.samples.assign(state.sample_count.begin(), state.sample_count.end());
+    const SurfaceLayers surface = first_surface_layers(scene, state.width, state.height);
+    out.albedo.resize(3 * n);
+    out.normal.resize(3 * n);
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            out.albedo[3 * i + size_t(k)] = float(surface.albedo[i][k]);
+            out.normal[3 * i + size_t(k)] = float(surface.normal[i][k]);
+        }
+    if (with_variance) {
+        const std::vector<Color> variance = state.variance_of_mean();
+        out.variance.resize(3 * n);
+        for (size_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k) out.variance[3 * i + size_t(k)] = float(variance[i][k]);
+    }
+    return out;
+}
+
+}  // namespace kr
