@@ -168,31 +168,34 @@ struct Tracer {
     }
 
     // ---- Whitted-style ray tracing: L D S* E, recursive. ----
-    // `event` counts scattering events; the camera ray's hit is event 1.
-    Color whitted(const Ray& ray, int event, double* primary_distance) {
+    // `event` counts scattering events; the camera ray's hit is event 1. `medium`: the
+    // dielectrics the ray has crossed, whose radiance scale the light gathered here takes.
+    Color whitted(const Ray& ray, int event, double* primary_distance, MediumScale medium = {}) {
         Hit hit;
         if (!intersect(ray, hit)) return {};  // nothing hit: black
         if (primary_distance) *primary_distance = hit.t;
         Color L;
         const int light_index = scene.sphere_light[hit.sphere];
-        if (light_index >= 0) L += scene.area_lights[light_index].radiance;
+        if (light_index >= 0) L += scene.area_lights[light_index].radiance * medium.radiance;
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         switch (m.type) {
             case MaterialType::diffuse:
                 // Every point light exactly; every area light with one sample (distributed RT).
-                for (const PointLight& light : scene.point_lights) L += point_light_now(light, m, hit, sp);
-                for (const AreaLight& light : scene.area_lights) L += area_light_now(light, m, hit, sp, sampler.next_2d());
+                for (const PointLight& light : scene.point_lights)
+                    L += point_light_now(light, m, hit, sp) * medium.radiance;
+                for (const AreaLight& light : scene.area_lights)
+                    L += area_light_now(light, m, hit, sp, sampler.next_2d()) * medium.radiance;
                 break;
             case MaterialType::specular:
-                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
+                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr, medium);
                 break;
             case MaterialType::glossy: {
                 ScatterSample s;
                 const double u_lobe = sampler.next_1d();
                 if (sample_material(m, sp, ray.d, u_lobe, sampler.next_2d(), s))
-                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
+                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr, medium);
                 break;
             }
             case MaterialType::dielectric:
@@ -204,12 +207,14 @@ struct Tracer {
                 const Vec2 u_reflect = sampler.next_2d(), u_transmit = sampler.next_2d();
                 Vec3 dir = perturb_direction(split.reflected, beta, u_reflect.x, u_reflect.y);
                 if (dot(dir, ns) > 0)
-                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
+                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr, medium);
                 if (split.reflectance < 1) {
                     dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
+                    MediumScale beyond = medium;
+                    beyond.cross(m, sp.front);
                     if (dot(dir, ns) < 0)
                         L += ((1 - split.reflectance) * m.rho_t) *
-                             whitted(spawn(hit, dir), event + 1, nullptr);
+                             whitted(spawn(hit, dir), event + 1, nullptr, beyond);
                 }
                 break;
             }
@@ -219,7 +224,8 @@ struct Tracer {
 
     // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
     Color path(Ray ray, double* primary_distance) {
-        Color L, throughput(1.0);
+        Color L, throughput(1.0);  // without the dielectrics' radiance scale (medium)
+        MediumScale medium;
         PathHistory history;
         for (int bounce = 0;; ++bounce) {
             Hit hit;
@@ -230,7 +236,7 @@ struct Tracer {
             const int light_index = scene.sphere_light[hit.sphere];
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
-                L += throughput * light.radiance *
+                L += throughput * medium.radiance * light.radiance *
                      emission_weight(scene, settings.light_sampling, light, hit, ray.d, history);
             }
             if (bounce >= settings.max_depth) break;
@@ -250,12 +256,13 @@ struct Tracer {
                 Color direct;
                 if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, direct) &&
                     visible(shadow))
-                    L += throughput * direct;
+                    L += throughput * medium.radiance * direct;
             }
 
             ScatterSample s;
             if (!sample_material(m, sp, ray.d, u.lobe, u.bsdf, s)) break;
             throughput *= s.weight;
+            if (s.transmitted) medium.cross(m, sp.front);
             history.full_emission = settings.integrator == Integrator::pt_naive || !s.smooth;
             history.last_bsdf_pdf = s.pdf;
             history.last_p = hit.p;
