@@ -38,6 +38,14 @@ SceneError::SceneError(std::string file, std::string json_path, std::string mess
       json_path_(std::move(json_path)),
       message_(std::move(message)) {}
 
+// A JSON string literal of user text, cut at kMaxQuotedLength characters; the replace
+// handler keeps a message from throwing on bad UTF-8.
+std::string in_quotes(std::string_view s) {
+    std::string text(s);
+    if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
+    return nlohmann::json(text).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 namespace {
 
 // ordered_json keeps keys in document order, so "the first error" is the first in the file.
@@ -47,7 +55,6 @@ constexpr int kMaxNesting = 64;
 constexpr double kMaxDimension = 32768;
 constexpr double kMaxSamples = 1 << 24;
 constexpr size_t kMaxListedIds = 10;
-constexpr size_t kMaxQuotedLength = 40;
 
 // ---------------------------------------------------------------------------------------
 // Small formatting helpers
@@ -65,13 +72,6 @@ std::string child(const std::string& pointer, std::string_view key) {
 
 std::string child(const std::string& pointer, size_t index) {
     return pointer + '/' + std::to_string(index);
-}
-
-// A JSON string literal; the replace handler keeps a message from throwing on bad UTF-8.
-std::string in_quotes(std::string_view s) {
-    std::string text(s);
-    if (text.size() > kMaxQuotedLength) text = text.substr(0, kMaxQuotedLength) + "...";
-    return Json(text).dump(-1, ' ', false, Json::error_handler_t::replace);
 }
 
 // "a", "b", "c": the form used for lists of keys and ids.

@@ -24,6 +24,10 @@ private:
     std::string file_, json_path_, message_;
 };
 
+// User text (an id) as a JSON string literal for a message, cut at 40 characters.
+inline constexpr size_t kMaxQuotedLength = 40;
+std::string in_quotes(std::string_view s);
+
 struct LoadedScene {
     Scene scene;
     // Non-fatal findings, each formatted like a SceneError message
