@@ -308,8 +308,9 @@ test::SceneBuilder scaled_room(double scale, int balls) {
     return b;
 }
 
-Image render_image(const RenderScene& scene, int spp) {
+Image render_image(const RenderScene& scene, int spp, Integrator integrator = Integrator::pt) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.integrator = integrator;
     settings.target_spp = spp;
     RenderState state(scene.renderer.width, scene.renderer.height);
     for (int i = 0; i < spp; ++i) render_pass(scene, settings, state);
@@ -348,8 +349,17 @@ double total_luminance(const Image& image) {
 // At every scale the default BVH gives the plain path's image (Embree's bit for bit, ours to
 // its rounding), and that is the scale-1 image: the rules of Ray are scale-free.
 TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
-    const Image unit = render_image(scaled_room(1, 34).build(), 2);
+    const RenderScene unit_scene = scaled_room(1, 34).build();
+    const Image unit = render_image(unit_scene, 2), unit_wrt = render_image(unit_scene, 1, Integrator::wrt);
     ASSERT_GT(total_luminance(unit), 0.0);
+    ASSERT_GT(total_luminance(unit_wrt), 0.0);
+    Ray centre;
+    centre.o = unit_scene.camera.position;
+    centre.d = normalize(Vec3{0, 0, 0} - centre.o);
+    Sampler unit_sampler(Rng::for_sample(1, 0, 0));
+    const double unit_depth =
+        trace_sample(unit_scene, RenderSettings::from_scene(unit_scene.renderer), centre, unit_sampler).primary_distance;
+    ASSERT_GT(unit_depth, 0.0);
     for (double scale : {1e-100, 1e-40, 1e-30, 1e-20, 1e-6, 1.0, 1e6, 1e17, 1e18, 1e20, 1e30, 1e100}) {
         const RenderScene automatic = scaled_room(scale, 34).build();
         RenderScene plain = automatic;
@@ -364,6 +374,15 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
         if (automatic.bvh.backend() == AccelBackend::embree) EXPECT_TRUE(same_image(a, p)) << where;
         EXPECT_LE(largest_relative_difference(a, p), 1e-9) << where;
         EXPECT_LE(largest_relative_difference(a, unit), 1e-9) << where;
+        // WRT too, and the depth of the first hits (primary_distance) scales with the scene.
+        EXPECT_LE(largest_relative_difference(render_image(automatic, 1, Integrator::wrt), unit_wrt), 1e-9) << where;
+        Ray centre;
+        centre.o = automatic.camera.position;
+        centre.d = normalize(Vec3{0, 0, 0} - centre.o);
+        Sampler sampler(Rng::for_sample(1, 0, 0));
+        const double depth = trace_sample(automatic, RenderSettings::from_scene(automatic.renderer), centre, sampler)
+                                 .primary_distance;
+        EXPECT_NEAR(depth / scale, unit_depth, 1e-9 * unit_depth) << where;
     }
 }
 

@@ -288,6 +288,22 @@ TEST(Dielectric, LightInsideGlassShowsRadianceOverEtaSquared) {
     EXPECT_NEAR(estimate(translucent.build(), settings_for(Integrator::wrt), axis, 1).mean.x, on_axis, 1e-12);
     const Estimate e = estimate(translucent.build(), settings_for(Integrator::pt), axis, 20000);
     EXPECT_NEAR(e.mean.x, on_axis, 5 * e.stderr_lum);
+
+    // The other way: a camera inside the glass ball (at its centre) sees the furnace's
+    // radiance Le outside it as eta^2 Le. Every path leaves through the ball's wall at normal
+    // incidence sooner or later (reflected ones cross the centre to the opposite side), so
+    // WRT sums eta^2 Le (1 - F) F^k up to the depth: eta^2 Le (1 - F^depth).
+    test::SceneBuilder inside = furnace(MaterialType::dielectric, Color(1), le);
+    inside.scene.materials[0].eta = eta;
+    const RenderScene camera_in_glass = inside.build();
+    const Ray out = ray_towards({0, 0, 0}, {0.3, 0.2, 1});
+    const double f = fresnel_dielectric(1, eta);
+    EXPECT_NEAR(estimate(camera_in_glass, settings_for(Integrator::wrt, LightSampling::cone, 20), out, 1).mean.x,
+                eta * eta * le * (1 - std::pow(f, 20)), 1e-9);
+    for (Integrator integrator : {Integrator::pt, Integrator::pt_naive}) {
+        const Estimate seen = estimate(camera_in_glass, settings_for(integrator, LightSampling::cone, 20), out, 2000);
+        EXPECT_NEAR(seen.mean.x, eta * eta * le, 5 * seen.stderr_lum + 1e-9 * le) << integrator_names.name(integrator);
+    }
 }
 
 // The same through the progressive renderer, whose paths run in SIMD lanes where the CPU has
