@@ -138,6 +138,7 @@ struct Tracer {
     const RenderSettings& settings;
     Sampler& sampler;
     uint64_t rays = 0;
+    MediumScale medium;  // WRT: the dielectrics the current ray has crossed
 
     bool intersect(const Ray& ray, Hit& hit) {
         ++rays;
@@ -168,15 +169,15 @@ struct Tracer {
     }
 
     // ---- Whitted-style ray tracing: L D S* E, recursive. ----
-    // `event` counts scattering events; the camera ray's hit is event 1. `medium`: the
-    // dielectrics the ray has crossed, whose radiance scale the light gathered here takes.
-    Color whitted(const Ray& ray, int event, double* primary_distance, MediumScale medium = {}) {
+    // `event` counts scattering events; the camera ray's hit is event 1. The light gathered
+    // here takes the radiance scale of the dielectrics the ray has crossed (`medium`).
+    Color whitted(const Ray& ray, int event, double* primary_distance) {
         Hit hit;
         if (!intersect(ray, hit)) return {};  // nothing hit: black
         if (primary_distance) *primary_distance = hit.t;
         Color L;
         const int light_index = scene.sphere_light[hit.sphere];
-        if (light_index >= 0) L += scene.area_lights[light_index].radiance * medium.radiance;
+        if (light_index >= 0) L += medium.seen(scene.area_lights[light_index].radiance);
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
@@ -184,18 +185,18 @@ struct Tracer {
             case MaterialType::diffuse:
                 // Every point light exactly; every area light with one sample (distributed RT).
                 for (const PointLight& light : scene.point_lights)
-                    L += point_light_now(light, m, hit, sp) * medium.radiance;
+                    L += medium.seen(point_light_now(light, m, hit, sp));
                 for (const AreaLight& light : scene.area_lights)
-                    L += area_light_now(light, m, hit, sp, sampler.next_2d()) * medium.radiance;
+                    L += medium.seen(area_light_now(light, m, hit, sp, sampler.next_2d()));
                 break;
             case MaterialType::specular:
-                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr, medium);
+                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
                 break;
             case MaterialType::glossy: {
                 ScatterSample s;
                 const double u_lobe = sampler.next_1d();
                 if (sample_material(m, sp, ray.d, u_lobe, sampler.next_2d(), s))
-                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr, medium);
+                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
                 break;
             }
             case MaterialType::dielectric:
@@ -207,14 +208,15 @@ struct Tracer {
                 const Vec2 u_reflect = sampler.next_2d(), u_transmit = sampler.next_2d();
                 Vec3 dir = perturb_direction(split.reflected, beta, u_reflect.x, u_reflect.y);
                 if (dot(dir, ns) > 0)
-                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr, medium);
+                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
                 if (split.reflectance < 1) {
                     dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
-                    MediumScale beyond = medium;
-                    beyond.cross(m, sp.front);
-                    if (dot(dir, ns) < 0)
-                        L += ((1 - split.reflectance) * m.rho_t) *
-                             whitted(spawn(hit, dir), event + 1, nullptr, beyond);
+                    if (dot(dir, ns) < 0) {
+                        const MediumScale here = medium;
+                        medium.cross(m, sp.front);
+                        L += ((1 - split.reflectance) * m.rho_t) * whitted(spawn(hit, dir), event + 1, nullptr);
+                        medium = here;
+                    }
                 }
                 break;
             }
@@ -225,7 +227,7 @@ struct Tracer {
     // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
     Color path(Ray ray, double* primary_distance) {
         Color L, throughput(1.0);  // without the dielectrics' radiance scale (medium)
-        MediumScale medium;
+        medium = {};
         PathHistory history;
         for (int bounce = 0;; ++bounce) {
             Hit hit;
@@ -236,7 +238,7 @@ struct Tracer {
             const int light_index = scene.sphere_light[hit.sphere];
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
-                L += throughput * medium.radiance * light.radiance *
+                L += medium.seen(throughput) * light.radiance *
                      emission_weight(scene, settings.light_sampling, light, hit, ray.d, history);
             }
             if (bounce >= settings.max_depth) break;
@@ -256,7 +258,7 @@ struct Tracer {
                 Color direct;
                 if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, direct) &&
                     visible(shadow))
-                    L += throughput * medium.radiance * direct;
+                    L += medium.seen(throughput) * direct;
             }
 
             ScatterSample s;
@@ -284,7 +286,7 @@ struct Tracer {
 
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
                           Sampler& sampler) {
-    Tracer tracer{scene, settings, sampler};
+    Tracer tracer{scene, settings, sampler, 0, {}};
     SampleResult result;
     result.radiance = settings.integrator == Integrator::wrt ? tracer.whitted(ray, 1, &result.primary_distance)
                                                              : tracer.path(ray, &result.primary_distance);
