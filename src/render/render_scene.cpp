@@ -151,7 +151,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
             std::string message = "primitive " + in_quotes(prim.id) + " (shape " + in_quotes(shape.id) +
                                   ") is the same sphere as primitive " + in_quotes(first.id) + " (shape " +
                                   in_quotes(scene.shapes[first.shape].id) + "); rendered once, as the first";
-            if (!same_material) message += "; its material " + in_quotes(scene.materials[prim.material].id) + " is unused";
+            if (!same_material) message += "; its material " + in_quotes(scene.materials[prim.material].id) + " is left out";
             if (!same_light)
                 message += prim.type == PrimitiveType::emissive
                                ? "; its light " + in_quotes(scene.lights[prim.light].id) + " does not emit"
