@@ -1323,11 +1323,12 @@ size_t occurrences(const std::string& text, const std::string& what) {
 // warning naming both primitives: the image is the one-sphere image byte for byte.
 TEST_F(TempDir, CoincidentSpheresRenderAsOne) {
     const fs::path one = write("one.json", copied_ball_json(0)), two = write("two.json", copied_ball_json(1));
-    test::CommandResult r = cli("render '" + one.string() + "' --seed 3 -o one.ppm -q");
+    test::CommandResult r = cli("render '" + one.string() + "' --seed 3 -o '" + (dir / "one.ppm").string() + "' -q");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.err, "");
-    r = cli("render '" + two.string() + "' --seed 3 -o two.ppm -q");
+    r = cli("render '" + two.string() + "' --seed 3 -o '" + (dir / "two.ppm").string() + "' -q");
     ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(fs::exists(dir / "one.ppm"));
     EXPECT_EQ(test::read_file(dir / "one.ppm"), test::read_file(dir / "two.ppm"));
     EXPECT_EQ(occurrences(r.err, "\n"), 1u) << r.err;  // one line
     EXPECT_EQ(occurrences(r.err, "warning: "), 1u) << r.err;
