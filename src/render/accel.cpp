@@ -323,6 +323,12 @@ bool embree_available() {
 #endif
 }
 
+bool embree_fits(const std::vector<SphereGeom>& spheres) {
+    double extent = 0;
+    for (const SphereGeom& s : spheres) extent = std::max(extent, length(s.centre) + s.radius);
+    return extent >= kEmbreeExtentMin && extent <= kEmbreeExtentMax;
+}
+
 void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backend) {
     static std::atomic<uint64_t> builds{0};
     build_id_ = ++builds;
@@ -337,7 +343,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
         embree_ = build_embree_spheres(spheres);
         return;
     }
-    if (backend == AccelBackend::automatic && spheres.size() >= kEmbreeFromSpheres) {
+    if (backend == AccelBackend::automatic && spheres.size() >= kEmbreeFromSpheres && embree_fits(spheres)) {
         // Embree is only the faster choice here: where it fails (no device on this CPU, or
         // its build runs out of memory), our own tree takes the scene.
         try {

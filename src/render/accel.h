@@ -24,11 +24,18 @@ struct EmbreeSpheres;  // accel_embree.cpp
 // embree:    Embree's BVH over user geometry whose intersection callbacks are our double-
 //            precision sphere tests: the faster one for large scenes (ray casting alone 1.4x
 //            at 1,000 to 100,000 spheres, whole renders 1.13x to 1.23x; docs/performance.md).
-// automatic: embree for more than 32 spheres where the build has Embree, else own.
+// automatic: embree for more than 32 spheres where the build has Embree and the spheres fit
+//            its single precision (embree_fits), else own.
 enum class AccelBackend { automatic, own, embree };
 inline constexpr EnumNames<AccelBackend, 3> accel_backend_names{{"auto", "own", "embree"}};
 // Whether this build can cast rays with Embree.
 bool embree_available();
+// Whether Embree's single-precision boxes and rays can hold these spheres: every sphere within
+// 2^-50 to 2^50 of the origin at its farthest (kEmbreeExtentMin/Max). Outside that range
+// Embree's float coordinates leave its valid range (1.8e18) or go denormal, and its box areas
+// (squares) overflow or vanish; automatic then builds our double-precision BVH instead.
+inline constexpr double kEmbreeExtentMin = 0x1.0p-50, kEmbreeExtentMax = 0x1.0p50;
+bool embree_fits(const std::vector<SphereGeom>& spheres);
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -97,13 +98,23 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
     }
 }
 
-// Embree's single-precision copy of `ray`. A ray from far outside the spheres' extent starts
-// where it could first meet one (no sphere point is nearer the origin than `extent`, and the
-// ray's point at t is at least |o| - t from it), so that its float origin stays as accurate
-// as the boxes' padding assumes.
-void embree_ray(const EmbreeSpheres& a, const Ray& ray, QueryContext& q, RTCRay& out) {
+// Embree's single-precision copy of `ray`, or false when the ray cannot meet any sphere. A ray
+// from outside the spheres' extent starts where it could first meet one (no sphere point is
+// nearer the origin than `extent`, and the ray's point at t is at least |o| - t from it), so
+// that its float origin stays as accurate as the boxes' padding assumes. A ray that meets the
+// extent's ball has its shifted origin within sqrt(2) extents of the origin (between the
+// origin and the line's nearest point to the centre); the others miss, and go no further:
+// their shifted origins could leave Embree's valid range (camera 1e30 away, looking away).
+bool embree_ray(const EmbreeSpheres& a, const Ray& ray, QueryContext& q, RTCRay& out) {
     const double origin_distance = length(ray.o);
     q.shift = std::max(0.0, origin_distance - a.extent);
+    if (q.shift > 0) {
+        const double along = dot(ray.o, ray.d);  // d is unit: the ray nears the origin while along < 0
+        const Vec3 nearest = ray.o - along * ray.d;
+        // The nearest point rounds by a few ulps of |o|: only lines clearly outside are culled.
+        const double reach = a.extent * (1 + 0x1.0p-20) + 0x1.0p-48 * origin_distance;
+        if (along >= 0 || dot(nearest, nearest) > reach * reach) return false;
+    }
     const Vec3 o = ray.o + q.shift * ray.d;
     out.org_x = float(o.x);
     out.org_y = float(o.y);
@@ -117,6 +128,7 @@ void embree_ray(const EmbreeSpheres& a, const Ray& ray, QueryContext& q, RTCRay&
     out.mask = ~0u;
     out.id = 0;
     out.flags = 0;
+    return true;
 }
 
 }  // namespace
@@ -125,11 +137,15 @@ std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<Sphe
     auto a = std::make_shared<EmbreeSpheres>();
     a->spheres = spheres;
     for (const SphereGeom& s : spheres) a->extent = std::max(a->extent, length(s.centre) + s.radius);
-    // Three times the extent (a shifted ray's origin) must be a finite float, with room.
-    if (!(a->extent < 1e36))
-        throw std::runtime_error("Embree: spheres reach " + std::to_string(a->extent) +
-                                 " from the origin, beyond its single-precision boxes");
-    // Float rounding of the ray (shifted within 3 extents of the origin, see embree_ray) and
+    if (!(a->extent >= kEmbreeExtentMin && a->extent <= kEmbreeExtentMax)) {
+        char message[160];
+        std::snprintf(message, sizeof message,
+                      "Embree: spheres reach %.3g from the origin, outside the %.3g to %.3g its single-precision "
+                      "boxes hold",
+                      a->extent, kEmbreeExtentMin, kEmbreeExtentMax);
+        throw std::runtime_error(message);
+    }
+    // Float rounding of the ray (shifted within 1.5 extents of the origin, see embree_ray) and
     // of Embree's slab tests moves a box test by under 2^-20 of the extent; the pad is four
     // times that.
     a->pad = float(std::ldexp(a->extent, -18));
@@ -159,9 +175,8 @@ int embree_closest(const EmbreeSpheres& accel, const Ray& ray, double& t) {
     q.accel = &accel;
     q.ray = ray;
     RTCRayHit rh;
-    embree_ray(accel, ray, q, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(accel.scene, &q.base, &rh);
+    if (embree_ray(accel, ray, q, rh.ray)) rtcIntersect1(accel.scene, &q.base, &rh);
     t = q.best >= 0 ? q.ray.tmax : ray.tmax;
     return q.best;
 }
@@ -172,8 +187,7 @@ bool embree_any(const EmbreeSpheres& accel, const Ray& ray) {
     q.accel = &accel;
     q.ray = ray;
     RTCRay r;
-    embree_ray(accel, ray, q, r);
-    rtcOccluded1(accel.scene, &q.base, &r);
+    if (embree_ray(accel, ray, q, r)) rtcOccluded1(accel.scene, &q.base, &r);
     return q.best >= 0;
 }
 

@@ -138,6 +138,7 @@ struct Tracer {
     const RenderSettings& settings;
     Sampler& sampler;
     uint64_t rays = 0;
+    MediumScale medium;  // WRT: the dielectrics the current ray has crossed
 
     bool intersect(const Ray& ray, Hit& hit) {
         ++rays;
@@ -168,22 +169,25 @@ struct Tracer {
     }
 
     // ---- Whitted-style ray tracing: L D S* E, recursive. ----
-    // `event` counts scattering events; the camera ray's hit is event 1.
+    // `event` counts scattering events; the camera ray's hit is event 1. The light gathered
+    // here takes the radiance scale of the dielectrics the ray has crossed (`medium`).
     Color whitted(const Ray& ray, int event, double* primary_distance) {
         Hit hit;
         if (!intersect(ray, hit)) return {};  // nothing hit: black
         if (primary_distance) *primary_distance = hit.t;
         Color L;
         const int light_index = scene.sphere_light[hit.sphere];
-        if (light_index >= 0) L += scene.area_lights[light_index].radiance;
+        if (light_index >= 0) L += medium.seen(scene.area_lights[light_index].radiance);
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         switch (m.type) {
             case MaterialType::diffuse:
                 // Every point light exactly; every area light with one sample (distributed RT).
-                for (const PointLight& light : scene.point_lights) L += point_light_now(light, m, hit, sp);
-                for (const AreaLight& light : scene.area_lights) L += area_light_now(light, m, hit, sp, sampler.next_2d());
+                for (const PointLight& light : scene.point_lights)
+                    L += medium.seen(point_light_now(light, m, hit, sp));
+                for (const AreaLight& light : scene.area_lights)
+                    L += medium.seen(area_light_now(light, m, hit, sp, sampler.next_2d()));
                 break;
             case MaterialType::specular:
                 L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
@@ -207,9 +211,12 @@ struct Tracer {
                     L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
                 if (split.reflectance < 1) {
                     dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
-                    if (dot(dir, ns) < 0)
-                        L += ((1 - split.reflectance) * m.rho_t) *
-                             whitted(spawn(hit, dir), event + 1, nullptr);
+                    if (dot(dir, ns) < 0) {
+                        const MediumScale here = medium;
+                        medium.cross(m, sp.front);
+                        L += ((1 - split.reflectance) * m.rho_t) * whitted(spawn(hit, dir), event + 1, nullptr);
+                        medium = here;
+                    }
                 }
                 break;
             }
@@ -219,7 +226,8 @@ struct Tracer {
 
     // ---- Path tracing: L (D|S)* E, iterative, with next-event estimation and MIS. ----
     Color path(Ray ray, double* primary_distance) {
-        Color L, throughput(1.0);
+        Color L, throughput(1.0);  // without the dielectrics' radiance scale (medium)
+        medium = {};
         PathHistory history;
         for (int bounce = 0;; ++bounce) {
             Hit hit;
@@ -230,7 +238,7 @@ struct Tracer {
             const int light_index = scene.sphere_light[hit.sphere];
             if (light_index >= 0) {
                 const AreaLight& light = scene.area_lights[light_index];
-                L += throughput * light.radiance *
+                L += medium.seen(throughput) * light.radiance *
                      emission_weight(scene, settings.light_sampling, light, hit, ray.d, history);
             }
             if (bounce >= settings.max_depth) break;
@@ -250,12 +258,13 @@ struct Tracer {
                 Color direct;
                 if (sample_one_light(scene, settings, m, hit, sp, u.light_pick, u.light, shadow, direct) &&
                     visible(shadow))
-                    L += throughput * direct;
+                    L += medium.seen(throughput) * direct;
             }
 
             ScatterSample s;
             if (!sample_material(m, sp, ray.d, u.lobe, u.bsdf, s)) break;
             throughput *= s.weight;
+            if (s.transmitted) medium.cross(m, sp.front);
             history.full_emission = settings.integrator == Integrator::pt_naive || !s.smooth;
             history.last_bsdf_pdf = s.pdf;
             history.last_p = hit.p;
@@ -277,7 +286,7 @@ struct Tracer {
 
 SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
                           Sampler& sampler) {
-    Tracer tracer{scene, settings, sampler};
+    Tracer tracer{scene, settings, sampler, 0, {}};
     SampleResult result;
     result.radiance = settings.integrator == Integrator::wrt ? tracer.whitted(ray, 1, &result.primary_distance)
                                                              : tracer.path(ray, &result.primary_distance);

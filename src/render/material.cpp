@@ -30,6 +30,7 @@ DielectricSplit split_dielectric(const Material& m, const SurfacePoint& sp, cons
 bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, double u_lobe,
                      Vec2 u, ScatterSample& out) {
     const Vec3 ns = sp.ns();
+    out.transmitted = false;
     switch (m.type) {
         case MaterialType::diffuse: {
             const Vec3 local = sample_cosine_hemisphere(u.x, u.y);
@@ -66,6 +67,7 @@ bool sample_material(const Material& m, const SurfacePoint& sp, const Vec3& wi, 
             }
             out.direction = perturb_direction(split.transmitted, beta, u.x, u.y);
             out.weight = m.rho_t;
+            out.transmitted = true;
             return dot(out.direction, ns) < 0;
         }
     }

@@ -21,6 +21,26 @@ struct ScatterSample {
     double pdf = 0;      // solid-angle density, for smooth lobes that also get light samples
     bool smooth = false; // true: a density the light sampler can match (MIS); false: a delta or
                          // a lobe sampled only through its own distribution (no light samples)
+    bool transmitted = false;  // crossed a dielectric's surface (see MediumScale)
+};
+
+// Radiance crossing a refractive interface scales by (eta_i / eta_t)^2 (pbrt's radiance
+// transport): radiance inside glass of index eta is eta^2 times that outside for the same
+// flux. A camera path keeps its throughput free of that factor (so Russian roulette decides
+// as without it, pbrt's etaScale) and scales only the light it gathers: by (eta of the camera's
+// medium / eta of the medium it is in)^2. `eta` is that ratio's inverse, kept as a product of
+// the materials' etas so that entering and leaving one dielectric gives exactly 1 again.
+struct MediumScale {
+    double eta = 1;       // index of the path's medium relative to the camera's
+    double radiance = 1;  // 1 / eta^2: what gathered light is multiplied by
+    // After a transmission through material `m` (`entering`: from outside its sphere).
+    void cross(const Material& m, bool entering) {
+        eta = entering ? eta * m.eta : eta / m.eta;
+        radiance = 1.0 / (eta * eta);
+    }
+    // Light gathered in this medium as the camera sees it. Most paths never enter a
+    // dielectric: the test costs less than the multiply it skips (measured, WRT).
+    Color seen(const Color& c) const { return radiance == 1 ? c : c * radiance; }
 };
 
 // Only the diffuse lobe is evaluated for next-event estimation; the others are

@@ -125,6 +125,9 @@ bool float_lanes_fit(const RenderScene& scene) {
         smallest_radius = std::min(smallest_radius, s.radius);
     }
     if (!(std::isfinite(largest) && smallest_radius > 0 && largest <= 0x1.0p12 * smallest_radius)) return false;
+    // Absolute range: the lanes square distances and radii, which must stay normal floats
+    // (2^-126..2^128) with room for the products they enter; lengths of 2^-40..2^40 do.
+    if (!(smallest_radius >= 0x1.0p-40 && largest <= 0x1.0p40)) return false;
     // Light: every nonzero radiance and intensity within 2^-60..2^60, which leaves single
     // precision's range (2^-126..2^128) room for the factors a light sample multiplies in.
     const auto in_range = [](const Color& c) {

@@ -202,8 +202,9 @@ inline constexpr EnumNames<PacketKernels, 4> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
-// distance a sphere test meets, stays below 2^-12 of the smallest radius, and its lights'
-// radiance stays far inside their range (2^-60 to 2^60; a light of 1e30 is double's).
+// distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
+// within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
+// inside their range (2^-60 to 2^60; a light of 1e30 is double's).
 bool float_lanes_fit(const RenderScene& scene);
 
 }  // namespace kr

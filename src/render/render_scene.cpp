@@ -1,5 +1,7 @@
 #include "render/render_scene.h"
 
+#include <array>
+#include <map>
 #include <stdexcept>
 
 #include "core/text.h"
@@ -120,21 +122,46 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
     std::vector<bool> active(scene.lights.size(), false);
     for (int l : scene.active_lights) active[size_t(l)] = true;
 
-    // One sphere per distinct shape: a repeated primitive would only hit itself again.
+    // One sphere per distinct shape: a repeated primitive would only hit itself again. The
+    // same holds for two shapes of exactly the same centre and radius (a copy under another
+    // id): coincident surfaces would shadow each other at random, so the first primitive
+    // renders the sphere and a later one is left out, with a warning naming both.
     std::vector<int> shape_sphere(scene.shapes.size(), -1);
+    std::map<std::array<double, 4>, int> geometry_sphere;  // exact centre and radius -> sphere
+    std::vector<size_t> sphere_primitive;                  // per sphere: the primitive it renders
     for (size_t i = 0; i < scene.primitives.size(); ++i) {
         const Primitive& prim = scene.primitives[i];
         const std::string path = "/scene/primitives/" + std::to_string(i);
+        const Shape& shape = scene.shapes[prim.shape];
+        if (shape_sphere[prim.shape] < 0) {
+            const auto [found, fresh] = geometry_sphere.try_emplace(
+                {shape.centre.x, shape.centre.y, shape.centre.z, shape.radius}, static_cast<int>(rs.spheres.size()));
+            if (!fresh) shape_sphere[prim.shape] = found->second;
+        }
         if (shape_sphere[prim.shape] >= 0) {
             const int existing = shape_sphere[prim.shape];
-            if (rs.materials[rs.sphere_material[existing]].id != scene.materials[prim.material].id ||
-                (prim.type == PrimitiveType::emissive) != (rs.sphere_light[existing] >= 0))
-                warn(path, "shape " + quote_user_text(scene.shapes[prim.shape].id) +
-                               " is already used by an earlier primitive; this one is ignored");
+            const Primitive& first = scene.primitives[sphere_primitive[size_t(existing)]];
+            const bool same_material = rs.materials[rs.sphere_material[existing]].id == scene.materials[prim.material].id;
+            const bool same_light = (prim.type == PrimitiveType::emissive) == (rs.sphere_light[existing] >= 0) &&
+                                    prim.light == first.light;
+            if (first.shape == prim.shape) {
+                if (!same_material || !same_light)
+                    warn(path, "shape " + in_quotes(shape.id) + " is already used by an earlier primitive; this one is ignored");
+                continue;
+            }
+            std::string message = "primitive " + in_quotes(prim.id) + " (shape " + in_quotes(shape.id) +
+                                  ") is the same sphere as primitive " + in_quotes(first.id) + " (shape " +
+                                  in_quotes(scene.shapes[first.shape].id) + "); rendered once, as the first";
+            if (!same_material) message += "; its material " + in_quotes(scene.materials[prim.material].id) + " is left out";
+            if (!same_light)
+                message += prim.type == PrimitiveType::emissive
+                               ? "; its light " + in_quotes(scene.lights[prim.light].id) + " does not emit"
+                               : "; the first one's light emits";
+            warn(path, message);
             continue;
         }
-        const Shape& shape = scene.shapes[prim.shape];
         shape_sphere[prim.shape] = static_cast<int>(rs.spheres.size());
+        sphere_primitive.push_back(i);
         rs.spheres.push_back({shape.centre, shape.radius});
         rs.sphere_material.push_back(use_material(prim.material));
         int light_index = -1;

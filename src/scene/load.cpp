@@ -44,6 +44,9 @@ SceneError::SceneError(std::string file, std::string json_path, std::string mess
       json_path_(std::move(json_path)),
       message_(std::move(message)) {}
 
+// User text in a message: quoted, escaped and bounded (core/text.h).
+std::string in_quotes(std::string_view s) { return quote_user_text(s); }
+
 namespace {
 
 // ordered_json keeps keys in document order, so "the first error" is the first in the file.
@@ -69,9 +72,6 @@ std::string child(const std::string& pointer, std::string_view key) {
 std::string child(const std::string& pointer, size_t index) {
     return pointer + '/' + std::to_string(index);
 }
-
-// User text in a message: quoted, escaped and bounded (core/text.h).
-std::string in_quotes(std::string_view s) { return quote_user_text(s); }
 
 // "a", "b", "c": the form used for lists of keys and ids.
 std::string quoted_list(const std::vector<std::string>& items) {

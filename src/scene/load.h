@@ -24,6 +24,9 @@ private:
     std::string file_, json_path_, message_;
 };
 
+// User text (an id, a key) for a message: quoted, escaped and bounded (core/text.h).
+std::string in_quotes(std::string_view s);
+
 struct LoadedScene {
     Scene scene;
     // Non-fatal findings, each formatted like a SceneError message
