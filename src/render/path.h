@@ -1,5 +1,6 @@
 // The steps of path tracing that the one-sample integrator (integrator.cpp) and the
-// four-lane one (packet.cpp) share, so that both trace the same paths.
+// lane-wise one (packet.cpp: eight float or four double lanes) share, so that both trace
+// the same paths.
 #pragma once
 
 #include "render/material.h"

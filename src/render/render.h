@@ -172,10 +172,11 @@ void camera_rays(const RenderScene& scene, int width, int height, const int* xs,
                  Sampler* const* samplers, int count, Ray* rays);
 
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
-// camera rays four paths at a time in SIMD lanes (packet.cpp), a lane starting the next sample
-// as its path ends, where the scene is one leaf of our BVH and packet_kernels() below has
-// lanes; anything else goes one by one through trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less
-// time lanes idle at the batch's end.
+// camera rays in SIMD lanes (packet.cpp: eight paths in single precision, or four in double,
+// as packet_kernels() below says), a lane starting the next sample as its path ends, where
+// the scene is one leaf of our BVH; anything else goes one by one through trace_sample.
+// render_pass hands it up to kSampleBatch samples: the more, the less time lanes idle at the
+// batch's end.
 inline constexpr int kSampleBatch = 64;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);

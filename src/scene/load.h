@@ -1,4 +1,5 @@
-// Strict scene loading from the JSON format described in SPEC.md.
+// Strict scene loading from the JSON format the README describes (the brief's format, with
+// the translucent material and the optional display block).
 #pragma once
 
 #include <filesystem>

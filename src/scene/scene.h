@@ -1,6 +1,6 @@
 // The authored scene: exactly what a scene file (and later the viewer) describes.
 // Objects refer to each other by index into the category vectors. The renderer never
-// reads this directly; render/prepare.h builds the render scene from it.
+// reads this directly; prepare_scene (render/render_scene.h) builds the render scene from it.
 #pragma once
 
 #include <array>
