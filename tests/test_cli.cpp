@@ -21,22 +21,8 @@ namespace {
 using CliRun = kr::test::CommandResult;
 using kr::test::read_file;
 
-class Cli : public testing::Test {
+class Cli : public kr::test::ScratchDirTest {
 protected:
-    fs::path dir;
-
-    void SetUp() override {
-        dir = fs::temp_directory_path() /
-              ("keithray_cli_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-
-    CliRun run(const std::string& args) {
-        return kr::test::run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
-    }
 
     // A small valid scene: a diffuse ball under a point light, 16x12 pixels.
     fs::path write_scene(const std::string& name, const std::string& material_type = "diffuse",
@@ -61,7 +47,7 @@ protected:
 }  // namespace
 
 TEST_F(Cli, HelpDocumentsEveryFlag) {
-    const CliRun r = run("--help");
+    const CliRun r = cli("--help");
     EXPECT_EQ(r.status, 0);
     for (const char* flag : {"render", "--spp", "--integrator", "wrt", "pt-naive", "--estimator", "uniform",
                              "stratified", "--tonemap", "sigmoid", "linear", "--blur", "--seed", "--threads", "-o",
@@ -71,7 +57,7 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
 
 TEST_F(Cli, RendersImageAndDepthBesideIt) {
     const fs::path scene = write_scene("ok.json");
-    const CliRun r = run("render '" + scene.string() + "' --spp 3 -o '" + (dir / "x.ppm").string() + "'");
+    const CliRun r = cli("render '" + scene.string() + "' --spp 3 -o '" + (dir / "x.ppm").string() + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     const kr::Rgb8Image img = kr::read_ppm(dir / "x.ppm");
     EXPECT_EQ(img.width, 16);
@@ -91,26 +77,26 @@ TEST_F(Cli, RendersImageAndDepthBesideIt) {
 TEST_F(Cli, PngOutputByNameAndPsnrReadsBothFormats) {
     const fs::path scene = write_scene("png.json");
     const std::string base = "render '" + scene.string() + "' --spp 2 -q -o '";
-    ASSERT_EQ(run(base + (dir / "x.ppm").string() + "'").status, 0);
-    const CliRun r = run(base + (dir / "x.PNG").string() + "'");
+    ASSERT_EQ(cli(base + (dir / "x.ppm").string() + "'").status, 0);
+    const CliRun r = cli(base + (dir / "x.PNG").string() + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     // A PNG by its signature, the depth map beside it too, and the same pixels as the PPM.
     EXPECT_EQ(read_file(dir / "x.PNG").substr(0, 8), std::string("\x89PNG\r\n\x1a\n"));
     EXPECT_EQ(read_file(dir / "x-depth.PNG").substr(0, 4), std::string("\x89PNG"));
-    const CliRun same = run("psnr '" + (dir / "x.ppm").string() + "' '" + (dir / "x.PNG").string() + "'");
+    const CliRun same = cli("psnr '" + (dir / "x.ppm").string() + "' '" + (dir / "x.PNG").string() + "'");
     EXPECT_EQ(same.status, 0) << same.err;
     EXPECT_EQ(same.out, "99.00\n");  // identical images
-    const CliRun depth = run("psnr '" + (dir / "x-depth.PNG").string() + "' '" + (dir / "x.ppm").string() + "'");
+    const CliRun depth = cli("psnr '" + (dir / "x-depth.PNG").string() + "' '" + (dir / "x.ppm").string() + "'");
     EXPECT_EQ(depth.status, 0) << depth.err;
     EXPECT_LT(std::stod(depth.out), 40.0);  // a different image
     // Images are told apart by content, not name: a PPM called .png still reads.
     fs::copy_file(dir / "x.ppm", dir / "ppm-inside.png");
-    const CliRun renamed = run("psnr '" + (dir / "ppm-inside.png").string() + "' '" + (dir / "x.PNG").string() + "'");
+    const CliRun renamed = cli("psnr '" + (dir / "ppm-inside.png").string() + "' '" + (dir / "x.PNG").string() + "'");
     EXPECT_EQ(renamed.status, 0) << renamed.err;
     EXPECT_EQ(renamed.out, "99.00\n");
     // A file that is neither: one message naming it, exit status 1.
     std::ofstream(dir / "bad.png") << "not an image";
-    const CliRun bad = run("psnr '" + (dir / "bad.png").string() + "' '" + (dir / "x.ppm").string() + "'");
+    const CliRun bad = cli("psnr '" + (dir / "bad.png").string() + "' '" + (dir / "x.ppm").string() + "'");
     EXPECT_EQ(bad.status, 1);
     EXPECT_NE(bad.err.find("bad.png"), std::string::npos) << bad.err;
     EXPECT_NE(bad.err.find("not a binary PPM (P6) or PNG"), std::string::npos) << bad.err;
@@ -118,7 +104,7 @@ TEST_F(Cli, PngOutputByNameAndPsnrReadsBothFormats) {
 
 TEST_F(Cli, OutputIsRelativeToTheSceneFolder) {
     const fs::path scene = write_scene("rel.json");
-    const CliRun r = run("render '" + scene.string() + "' -q");
+    const CliRun r = cli("render '" + scene.string() + "' -q");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir / "out" / "render.ppm"));
     EXPECT_TRUE(fs::exists(dir / "out" / "render-depth.ppm"));
@@ -127,12 +113,12 @@ TEST_F(Cli, OutputIsRelativeToTheSceneFolder) {
 TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
     const fs::path scene = write_scene("seed.json");
     const std::string base = "render '" + scene.string() + "' --integrator pt --spp 4 --threads ";
-    ASSERT_EQ(run(base + "1 -o '" + (dir / "a.ppm").string() + "'").status, 0);
-    ASSERT_EQ(run(base + "2 -o '" + (dir / "b.ppm").string() + "'").status, 0);
-    ASSERT_EQ(run(base + "2 --seed 7 -o '" + (dir / "c.ppm").string() + "'").status, 0);
+    ASSERT_EQ(cli(base + "1 -o '" + (dir / "a.ppm").string() + "'").status, 0);
+    ASSERT_EQ(cli(base + "2 -o '" + (dir / "b.ppm").string() + "'").status, 0);
+    ASSERT_EQ(cli(base + "2 --seed 7 -o '" + (dir / "c.ppm").string() + "'").status, 0);
     EXPECT_EQ(read_file(dir / "a.ppm"), read_file(dir / "b.ppm"));
     EXPECT_NE(read_file(dir / "a.ppm"), read_file(dir / "c.ppm"));
-    const CliRun linear = run(base + "2 --tonemap linear --blur 1 --estimator uniform -o '" + (dir / "d.ppm").string() + "'");
+    const CliRun linear = cli(base + "2 --tonemap linear --blur 1 --estimator uniform -o '" + (dir / "d.ppm").string() + "'");
     EXPECT_EQ(linear.status, 0) << linear.err;
     // Linear tone mapping scales the brightest channel to 255.
     const kr::Rgb8Image d = kr::read_ppm(dir / "d.ppm");
@@ -141,7 +127,7 @@ TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
 
 TEST_F(Cli, BadSceneGivesOneMessageAndNoOutput) {
     const fs::path scene = write_scene("bad.json", "plastic");
-    const CliRun r = run("render '" + scene.string() + "' -o '" + (dir / "x.ppm").string() + "'");
+    const CliRun r = cli("render '" + scene.string() + "' -o '" + (dir / "x.ppm").string() + "'");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("/materials/0/type"), std::string::npos) << r.err;
@@ -152,25 +138,25 @@ TEST_F(Cli, BadSceneGivesOneMessageAndNoOutput) {
 }
 
 TEST_F(Cli, MissingFileAndBadFlags) {
-    CliRun r = run("render '" + (dir / "nope.json").string() + "'");
+    CliRun r = cli("render '" + (dir / "nope.json").string() + "'");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("nope.json"), std::string::npos);
     EXPECT_NE(r.err.find("cannot open"), std::string::npos);
-    r = run("render --spp 0");
+    r = cli("render --spp 0");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--spp"), std::string::npos);
-    r = run("render --integrator magic");
+    r = cli("render --integrator magic");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("\"pt-naive\""), std::string::npos);
-    r = run("render --frobnicate");
+    r = cli("render --frobnicate");
     EXPECT_EQ(r.status, 2);
-    r = run("paint");
+    r = cli("paint");
     EXPECT_EQ(r.status, 2);
 }
 
 TEST_F(Cli, DepthAbove20IsClampedWithAWarning) {
     const fs::path scene = write_scene("deep.json", "diffuse", 25);
-    const CliRun r = run("render '" + scene.string() + "' -q");
+    const CliRun r = cli("render '" + scene.string() + "' -q");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("clamped to 20"), std::string::npos) << r.err;
 }
@@ -178,7 +164,7 @@ TEST_F(Cli, DepthAbove20IsClampedWithAWarning) {
 TEST_F(Cli, NeverOverwritesTheSceneFile) {
     const fs::path scene = write_scene("self.json");
     const std::string before = read_file(scene);
-    const CliRun r = run("render '" + scene.string() + "' -o '" + scene.string() + "'");
+    const CliRun r = cli("render '" + scene.string() + "' -o '" + scene.string() + "'");
     EXPECT_EQ(r.status, 1);
     EXPECT_NE(r.err.find("overwrite"), std::string::npos) << r.err;
     EXPECT_EQ(read_file(scene), before);
@@ -186,15 +172,15 @@ TEST_F(Cli, NeverOverwritesTheSceneFile) {
 
 TEST_F(Cli, StopRulesAndTheirErrors) {
     const fs::path scene = write_scene("scene.json");
-    CliRun r = run("render '" + scene.string() + "' --integrator pt --time 0.2 -o '" + (dir / "t.ppm").string() + "'");
+    CliRun r = cli("render '" + scene.string() + "' --integrator pt --time 0.2 -o '" + (dir / "t.ppm").string() + "'");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("stopped by --time"), std::string::npos) << r.err;
     EXPECT_TRUE(fs::exists(dir / "t.ppm"));
-    r = run("render '" + scene.string() + "' --integrator pt --noise 0.05 --spp 4096 -o '" + (dir / "n.ppm").string() + "'");
+    r = cli("render '" + scene.string() + "' --integrator pt --noise 0.05 --spp 4096 -o '" + (dir / "n.ppm").string() + "'");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.err.find("stopped by --noise"), std::string::npos) << r.err;
     for (const char* bad : {"--noise 0", "--noise -1", "--time abc", "--time"}) {
-        r = run("render '" + scene.string() + "' " + bad + " -o '" + (dir / "bad.ppm").string() + "'");
+        r = cli("render '" + scene.string() + "' " + bad + " -o '" + (dir / "bad.ppm").string() + "'");
         EXPECT_EQ(r.status, 2) << bad;
         EXPECT_FALSE(fs::exists(dir / "bad.ppm")) << bad;
     }
@@ -202,7 +188,7 @@ TEST_F(Cli, StopRulesAndTheirErrors) {
 
 TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     const fs::path scene = write_scene("scene.json");
-    CliRun r = run("bench --throughput '" + scene.string() + "' --runs 1 --fraction 1");
+    CliRun r = cli("bench --throughput '" + scene.string() + "' --runs 1 --fraction 1");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("| scene |"), std::string::npos);
     EXPECT_NE(r.out.find("Mrays/s"), std::string::npos);
@@ -212,37 +198,37 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     text.replace(text.find("\"WRT\""), 5, "\"PT\"");
     std::ofstream(dir / "pt.json") << text;
     const std::string pt = (dir / "pt.json").string();
-    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels any");
+    r = cli("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels any");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("| x86-64 lanes |"), std::string::npos) << r.out;  // never the v3 ones
     EXPECT_NE(r.out.find("--kernels any)"), std::string::npos) << r.out;
-    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels off");
+    r = cli("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels off");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("| one path |"), std::string::npos) << r.out;
-    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels double");
+    r = cli("bench --throughput '" + pt + "' --runs 1 --fraction 1 --kernels double");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out.find("float lanes"), std::string::npos) << r.out;
-    r = run("bench --throughput '" + pt + "' --runs 1 --fraction 1");
+    r = cli("bench --throughput '" + pt + "' --runs 1 --fraction 1");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out.find("| x86-64 lanes |"), std::string::npos) << r.out;
-    r = run("bench --throughput --kernels avx9");
+    r = cli("bench --throughput --kernels avx9");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("\"best\", \"double\", \"any\" or \"off\""), std::string::npos) << r.err;
-    r = run("bench --stress 20 --runs 1 --size 16");
+    r = cli("bench --stress 20 --runs 1 --size 16");
     EXPECT_EQ(r.status, 0) << r.err;
     // One row per BVH: ours, and Embree's where the build has it.
     EXPECT_NE(r.out.find("| 20 | own |"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("| 20 | embree |") != std::string::npos, kr::embree_available()) << r.out;
-    r = run("bench --stress 20 --runs 1 --size 16 --accel bogus");
+    r = cli("bench --stress 20 --runs 1 --size 16 --accel bogus");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--accel expects \"auto\", \"own\" or \"embree\""), std::string::npos) << r.err;
-    EXPECT_EQ(run("bench --throughput --accel own,embree").status, 2);  // one BVH at a time
-    EXPECT_EQ(run("bench --bogus").status, 2);
-    EXPECT_EQ(run("bench").status, 2);
+    EXPECT_EQ(cli("bench --throughput --accel own,embree").status, 2);  // one BVH at a time
+    EXPECT_EQ(cli("bench --bogus").status, 2);
+    EXPECT_EQ(cli("bench").status, 2);
     // --write-stress never overwrites.
-    EXPECT_EQ(run("bench --write-stress 5 '" + scene.string() + "'").status, 1);
-    EXPECT_EQ(run("bench --write-stress 5 '" + (dir / "s.json").string() + "'").status, 0);
-    r = run("render '" + (dir / "s.json").string() + "' --spp 1 -o '" + (dir / "s.ppm").string() + "'");
+    EXPECT_EQ(cli("bench --write-stress 5 '" + scene.string() + "'").status, 1);
+    EXPECT_EQ(cli("bench --write-stress 5 '" + (dir / "s.json").string() + "'").status, 0);
+    r = cli("render '" + (dir / "s.json").string() + "' --spp 1 -o '" + (dir / "s.ppm").string() + "'");
     EXPECT_EQ(r.status, 0) << r.err;
 }
 
@@ -251,7 +237,7 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
 TEST_F(Cli, BenchConvergenceWritesCsvPlotAndTable) {
     const fs::path scene = write_scene("conv.json");
     const fs::path out = dir / "bench";
-    CliRun r = run("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
+    CliRun r = cli("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
                    "wrt/area/uniform,wrt/area/sobol --out '" + out.string() + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     const std::string csv = read_file(out / "convergence.csv");
@@ -265,7 +251,7 @@ TEST_F(Cli, BenchConvergenceWritesCsvPlotAndTable) {
     EXPECT_EQ(png.substr(1, 3), "PNG");
     // The reference is cached: a second run renders none and gives the same errors at 4 spp.
     EXPECT_FALSE(fs::is_empty(out / "cache"));
-    r = run("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
+    r = cli("bench --convergence '" + scene.string() + "' --scale 1 --spp 4 --reference-factor 2 --configs " +
             "wrt/area/uniform,wrt/area/sobol --out '" + out.string() + "'");
     ASSERT_EQ(r.status, 0) << r.err;
     auto rows_at_4 = [](const std::string& text) {
@@ -281,8 +267,8 @@ TEST_F(Cli, BenchConvergenceWritesCsvPlotAndTable) {
     };
     EXPECT_EQ(rows_at_4(read_file(out / "convergence.csv")), rows_at_4(csv));
 
-    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --configs pt/cone").status, 2);
-    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --configs pt/lamp/sobol").status, 2);
-    EXPECT_EQ(run("bench --convergence '" + scene.string() + "' --scale 0").status, 2);
-    EXPECT_EQ(run("bench --convergence --help").status, 0);
+    EXPECT_EQ(cli("bench --convergence '" + scene.string() + "' --configs pt/cone").status, 2);
+    EXPECT_EQ(cli("bench --convergence '" + scene.string() + "' --configs pt/lamp/sobol").status, 2);
+    EXPECT_EQ(cli("bench --convergence '" + scene.string() + "' --scale 0").status, 2);
+    EXPECT_EQ(cli("bench --convergence --help").status, 0);
 }

@@ -382,19 +382,8 @@ TEST(HdrRender, ToneMappedExrRadianceEqualsTheEightBitImage) {
 
 namespace {
 
-class HdrCli : public testing::Test {
+class HdrCli : public test::ScratchDirTest {
 protected:
-    fs::path dir;
-
-    void SetUp() override {
-        dir = fs::temp_directory_path() /
-              ("keithray_hdr_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-
     test::CommandResult run(const std::string& args) {
         return test::run_command("cd '" + dir.string() + "' && '" + KEITHRAY_EXE + "' " + args, dir);
     }

@@ -58,25 +58,7 @@ std::string scene_with(const std::string& dims) {
     return s;
 }
 
-class Hostile : public ::testing::Test {
-protected:
-    fs::path dir;
-    void SetUp() override {
-        dir = fs::temp_directory_path() /
-              ("keithray_hostile_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-    fs::path write(const std::string& name, const std::string& text) {
-        std::ofstream(dir / name, std::ios::binary) << text;
-        return dir / name;
-    }
-    test::CommandResult cli(const std::string& args) {
-        return test::run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
-    }
-};
+class Hostile : public test::ScratchDirTest {};
 
 // Lines of a program's stderr that start with "error:".
 int error_lines(const std::string& err) {

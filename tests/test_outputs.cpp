@@ -28,31 +28,8 @@ using namespace kr;
 
 namespace {
 
-class Outputs : public testing::Test {
+class Outputs : public test::ScratchDirTest {
 protected:
-    fs::path dir;
-
-    void SetUp() override {
-        dir = fs::temp_directory_path() /
-              ("keithray_outputs_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        fs::permissions(dir, fs::perms::owner_all, fs::perm_options::add, ec);
-        fs::remove_all(dir);
-    }
-
-    fs::path write(const fs::path& name, const std::string& text) {
-        const fs::path file = dir / name;
-        std::ofstream(file, std::ios::binary) << text;
-        return file;
-    }
-    test::CommandResult cli(const std::string& args) {
-        return test::run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
-    }
     // A small valid scene whose output is `output` (JSON string text, escapes allowed).
     fs::path scene(const std::string& output = "out.ppm", const std::string& dims = "[16, 12]") {
         return write("scene.json", R"({

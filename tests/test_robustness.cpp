@@ -177,27 +177,7 @@ test::SceneBuilder room(double R) {
 using test::furnace;
 
 // A scratch folder per test.
-class TempDir : public ::testing::Test {
-protected:
-    fs::path dir;
-    void SetUp() override {
-        dir = fs::temp_directory_path() /
-              ("keithray_robust_" + std::string(testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-               std::to_string(::getpid()));
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    void TearDown() override { fs::remove_all(dir); }
-
-    fs::path write(const std::string& name, const std::string& text) {
-        const fs::path file = dir / name;
-        std::ofstream(file, std::ios::binary) << text;
-        return file;
-    }
-    test::CommandResult cli(const std::string& args) {
-        return test::run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
-    }
-};
+class TempDir : public test::ScratchDirTest {};
 
 // A valid scene file; `renderer` and `extra` let tests change one thing.
 std::string scene_json(const std::string& output = "out.ppm", const std::string& dims = "[16, 12]",

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -10,6 +11,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <gtest/gtest.h>
 
 #include "render/render.h"
 #include "render/render_scene.h"
@@ -37,6 +40,38 @@ inline CommandResult run_command(const std::string& command, const std::filesyst
     const int raw = std::system(cmd.c_str());
     return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
 }
+
+// A fixture with a scratch folder per test (named after the suite, the test and the process),
+// removed after it even where the test took its write permission away. `cli` runs the
+// keithray executable there, its output captured.
+class ScratchDirTest : public testing::Test {
+protected:
+    std::filesystem::path dir;
+
+    void SetUp() override {
+        const testing::TestInfo* info = testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = "keithray_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
+                           std::to_string(::getpid());
+        for (char& c : name)
+            if (c == '/') c = '_';
+        dir = std::filesystem::temp_directory_path() / name;
+        std::filesystem::remove_all(dir);
+        std::filesystem::create_directories(dir);
+    }
+    void TearDown() override {
+        std::error_code ec;
+        std::filesystem::permissions(dir, std::filesystem::perms::owner_all, std::filesystem::perm_options::add, ec);
+        std::filesystem::remove_all(dir, ec);
+    }
+    std::filesystem::path write(const std::filesystem::path& name, const std::string& text) {
+        const std::filesystem::path file = dir / name;
+        std::ofstream(file, std::ios::binary) << text;
+        return file;
+    }
+    CommandResult cli(const std::string& args) {
+        return run_command(std::string("'") + KEITHRAY_EXE + "' " + args, dir);
+    }
+};
 
 // The relative tolerance of a render's analytic value: the rounding of the single-precision
 // lanes where they trace the scene (packet_kernels), else double's.
