@@ -1238,14 +1238,6 @@ TEST_F(TempDir, SceneFileIsNeverOverwritten) {
         EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
 }
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-#define KR_TEST_SANITIZED 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
-#define KR_TEST_SANITIZED 1
-#endif
-#endif
-
 // Dimensions the loader accepts but memory cannot hold: a clear error naming the size, exit
 // status 1, nothing written (run under a 1 GiB address-space limit).
 TEST_F(TempDir, DimensionsTooLargeForMemory) {

@@ -19,6 +19,16 @@
 #include "scene/load.h"
 #include "scene/scene.h"
 
+// KR_TEST_SANITIZED: this build runs under a sanitizer, which reserves terabytes of address
+// space, so tests that run the program under `ulimit -v` skip.
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define KR_TEST_SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || __has_feature(memory_sanitizer)
+#define KR_TEST_SANITIZED 1
+#endif
+#endif
+
 namespace kr::test {
 
 inline std::string read_file(const std::filesystem::path& p) {
