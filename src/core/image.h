@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/math.h"
-#include "scene/scene.h"  // EnumNames
+#include "scene/scene.h"  // EnumNames, ToneMap
 
 namespace kr {
 
@@ -27,9 +27,6 @@ struct Rgb8Image {
     int width = 0, height = 0;
     std::vector<uint8_t> bytes;  // 3 per pixel
 };
-
-enum class ToneMap { sigmoid, linear };
-inline constexpr EnumNames<ToneMap, 2> tonemap_names{{"sigmoid", "linear"}};
 
 // Per channel: sigmoid I/(1+I), or linear I/max where max is the largest channel value
 // of the whole image (one scale for all channels, so hues are kept). Then x255 and round,

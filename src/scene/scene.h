@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -57,6 +58,11 @@ inline constexpr EnumNames<PrimitiveType, 2> primitive_type_names{{"geometric", 
 
 enum class RendererType { wrt, pt };
 inline constexpr EnumNames<RendererType, 2> renderer_type_names{{"WRT", "PT"}};
+
+// Display tone maps (core/image.h applies them): one table for the loader, the saver, the
+// command lines and the viewer's combos.
+enum class ToneMap { sigmoid, linear };
+inline constexpr EnumNames<ToneMap, 2> tonemap_names{{"sigmoid", "linear"}};
 
 // The brief caps the recursion depth at 20 bounces.
 inline constexpr int kMaxDepth = 20;
@@ -114,6 +120,15 @@ struct RendererSettings {
     std::string output;  // as written in the file: relative to the scene file's folder
 };
 
+// How the image is shown and written: the optional `scene.display` block. The exposure is
+// in stops (EV): radiance is scaled by 2^exposure before the tone map, so 0 leaves it as is.
+inline constexpr double kMaxExposureStops = 10;
+struct DisplaySettings {
+    ToneMap tonemap = ToneMap::sigmoid;
+    double exposure = 0;  // EV, in [-kMaxExposureStops, kMaxExposureStops]
+    double exposure_scale() const { return std::exp2(exposure); }
+};
+
 // The whole file. Unreferenced cameras, materials, shapes and lights are kept (so the
 // viewer can offer them and save the file back) but only the `scene` block is rendered.
 struct Scene {
@@ -126,6 +141,7 @@ struct Scene {
     std::vector<int> active_lights;   // indices into lights
     std::vector<Primitive> primitives;
     RendererSettings renderer;
+    DisplaySettings display;
 
     std::filesystem::path source_file;  // where it was loaded from (empty if built in code)
 

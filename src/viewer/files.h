@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -23,6 +24,16 @@ void write_image(const std::filesystem::path& path, const Rgb8Image& image);
 
 // The *.json files of `dir`, sorted.
 std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& dir);
+
+// The scenes offered by the Open list: the *.json files of each folder, once each however
+// the folders are spelled (a relative and an absolute path to one folder, a symlink), in
+// folder order. The label is the file name, followed by its folder when two listed files
+// share a name.
+struct SceneChoice {
+    std::filesystem::path path;
+    std::string label;
+};
+std::vector<SceneChoice> scene_choices(const std::vector<std::filesystem::path>& folders);
 
 // Polls a file's modification time, at most once per `interval`.
 class FileWatch {
