@@ -28,6 +28,15 @@
 #define KR_TEST_SANITIZED 1
 #endif
 #endif
+// KR_TEST_TSAN: ThreadSanitizer, whose runtime maps files that `ulimit -f` cuts short (it
+// dies of SIGBUS), so tests that run the program under a file size limit skip.
+#if defined(__SANITIZE_THREAD__)
+#define KR_TEST_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define KR_TEST_TSAN 1
+#endif
+#endif
 
 namespace kr::test {
 

@@ -52,12 +52,12 @@ TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
 
     // Tone map: same generation, same prepared scene (the render keeps its samples).
     ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) {
-        s.tone.op = ToneMap::linear;
-        s.tone.exposure = 4;
+        s.tone.tonemap = ToneMap::linear;
+        s.tone.exposure = 2;
     }));
     EXPECT_EQ(m.generation(), g0);
     EXPECT_EQ(m.prepared(), scene_before);
-    EXPECT_EQ(m.settings().tone.op, ToneMap::linear);
+    EXPECT_EQ(m.settings().tone.tonemap, ToneMap::linear);
     ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));
     EXPECT_EQ(m.generation(), g0);
 
@@ -82,7 +82,7 @@ TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
     expect_reset(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; });
     EXPECT_EQ(m.settings().render.max_depth, 2);
     // Tone map and pause survived every reset.
-    EXPECT_EQ(m.settings().tone.exposure, 4);
+    EXPECT_EQ(m.settings().tone.exposure, 2);
     EXPECT_TRUE(m.settings().paused);
 }
 

@@ -75,7 +75,9 @@ Options:
                         sampled; brief-area is the brief's own uniform sampling of it;
                         cone and area are exact: docs/fidelity.md, docs/accuracy.md)
   --depth N             maximum ray depth, 0..20 (default: the file's "depth")
-  --tonemap NAME        sigmoid | linear (default: sigmoid)
+  --tonemap NAME        sigmoid | linear (default: the scene's "display" block, else sigmoid)
+  --exposure EV         exposure in stops, -10..10: radiance x 2^EV before the tone map
+                        (default: the scene's "display" block, else 0)
   --gl                  tone map through the viewer's GLSL display shaders in an
                         offscreen OSMesa framebuffer (no display, no GPU needed)
   --blur R              box blur of radius R pixels on the radiance, 0..4096 (default: 0)
@@ -114,7 +116,8 @@ struct Options {
     std::optional<Estimator> estimator;
     std::optional<Allocation> allocation;
     std::optional<LightSampling> light_sampling;
-    ToneMap tonemap = ToneMap::sigmoid;
+    std::optional<ToneMap> tonemap;  // default: the scene's display block
+    std::optional<double> exposure;  // EV stops; default: the scene's display block
     int blur = 0;
     uint64_t seed = 0;
     std::optional<fs::path> output;
@@ -141,6 +144,7 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--allocation") o.allocation = parse_name(arg, value(), allocation_names);
         else if (arg == "--light-sampling") o.light_sampling = parse_name(arg, value(), light_sampling_names);
         else if (arg == "--tonemap") o.tonemap = parse_name(arg, value(), tonemap_names);
+        else if (arg == "--exposure") o.exposure = parse_number(arg, value(), -kMaxExposureStops, kMaxExposureStops);
         else if (arg == "-o" || arg == "--output") o.output = value();
         else if (arg == "-q" || arg == "--quiet") o.quiet = true;
         else if (arg == "--gl") o.gl = true;
@@ -290,9 +294,13 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
             files.push_back({depth_output, encode_pfm_gray(std::vector<float>(depth.begin(), depth.end()),
                                                            state.width, state.height)});
         } else {
-            const Rgb8Image display =
-                opt.gl ? viewer::display_offscreen(radiance, {opt.tonemap, 1.0}) : tonemap(radiance, opt.tonemap);
-            files.push_back({output, encode_image(output, display)});
+            // The scene's display block, then the command line over it.
+            DisplaySettings display = loaded.scene.display;
+            if (opt.tonemap) display.tonemap = *opt.tonemap;
+            if (opt.exposure) display.exposure = *opt.exposure;
+            const Rgb8Image shown = opt.gl ? viewer::display_offscreen(radiance, display)
+                                           : tonemap(radiance, display.tonemap, display.exposure_scale());
+            files.push_back({output, encode_image(output, shown)});
             files.push_back(
                 {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))});
         }

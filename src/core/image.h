@@ -27,6 +27,8 @@ struct Rgb8Image {
     std::vector<uint8_t> bytes;  // 3 per pixel
 };
 
+// Display tone maps: one table for the loader, the saver, the command lines and the viewer's
+// combos.
 enum class ToneMap { sigmoid, linear };
 inline constexpr EnumNames<ToneMap, 2> tonemap_names{{"sigmoid", "linear"}};
 

@@ -386,6 +386,7 @@ private:
     void read_scene(const Json& j, const std::string& pointer);
     void read_primitive(const Json& j, const std::string& pointer);
     void read_renderer(const Json& j, const std::string& pointer);
+    void read_display(const Json& j, const std::string& pointer);
 
     struct Usage {
         std::vector<bool> cameras, materials, shapes, lights;
@@ -759,7 +760,37 @@ void Loader::read_scene(const Json& j, const std::string& pointer) {
               for (size_t i = 0; i < v.size(); ++i) read_primitive(v[i], child(p, i));
           }},
          {"renderer", "the renderer settings (an object)",
-          [&](const Json& v, const std::string& p) { read_renderer(v, p); }}});
+          [&](const Json& v, const std::string& p) { read_renderer(v, p); }},
+         {"display", "the display settings (an object)",
+          [&](const Json& v, const std::string& p) { read_display(v, p); }, false}});
+}
+
+// Optional: how the image is tone mapped, as `render` writes it and the viewer shows it.
+void Loader::read_display(const Json& j, const std::string& pointer) {
+    DisplaySettings& d = out_.scene.display;
+    const Owner owner{Category::scene, 0};
+    require_object(j, pointer, "display settings");
+    const std::string stops = "a number of stops in [-" + std::to_string(int(kMaxExposureStops)) + ", " +
+                              std::to_string(int(kMaxExposureStops)) + "]";
+    read_fields(
+        j, pointer,
+        {{"tonemap", tonemap_names.list(),
+          [&](const Json& v, const std::string& p) {
+              if (!v.is_string()) fail(p, "expected a tone map (a string), got " + describe(v));
+              const auto op = tonemap_names.parse(v.get_ref<const std::string&>());
+              if (!op)
+                  fail(p, "unknown tone map " + in_quotes(v.get_ref<const std::string&>()) + "; expected " +
+                              tonemap_names.list());
+              d.tonemap = *op;
+          },
+          false},
+         {"exposure", stops,
+          [&](const Json& v, const std::string& p) {
+              const double ev = number(v, p);
+              if (std::abs(ev) > kMaxExposureStops) range_problem(owner, p, "expected " + stops + ", got " + number_text(v));
+              d.exposure = std::clamp(ev, -kMaxExposureStops, kMaxExposureStops);
+          },
+          false}});
 }
 
 // Which objects the scene block uses: the active camera, the active lights, the

@@ -107,6 +107,10 @@ std::string scene_to_json(const Scene& scene) {
     renderer["depth"] = r.depth;
     renderer["output"] = r.output;
     block["renderer"] = renderer;
+    Json display;
+    display["tonemap"] = tonemap_names.name(scene.display.tonemap);
+    display["exposure"] = scene.display.exposure;
+    block["display"] = display;
     root["scene"] = block;
     // nlohmann prints doubles in their shortest round-trip form, so values load back equal.
     return root.dump(2) + "\n";

@@ -4,14 +4,16 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
-#include "core/limits.h"  // kMaxDepth, kMaxDimension, kMaxSamples
 #include "core/enum_names.h"
+#include "core/image.h"   // ToneMap
+#include "core/limits.h"  // kMaxDepth, kMaxDimension, kMaxSamples
 #include "core/math.h"
 
 namespace kr {
@@ -89,6 +91,15 @@ struct RendererSettings {
     std::string output;  // as written in the file: relative to the scene file's folder
 };
 
+// How the image is shown and written: the optional `scene.display` block. The exposure is
+// in stops (EV): radiance is scaled by 2^exposure before the tone map, so 0 leaves it as is.
+inline constexpr double kMaxExposureStops = 10;
+struct DisplaySettings {
+    ToneMap tonemap = ToneMap::sigmoid;
+    double exposure = 0;  // EV, in [-kMaxExposureStops, kMaxExposureStops]
+    double exposure_scale() const { return std::exp2(exposure); }
+};
+
 // The whole file. Unreferenced cameras, materials, shapes and lights are kept (so the
 // viewer can offer them and save the file back) but only the `scene` block is rendered.
 struct Scene {
@@ -101,6 +112,7 @@ struct Scene {
     std::vector<int> active_lights;   // indices into lights
     std::vector<Primitive> primitives;
     RendererSettings renderer;
+    DisplaySettings display;
 
     std::filesystem::path source_file;  // where it was loaded from (empty if built in code)
 

@@ -1,8 +1,14 @@
 // The viewer's reset rule: which edits change the rendered image (accumulation restarts)
 // and which only change how it is displayed or how long it runs (samples are kept).
+// Also the check of a value typed into a panel field before it is applied.
 #pragma once
 
+#include <optional>
+#include <string>
+#include <string_view>
+
 #include "core/image.h"
+#include "scene/scene.h"  // DisplaySettings
 
 namespace kr::viewer {
 
@@ -11,10 +17,10 @@ enum class Edit {
     lens,       // camera type, focal distance, aperture
     light,      // active lights' position, power, area radius
     material,   // rho, roughness, eta, type
-    renderer,   // integrator, depth, estimator, light sampling, target spp, seed
+    renderer,   // integrator, depth, estimator, light sampling, seed
     scene,      // another file, a reload, a watched file that changed
     tone_map,   // operator, exposure: re-display only
-    run_control // pause, unlimited: how long the same estimate keeps refining
+    run_control // pause, unlimited, target spp, stop rules: how long the same estimate refines
 };
 
 // True when the edit changes the image, so accumulated samples no longer belong to it.
@@ -32,10 +38,14 @@ constexpr bool edit_resets(Edit e) {
     return true;
 }
 
-// How the accumulated radiance is shown (and saved): the display shader's parameters.
-struct ToneSettings {
-    ToneMap op = ToneMap::sigmoid;
-    double exposure = 1.0;  // sigmoid only; cancels in the linear map (as in kr::tonemap)
-};
+// How the accumulated radiance is shown (and saved): the display shader's parameters,
+// the scene file's `display` block (tone map, exposure in stops).
+using ToneSettings = DisplaySettings;
+
+// A value typed into the field `field`: nullopt when every component is finite and in
+// [lo, hi], else the one-line reason the edit is refused ("fov (deg): -20 is below the
+// minimum 0.5; the previous value is kept").
+std::optional<std::string> check_typed_value(std::string_view field, const double* values, int count, double lo,
+                                             double hi);
 
 }  // namespace kr::viewer

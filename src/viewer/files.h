@@ -1,12 +1,24 @@
-// The viewer's polling watch on the scene file (needs no window). Image files are in
-// core/image_io.h, the scene list in scene/load.h.
+// File helpers of the viewer that need no window: the polling watch on the scene file and
+// the Open list's choices. Image files are in core/image_io.h, the scene lists in scene/load.h.
 #pragma once
 
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace kr::viewer {
+
+// The scenes offered by the Open list: the *.json files of each folder, once each however
+// the folders are spelled (a relative and an absolute path to one folder, a symlink), in
+// folder order. The label is the file name, followed by its folder when two listed files
+// share a name.
+struct SceneChoice {
+    std::filesystem::path path;
+    std::string label;
+};
+std::vector<SceneChoice> scene_choices(const std::vector<std::filesystem::path>& folders);
 
 // Polls a file's modification time, at most once per `interval`.
 class FileWatch {

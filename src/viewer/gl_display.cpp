@@ -103,8 +103,8 @@ void Display::draw(const PixelRect& where, int framebuffer_width, int framebuffe
     const double y1 = 1.0 - 2.0 * (where.y + where.height) / framebuffer_height;
     gl_.UseProgram(program_);
     gl_.Uniform4f(rect_loc_, float(x0), float(y0), float(x1), float(y1));
-    gl_.Uniform1i(op_loc_, tone.op == ToneMap::sigmoid ? 0 : 1);
-    gl_.Uniform1f(exposure_loc_, float(tone.exposure));
+    gl_.Uniform1i(op_loc_, tone.tonemap == ToneMap::sigmoid ? 0 : 1);
+    gl_.Uniform1f(exposure_loc_, float(tone.exposure_scale()));
     gl_.Uniform1f(inv_max_loc_, float(inv_max_));
     gl_.Uniform1i(sampler_loc_, 0);
     gl_.ActiveTexture(GL_TEXTURE0);

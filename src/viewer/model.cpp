@@ -1,5 +1,8 @@
 #include "viewer/model.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "scene/load.h"
@@ -31,7 +34,6 @@ void ViewerModel::load(const std::filesystem::path& file) {
 void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     auto prepared = prepare(scene, &warnings, prepared_.get());  // throws before anything changes
     ViewerSettings settings = settings_;
-    const ToneSettings tone = settings_.tone;
     settings.render = RenderSettings::from_scene(scene.renderer);
     if (overrides_.spp) settings.render.target_spp = *overrides_.spp;
     if (overrides_.depth) settings.render.max_depth = std::min(*overrides_.depth, kMaxDepth);
@@ -40,34 +42,114 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     if (overrides_.allocation) settings.render.allocation = *overrides_.allocation;
     if (overrides_.light_sampling) settings.render.light_sampling = *overrides_.light_sampling;
     if (overrides_.seed) settings.render.seed = *overrides_.seed;
-    settings.tone = tone;
+    settings.tone = scene.display;
+    if (overrides_.tonemap) settings.tone.tonemap = *overrides_.tonemap;
+    if (overrides_.exposure) settings.tone.exposure = *overrides_.exposure;
+    file_cameras_ = scene.cameras;
+    file_camera_ = scene.camera;
     scene_ = std::move(scene);
     prepared_ = std::move(prepared);
     settings_ = settings;
     warnings_ = std::move(warnings);
     ++generation_;
+    undo_.clear();
+    redo_.clear();
+    open_group_.clear();
+    saved_id_ = state_id_ = next_state_id_++;
 }
 
-bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string* error) {
-    if (!edit_resets(kind)) {
-        change(scene_, settings_);
-        return true;
-    }
+bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string* error,
+                       std::string_view field, std::string_view group) {
     Scene scene = scene_;
     ViewerSettings settings = settings_;
     change(scene, settings);
-    std::vector<std::string> warnings;
-    try {
-        prepared_ = prepare(scene, &warnings, prepared_.get());
-    } catch (const SceneError& e) {
-        if (error) *error = e.what();
-        return false;
+    const bool resets = edit_resets(kind);
+    std::shared_ptr<const RenderScene> prepared = prepared_;
+    std::vector<std::string> warnings = warnings_;
+    if (resets) {
+        warnings.clear();
+        try {
+            prepared = prepare(scene, &warnings, prepared_.get());
+        } catch (const SceneError& e) {
+            // A panel edit: the reason, named by the field, not blamed on the file.
+            if (error) *error = std::string(field.empty() ? "edit" : field) + ": " + e.message() +
+                                "; the previous value is kept";
+            return false;
+        }
+    }
+    // Pausing is run control the user toggles, not a change to undo.
+    const bool only_pause = !resets && kind == Edit::run_control && settings.paused != settings_.paused;
+    if (!only_pause) {
+        const bool coalesce = !group.empty() && group == open_group_ && !undo_.empty();
+        if (coalesce) {
+            undo_.back().resets |= resets;
+        } else {
+            undo_.push_back({std::move(scene_), settings_, state_id_, resets});
+            if (undo_.size() > kMaxUndoSteps) undo_.erase(undo_.begin());
+        }
+        open_group_ = std::string(group);
+        redo_.clear();
+        state_id_ = next_state_id_++;
     }
     scene_ = std::move(scene);
     settings_ = settings;
-    warnings_ = std::move(warnings);
-    ++generation_;
+    if (resets) {
+        prepared_ = std::move(prepared);
+        warnings_ = std::move(warnings);
+        ++generation_;
+    }
     return true;
+}
+
+void ViewerModel::restore(State& state, std::vector<State>& push_to) {
+    // The state being left goes on the other stack; it resets the image if the step did.
+    State here{scene_, settings_, state_id_, state.resets};
+    if (state.resets) {
+        std::vector<std::string> warnings;
+        // Every state on the stacks was prepared once, so this succeeds.
+        prepared_ = prepare(state.scene, &warnings, prepared_.get());
+        warnings_ = std::move(warnings);
+        ++generation_;
+    }
+    const bool paused = settings_.paused;
+    scene_ = std::move(state.scene);
+    settings_ = state.settings;
+    settings_.paused = paused;
+    state_id_ = state.id;
+    push_to.push_back(std::move(here));
+    open_group_.clear();
+}
+
+bool ViewerModel::undo() {
+    if (undo_.empty()) return false;
+    State state = std::move(undo_.back());
+    undo_.pop_back();
+    restore(state, redo_);
+    return true;
+}
+
+bool ViewerModel::redo() {
+    if (redo_.empty()) return false;
+    State state = std::move(redo_.back());
+    redo_.pop_back();
+    restore(state, undo_);
+    return true;
+}
+
+bool ViewerModel::set_target_spp(int spp) {
+    const Edit kind = settings_.render.estimator == Estimator::stratified ? Edit::renderer : Edit::run_control;
+    return edit(kind, [&](Scene& s, ViewerSettings& out) {
+        out.render.target_spp = std::max(1, spp);
+        s.renderer.samples = out.render.target_spp;
+    }, nullptr, "target spp");
+}
+
+bool ViewerModel::reset_view() {
+    if (!has_scene() || file_camera_ < 0) return false;
+    return edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+        s.cameras = file_cameras_;
+        s.camera = file_camera_;
+    }, nullptr, "reset view");
 }
 
 bool ViewerModel::focus_at(double fx, double fy) {
@@ -78,7 +160,7 @@ bool ViewerModel::focus_at(double fx, double fy) {
         Camera& cam = scene.cameras[size_t(scene.camera)];
         cam.type = CameraType::lens;
         cam.focal_distance = *distance;
-    });
+    }, nullptr, "click-to-focus");
 }
 
 Scene ViewerModel::scene_for_saving() const {
@@ -88,7 +170,22 @@ Scene ViewerModel::scene_for_saving() const {
     scene.renderer.type = r.integrator == Integrator::wrt ? RendererType::wrt : RendererType::pt;
     scene.renderer.depth = r.max_depth;
     scene.renderer.samples = r.target_spp;
+    scene.display = settings_.tone;
     return scene;
+}
+
+std::optional<std::string> check_typed_value(std::string_view field, const double* values, int count, double lo,
+                                             double hi) {
+    for (int i = 0; i < count; ++i) {
+        const double v = values[i];
+        char text[96];
+        if (!std::isfinite(v)) std::snprintf(text, sizeof text, "%g is not a finite number", v);
+        else if (v < lo) std::snprintf(text, sizeof text, "%.6g is below the minimum %.6g", v, lo);
+        else if (v > hi) std::snprintf(text, sizeof text, "%.6g is above the maximum %.6g", v, hi);
+        else continue;
+        return std::string(field) + ": " + text + "; the previous value is kept";
+    }
+    return std::nullopt;
 }
 
 }  // namespace kr::viewer

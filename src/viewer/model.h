@@ -1,8 +1,8 @@
 // The viewer's state without any window: the authored scene (what the file says, edited
 // by the panels and saved back), the prepared render scene built from it, the render and
-// display settings, and a generation counter that advances on every edit that changes
-// the image. The window and the scripted modes both edit through this class, so the
-// reset rule (viewer/edit.h) is applied in one place and unit-tested.
+// display settings, a generation counter that advances on every edit that changes the
+// image, and the undo history. The window and the scripted modes both edit through this
+// class, so the reset rule (viewer/edit.h) is applied in one place and unit-tested.
 #pragma once
 
 #include <cstdint>
@@ -11,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "render/render.h"
@@ -29,6 +30,12 @@ struct ViewerSettings {
     ToneSettings tone;
 };
 
+// What to do when the watched scene file changes on disk.
+enum class WatchAction {
+    reload,  // no unsaved edits: load it
+    ask      // unsaved edits: ask whether to reload (losing them) or keep the edits
+};
+
 class ViewerModel {
 public:
     // An empty model: nothing to render until a scene is set.
@@ -38,7 +45,8 @@ public:
     // refuses) the model keeps its current scene and rethrows.
     void load(const std::filesystem::path& file);
     // Takes a loaded scene and advances the generation. Render settings are reset to the
-    // file's renderer block, except the command-line overrides; the tone map is kept.
+    // file's renderer block and the tone map to its display block, except the
+    // command-line overrides. The undo history starts again; the scene counts as saved.
     void set_scene(Scene scene, std::vector<std::string> warnings = {});
 
     bool has_scene() const { return prepared_ != nullptr; }
@@ -50,9 +58,34 @@ public:
 
     // Applies `change` to the authored scene and settings. An edit that changes the image
     // rebuilds the render scene and advances the generation; if the result cannot be
-    // prepared, the edit is undone and false is returned with the reason in `error`.
+    // prepared, the edit is undone and false is returned with the reason in `error`,
+    // naming `field` when given ("camera position: ...; the previous value is kept").
+    // Consecutive edits of the same non-empty `group` (one drag, one held key) make one
+    // undo step until seal_undo_step() is called. Pausing is not an undoable edit.
     bool edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change,
-              std::string* error = nullptr);
+              std::string* error = nullptr, std::string_view field = {}, std::string_view group = {});
+    // Ends the open undo group: the next edit starts a new step.
+    void seal_undo_step() { open_group_.clear(); }
+
+    // Undo / redo of scene and settings edits (the pause state stays as it is).
+    bool can_undo() const { return !undo_.empty(); }
+    bool can_redo() const { return !redo_.empty(); }
+    bool undo();
+    bool redo();
+
+    // A new target spp. The running estimate keeps its samples and refines on (or stops, if
+    // it already has as many): run control. Except with the stratified estimator, whose
+    // strata divide each pixel for the target: there the image restarts.
+    bool set_target_spp(int spp);
+
+    // Puts the active camera back as the file has it (an undoable camera edit).
+    bool reset_view();
+
+    // Edits not yet saved: the state differs from the one loaded or last saved.
+    bool dirty() const { return state_id_ != saved_id_; }
+    // After the scene was written to its own file: the current state counts as saved.
+    void mark_saved() { saved_id_ = state_id_; }
+    WatchAction on_file_changed() const { return dirty() ? WatchAction::ask : WatchAction::reload; }
 
     // The active camera (the scene must have one).
     const Camera& camera() const { return scene_.cameras[size_t(scene_.camera)]; }
@@ -63,7 +96,7 @@ public:
     bool focus_at(double fx, double fy);
 
     // The authored scene with its renderer block brought in line with the settings
-    // (type, depth, samples), as it is saved.
+    // (type, depth, samples) and its display block with the tone map, as it is saved.
     Scene scene_for_saving() const;
 
     // Settings kept across loads of another file: those given on the command line.
@@ -74,16 +107,35 @@ public:
         std::optional<Allocation> allocation;
         std::optional<LightSampling> light_sampling;
         std::optional<uint64_t> seed;
+        std::optional<ToneMap> tonemap;
+        std::optional<double> exposure;  // EV stops
     };
     void set_overrides(const Overrides& overrides) { overrides_ = overrides; }
 
 private:
+    // One undo step: the state before it, and whether going back changes the image.
+    struct State {
+        Scene scene;
+        ViewerSettings settings;
+        uint64_t id = 0;
+        bool resets = false;
+    };
+    void restore(State& state, std::vector<State>& push_to);
+
+    static constexpr size_t kMaxUndoSteps = 256;
+
     Scene scene_;
     std::shared_ptr<const RenderScene> prepared_;
     ViewerSettings settings_;
     std::vector<std::string> warnings_;
     uint64_t generation_ = 0;
     Overrides overrides_;
+
+    std::vector<State> undo_, redo_;
+    std::string open_group_;  // the group the newest undo step may still absorb
+    uint64_t next_state_id_ = 1, state_id_ = 0, saved_id_ = 0;
+    std::vector<Camera> file_cameras_;  // as loaded, for reset_view
+    int file_camera_ = -1;
 };
 
 }  // namespace kr::viewer

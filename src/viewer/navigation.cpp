@@ -51,6 +51,44 @@ void dolly(Camera& camera, double factor) {
     if (r > 0) camera.position = camera.target + offset * (new_r / r);
 }
 
+void DragGesture::press(double x, double y) {
+    pressed = true;
+    dragging = false;
+    press_x = x;
+    press_y = y;
+}
+
+bool DragGesture::move(double x, double y, const Camera& camera, double& dx, double& dy) {
+    if (!pressed) return false;
+    if (!dragging) {
+        if (std::hypot(x - press_x, y - press_y) <= kDragThresholdPixels) return false;
+        dragging = true;
+        start_x = x;
+        start_y = y;
+        start_camera = camera;
+    }
+    dx = x - start_x;
+    dy = y - start_y;
+    return true;
+}
+
+void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height) {
+    const double orbit_pixels = kKeyOrbitDegreesPerSecond / kOrbitDegreesPerPixel * seconds;
+    if (keys.orbit_x || keys.orbit_y) orbit_drag(camera, keys.orbit_x * orbit_pixels, keys.orbit_y * orbit_pixels);
+    const double pan_pixels = kKeyPanPixelsPerSecond * seconds;
+    if (keys.pan_x || keys.pan_y) pan_drag(camera, keys.pan_x * pan_pixels, keys.pan_y * pan_pixels, image_height);
+    if (keys.dolly) dolly(camera, std::exp(keys.dolly * kKeyDollyPerSecond * seconds));
+}
+
+std::optional<std::string> sphere_containing(const Scene& scene, const Vec3& point) {
+    for (const Primitive& p : scene.primitives) {
+        if (p.shape < 0) continue;
+        const Shape& s = scene.shapes[size_t(p.shape)];
+        if (dot(point - s.centre, point - s.centre) < s.radius * s.radius) return s.id;
+    }
+    return std::nullopt;
+}
+
 std::optional<double> focus_distance(const RenderScene& scene, double fx, double fy) {
     CameraModel pinhole = scene.camera;
     pinhole.lens_radius = 0;  // the ray through the lens centre

@@ -55,6 +55,7 @@ RenderWorker::~RenderWorker() {
 void RenderWorker::submit(RenderJob job) {
     {
         std::lock_guard lock(mutex_);
+        target_spp_ = std::max(1, job.settings.target_spp);
         pending_ = std::move(job);
         stop_.store(true);  // the pass in flight ends at its next row
     }
@@ -74,6 +75,14 @@ void RenderWorker::set_stop_rule(double seconds, double noise) {
         std::lock_guard lock(mutex_);
         stop_seconds_ = seconds;
         stop_noise_ = noise;
+    }
+    changed_.notify_all();
+}
+
+void RenderWorker::set_target_spp(int target_spp) {
+    {
+        std::lock_guard lock(mutex_);
+        target_spp_ = std::max(1, target_spp);
     }
     changed_.notify_all();
 }
@@ -131,7 +140,7 @@ void RenderWorker::run() {
             if (next_preview < previews.size()) return nullptr;
             if (stop_noise_ > 0 && noise_met && noise_checked == stop_noise_) return "noise";
             if (stop_seconds_ > 0 && full_seconds >= stop_seconds_) return "time";
-            if (!unlimited_ && accumulator.passes() >= job.settings.target_spp) return "spp";
+            if (!unlimited_ && accumulator.passes() >= target_spp_) return "spp";
             return nullptr;
         };
         {
@@ -190,7 +199,6 @@ void RenderWorker::run() {
         const RenderState& totals = accumulator.totals();
         frame->generation = job.generation;
         frame->spp = accumulator.passes();
-        frame->target_spp = job.settings.target_spp;
         frame->seconds = seconds;
         frame->full_seconds = full_seconds;
         frame->rays = totals.rays;
@@ -198,6 +206,7 @@ void RenderWorker::run() {
         frame->nonfinite_samples = totals.nonfinite_samples;
         {
             std::lock_guard lock(mutex_);
+            frame->target_spp = target_spp_;
             const char* reason = stop_reason();
             frame->finished = reason != nullptr;
             frame->stopped_by = reason ? reason : "";

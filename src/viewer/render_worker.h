@@ -65,6 +65,9 @@ public:
     // so the accumulated passes stay whole (and the image deterministic).
     void set_paused(bool paused);
     void set_unlimited(bool unlimited);
+    // A new target spp for the running estimate: it keeps its samples and refines on to
+    // the new target, or stops (finished) if it already has as many.
+    void set_target_spp(int target_spp);
     // The stop rules of `keithray render --time / --noise` (0 disables each): the estimate
     // stops refining after `seconds` of full-resolution rendering, or once its estimated
     // relative error is below `noise`, passes going only to pixels above their share of it.
@@ -86,6 +89,7 @@ private:
     mutable std::condition_variable published_; // wakes waiters on frames
     std::optional<RenderJob> pending_;
     bool paused_ = false, unlimited_ = false, quit_ = false;
+    int target_spp_ = 1;  // the job's, until set_target_spp
     double stop_seconds_ = 0, stop_noise_ = 0;
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;

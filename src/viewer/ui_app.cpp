@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include <sys/resource.h>
+
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
@@ -19,9 +21,35 @@ namespace kr::viewer {
 
 namespace {
 
-constexpr double kPanelWidth = 420;      // framebuffer pixels reserved for the panels
 constexpr double kFrameInterval = 1.0 / 60;  // UI frame cap where there is no vsync (Xvfb)
 constexpr double kMinFrameInterval = 1.0 / 120;  // ... and when a new snapshot cuts the wait short
+constexpr double kWatchInterval = 0.25;      // seconds between scene-file polls while idle
+constexpr int kSettleFrames = 3;             // frames drawn after input so ImGui's state settles
+constexpr double kErrorFlashSeconds = 3;     // a refused edit shows at the pointer this long
+constexpr int kMinWindowWidth = 640, kMinWindowHeight = 400;
+
+// Process CPU time (all threads), seconds.
+double process_cpu_seconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+ViewerApp* app_of(GLFWwindow* w) { return static_cast<ViewerApp*>(glfwGetWindowUserPointer(w)); }
+
+// Installed before ImGui's (which chain to them): any input wakes a redraw.
+void install_input_callbacks(GLFWwindow* w) {
+    glfwSetCursorPosCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
+    glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int, int, int) { app_of(win)->note_input(); });
+    glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
+    glfwSetKeyCallback(w, [](GLFWwindow* win, int, int, int, int) { app_of(win)->note_input(); });
+    glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
+    glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
+    glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
+    glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { app_of(win)->note_input(); });
+    glfwSetWindowRefreshCallback(w, [](GLFWwindow* win) { app_of(win)->note_input(); });
+    glfwSetWindowCloseCallback(w, [](GLFWwindow* win) { app_of(win)->on_close_request(); });
+}
 
 double seconds(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
@@ -35,8 +63,7 @@ double percentile(std::vector<double> v, double p) {
 
 ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)) {
     model_.set_overrides(options_.overrides);
-    model_.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) {
-        s.tone = options_.tone;
+    model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
         s.stop_seconds = options_.stop_seconds;
         s.stop_noise = options_.stop_noise;
@@ -56,13 +83,16 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)) {
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
     const int w = model_.has_scene() ? model_.scene().renderer.width : 512;
     const int h = model_.has_scene() ? model_.scene().renderer.height : 512;
-    // Room for the image at 1:1 when it is not huge, and the panels beside it.
-    const int win_w = std::min(w, 1400) + int(kPanelWidth), win_h = std::max(std::min(h, 1000), 720);
+    // Room for the image at 1:1 when it is not huge, the panels beside it, the status bar below.
+    const int win_w = std::min(w, 1400) + int(panel_width_), win_h = std::max(std::min(h, 1000) + 48, 720);
     window_ = glfwCreateWindow(win_w, win_h, "keithray", nullptr, nullptr);
     if (!window_) {
         glfwTerminate();
         throw std::runtime_error("cannot open a window with an OpenGL 3.3 core context");
     }
+    glfwSetWindowSizeLimits(window_, kMinWindowWidth, kMinWindowHeight, GLFW_DONT_CARE, GLFW_DONT_CARE);
+    glfwSetWindowUserPointer(window_, this);
+    install_input_callbacks(window_);
     glfwMakeContextCurrent(window_);
     glfwSwapInterval(1);
     gl_.load(&glfwGetProcAddress);
@@ -88,10 +118,11 @@ ViewerApp::~ViewerApp() {
     glfwTerminate();
 }
 
-bool ViewerApp::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change) {
+bool ViewerApp::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string_view field,
+                     std::string_view group) {
     std::string why;
-    if (!model_.edit(kind, change, &why)) {
-        error_ = why;
+    if (!model_.edit(kind, change, &why, field, group)) {
+        show_error(why);
         return false;
     }
     if (edit_resets(kind)) {
@@ -99,6 +130,20 @@ bool ViewerApp::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&
         generation_edited_ = Clock::now();
     }
     return true;
+}
+
+void ViewerApp::show_error(std::string message) {
+    error_ = std::move(message);
+    error_time_ = Clock::now();
+}
+
+void ViewerApp::open_scene_asking(const std::filesystem::path& file) {
+    if (model_.dirty()) {
+        pending_open_ = file;
+        open_pending_popup_ = true;
+        return;
+    }
+    open_scene(file);
 }
 
 void ViewerApp::open_scene(const std::filesystem::path& file) {
@@ -111,13 +156,21 @@ void ViewerApp::open_scene(const std::filesystem::path& file) {
             reset_save_paths();
         }
     } catch (const SceneError& e) {
-        error_ = e.what();  // the last good scene stays on screen
+        show_error(e.what());  // the last good scene stays on screen
         if (!model_.has_scene()) watch_.watch(file);
     }
 }
 
 void ViewerApp::poll_watch() {
-    if (watch_.changed()) open_scene(watch_.file());
+    if (!watch_.changed()) return;
+    input_seen_ = true;  // something to show either way
+    // Never drop the user's edits silently: with unsaved edits, ask.
+    if (model_.has_scene() && model_.on_file_changed() == WatchAction::ask) {
+        pending_open_ = watch_.file();
+        open_pending_popup_ = true;
+        return;
+    }
+    open_scene(watch_.file());
 }
 
 void ViewerApp::sync_worker() {
@@ -129,18 +182,28 @@ void ViewerApp::sync_worker() {
         worker_->set_stop_rule(submitted_stop_seconds_ = s.stop_seconds, submitted_stop_noise_ = s.stop_noise);
     if (model_.generation() != submitted_generation_) {
         submitted_generation_ = model_.generation();
+        submitted_target_ = s.render.target_spp;
         worker_->submit({submitted_generation_, model_.prepared(), s.render});
     }
+    // A new target keeps the samples taken (the reset rule: run control).
+    if (s.render.target_spp != submitted_target_) worker_->set_target_spp(submitted_target_ = s.render.target_spp);
 }
 
-void ViewerApp::fetch_frame() {
+bool ViewerApp::fetch_frame() {
     std::shared_ptr<const Snapshot> frame = worker_->latest();
-    if (!frame || frame->serial == shown_serial_) return;
+    if (!frame || frame->serial == shown_serial_) return false;
     shown_serial_ = frame->serial;
     // A frame of an older generation shows an image the user already changed.
-    if (frame->generation != model_.generation()) return;
+    if (frame->generation != model_.generation()) return false;
     display_->upload(frame->radiance);
     shown_ = std::move(frame);
+    return true;
+}
+
+double ViewerApp::status_bar_height() const {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    // Two lines: the render's figures, then the message line.
+    return (2 * ImGui::GetFrameHeightWithSpacing() + 2 * style.WindowPadding.y) * ImGui::GetIO().DisplayFramebufferScale.y;
 }
 
 PixelRect ViewerApp::image_rect() const {
@@ -148,7 +211,9 @@ PixelRect ViewerApp::image_rect() const {
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
     if (!model_.has_scene()) return {};
     const double w = model_.scene().renderer.width, h = model_.scene().renderer.height;
-    const double area_w = std::max(1.0, fb_w - kPanelWidth), area_h = std::max(1.0, double(fb_h));
+    const double panel = panel_visible_ ? panel_width_ * ImGui::GetIO().DisplayFramebufferScale.x : 0.0;
+    // The free area left of the panel and above the status bar; the image fits it whole.
+    const double area_w = std::max(1.0, fb_w - panel), area_h = std::max(1.0, fb_h - status_bar_height());
     double scale = std::min(area_w / w, area_h / h);
     // Whole pixels when it fits, so each image pixel is exactly one (or k x k) screen pixels.
     if (scale >= 1) scale = std::floor(scale);
@@ -174,63 +239,199 @@ Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
 
 void ViewerApp::handle_input() {
     if (!model_.has_scene()) return;
+    handle_mouse(image_rect());
+    handle_keys();
+    // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
+    const ImGuiIO& io = ImGui::GetIO();
+    const bool holding = io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || ImGui::IsAnyItemActive() ||
+                         motion_keys_held_;
+    if (!holding) model_.seal_undo_step();
+}
+
+void ViewerApp::handle_mouse(const PixelRect& rect) {
     ImGuiIO& io = ImGui::GetIO();
-    const PixelRect rect = image_rect();
     const double to_fb = io.DisplayFramebufferScale.x;  // window points to framebuffer pixels
     const double image_scale = rect.width / model_.scene().renderer.width;
+    const double mx = io.MousePos.x * to_fb, my = io.MousePos.y * to_fb;
+    const bool over_image = mx >= rect.x && my >= rect.y && mx < rect.x + rect.width && my < rect.y + rect.height;
+    for (int b = 0; b < 3; ++b)
+        if (!io.MouseDown[b]) drags_[b].release();
     // Mouse: only when ImGui does not want it, so a click on a panel never moves the camera.
-    if (!io.WantCaptureMouse) {
-        const double mx = io.MousePos.x * to_fb, my = io.MousePos.y * to_fb;
-        const bool over_image =
-            mx >= rect.x && my >= rect.y && mx < rect.x + rect.width && my < rect.y + rect.height;
-        const double dx = io.MouseDelta.x * to_fb / image_scale, dy = io.MouseDelta.y * to_fb / image_scale;
-        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && over_image && (io.KeyCtrl || pick_focus_)) {
+    if (io.WantCaptureMouse || !over_image) {
+        for (int b = 0; b < 3; ++b)
+            if (ImGui::IsMouseClicked(b)) drags_[b].release();  // a press on a panel drags nothing
+    } else {
+        for (int b = 0; b < 3; ++b)
+            if (ImGui::IsMouseClicked(b))
+                drags_[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
+        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && (io.KeyCtrl || pick_focus_)) {
+            drags_[0].release();  // a focus click, never an orbit
             const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
             const Vec2 film = raster_to_camera((mx - rect.x) / rect.width * w, (my - rect.y) / rect.height * h, w, h);
-            if (!model_.focus_at(film.x, film.y))
-                error_ = "click-to-focus: nothing there to focus on";
-            else
-                generation_edited_ = Clock::now();
+            if (!model_.focus_at(film.x, film.y)) show_error("click-to-focus: nothing there to focus on");
+            else generation_edited_ = Clock::now();
             pick_focus_ = false;
-        } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0) && (dx != 0 || dy != 0) && !io.KeyCtrl) {
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) { orbit_drag(s.cameras[size_t(s.camera)], dx, dy); });
-        } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0) && (dx != 0 || dy != 0)) {
-            const int h = model_.scene().renderer.height;
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) { pan_drag(s.cameras[size_t(s.camera)], dx, dy, h); });
-        } else if (ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0) && dy != 0) {
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) { dolly(s.cameras[size_t(s.camera)], std::exp(dy * 0.005)); });
         }
-        if (io.MouseWheel != 0 && over_image)
+        if (io.MouseWheel != 0)
             edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
                 dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
-            });
+            }, "dolly", "wheel");
     }
-    if (io.WantCaptureKeyboard) return;
-    // Keys: arrows orbit, W/S dolly, A/D/Q/E pan, F pick focus, Space pause.
-    const double step = 8;  // pixels of drag per frame a key is held
-    double ox = 0, oy = 0, px = 0, py = 0, zoom = 1;
-    if (ImGui::IsKeyDown(GLFW_KEY_LEFT)) ox -= step;
-    if (ImGui::IsKeyDown(GLFW_KEY_RIGHT)) ox += step;
-    if (ImGui::IsKeyDown(GLFW_KEY_UP)) oy -= step;
-    if (ImGui::IsKeyDown(GLFW_KEY_DOWN)) oy += step;
-    if (ImGui::IsKeyDown(GLFW_KEY_A)) px += step;
-    if (ImGui::IsKeyDown(GLFW_KEY_D)) px -= step;
-    if (ImGui::IsKeyDown(GLFW_KEY_Q)) py -= step;
-    if (ImGui::IsKeyDown(GLFW_KEY_E)) py += step;
-    if (ImGui::IsKeyDown(GLFW_KEY_W)) zoom *= 0.97;
-    if (ImGui::IsKeyDown(GLFW_KEY_S)) zoom /= 0.97;
-    if (ox != 0 || oy != 0 || px != 0 || py != 0 || zoom != 1) {
+    // Drags started on the image go on wherever the pointer goes. Each applies its whole
+    // offset from where it started (screen pixels, in image pixels here) to the camera as it was then.
+    const int h = model_.scene().renderer.height;
+    double dx = 0, dy = 0;
+    const int active = model_.scene().camera;
+    auto drag = [&](DragGesture& g) {
+        if (!g.move(mx, my, model_.camera(), dx, dy)) return false;
+        dx /= image_scale;
+        dy /= image_scale;
+        return true;
+    };
+    if (drag(drags_[0]))
+        edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = drags_[0].start_camera;
+            orbit_drag(cam, dx, dy);
+            s.cameras[size_t(active)] = cam;
+        }, "orbit", "orbit");
+    if (drag(drags_[1]))
+        edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = drags_[1].start_camera;
+            pan_drag(cam, dx, dy, h);
+            s.cameras[size_t(active)] = cam;
+        }, "pan", "pan");
+    if (drag(drags_[2]))
+        edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = drags_[2].start_camera;
+            dolly(cam, std::exp(dy * 0.005));
+            s.cameras[size_t(active)] = cam;
+        }, "dolly", "dolly");
+}
+
+void ViewerApp::handle_keys() {
+    ImGuiIO& io = ImGui::GetIO();
+    const auto now = Clock::now();
+    auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
+    // Keys that work even while a field has the keyboard: none but these window keys.
+    if (pressed(GLFW_KEY_F11)) toggle_fullscreen();
+    if (pressed(GLFW_KEY_F1)) help_visible_ = !help_visible_;
+    if (io.WantTextInput || ImGui::IsAnyItemActive()) {
+        motion_keys_held_ = false;
+        return;
+    }
+    bool question = false;
+    for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
+    if (question) help_visible_ = !help_visible_;
+    if (pressed(GLFW_KEY_ESCAPE)) {
+        if (help_visible_) help_visible_ = false;
+        else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) request_quit();
+    }
+    if (pressed(GLFW_KEY_TAB)) panel_visible_ = !panel_visible_;
+    if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
+        const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
+        if (redo ? model_.redo() : model_.undo()) {
+            error_.clear();
+            generation_edited_ = Clock::now();
+        }
+        return;
+    }
+    if (pressed(GLFW_KEY_HOME) || pressed(GLFW_KEY_R)) {
+        model_.seal_undo_step();
+        if (model_.reset_view()) generation_edited_ = Clock::now();
+    }
+    if (pressed(GLFW_KEY_RIGHT_BRACKET) || pressed(GLFW_KEY_LEFT_BRACKET)) {
+        const int spp = model_.settings().render.target_spp;
+        model_.seal_undo_step();
+        model_.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
+    }
+    if (pressed(GLFW_KEY_F)) pick_focus_ = !pick_focus_;
+    if (pressed(GLFW_KEY_SPACE))
+        edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
+    if (io.KeyCtrl) {
+        motion_keys_held_ = false;
+        return;
+    }
+    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
+    KeyMotion keys;
+    keys.orbit_x = int(ImGui::IsKeyDown(GLFW_KEY_RIGHT)) - int(ImGui::IsKeyDown(GLFW_KEY_LEFT));
+    keys.orbit_y = int(ImGui::IsKeyDown(GLFW_KEY_DOWN)) - int(ImGui::IsKeyDown(GLFW_KEY_UP));
+    keys.pan_x = int(ImGui::IsKeyDown(GLFW_KEY_A)) - int(ImGui::IsKeyDown(GLFW_KEY_D));
+    keys.pan_y = int(ImGui::IsKeyDown(GLFW_KEY_E)) - int(ImGui::IsKeyDown(GLFW_KEY_Q));
+    keys.dolly = int(ImGui::IsKeyDown(GLFW_KEY_S)) - int(ImGui::IsKeyDown(GLFW_KEY_W));
+    if (keys.any()) {
+        // The time since the previous frame with keys held; a first frame moves one 60 Hz step.
+        const double dt = motion_keys_held_ ? std::clamp(seconds(now - last_motion_), 0.0, 0.1) : 1.0 / 60;
         const int h = model_.scene().renderer.height;
         edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera& cam = s.cameras[size_t(s.camera)];
-            if (ox != 0 || oy != 0) orbit_drag(cam, ox, oy);
-            if (px != 0 || py != 0) pan_drag(cam, px, py, h);
-            if (zoom != 1) dolly(cam, zoom);
-        });
+            apply_key_motion(s.cameras[size_t(s.camera)], keys, dt, h);
+        }, "camera keys", "keys");
     }
-    if (ImGui::IsKeyPressed(GLFW_KEY_F, false)) pick_focus_ = !pick_focus_;
-    if (ImGui::IsKeyPressed(GLFW_KEY_SPACE, false))
-        edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
+    motion_keys_held_ = keys.any();
+    last_motion_ = now;
+}
+
+void ViewerApp::request_quit() {
+    if (model_.dirty()) quit_asked_ = true;
+    else glfwSetWindowShouldClose(window_, GLFW_TRUE);
+}
+
+void ViewerApp::on_close_request() {
+    // The window's close button: like Esc, it asks first when there are unsaved edits.
+    if (model_.dirty() && !options_.scripted()) {
+        glfwSetWindowShouldClose(window_, GLFW_FALSE);
+        quit_asked_ = true;
+    }
+    input_seen_ = true;
+}
+
+void ViewerApp::toggle_fullscreen() {
+    GLFWmonitor* monitor = glfwGetPrimaryMonitor();
+    if (!fullscreen_) {
+        const GLFWvidmode* mode = monitor ? glfwGetVideoMode(monitor) : nullptr;
+        if (!mode) return;
+        glfwGetWindowPos(window_, &windowed_x_, &windowed_y_);
+        glfwGetWindowSize(window_, &windowed_w_, &windowed_h_);
+        glfwSetWindowMonitor(window_, monitor, 0, 0, mode->width, mode->height, mode->refreshRate);
+        fullscreen_ = true;
+    } else {
+        glfwSetWindowMonitor(window_, nullptr, windowed_x_, windowed_y_, windowed_w_, windowed_h_, 0);
+        fullscreen_ = false;
+    }
+}
+
+bool ViewerApp::animating() const {
+    const ImGuiIO& io = ImGui::GetIO();
+    if (io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || motion_keys_held_) return true;
+    if (!error_.empty() && seconds(Clock::now() - error_time_) < kErrorFlashSeconds) return true;
+    // The latency measurement redraws at the frame rate, as while dragging.
+    return options_.measure_latency > 0 && latency_edits_done_ < options_.measure_latency;
+}
+
+void ViewerApp::update_title() {
+    const RunStatus status = run_status(shown_ && shown_->generation == model_.generation() ? shown_.get() : nullptr,
+                                        model_.settings(), !error_.empty() && !model_.has_scene());
+    const std::string name = watch_.file().filename().string();
+    std::string title = window_title(name, status, model_.dirty());
+    if (title != title_) {
+        glfwSetWindowTitle(window_, title.c_str());
+        title_ = std::move(title);
+    }
+    if (options_.status_file) write_status_file(status);
+}
+
+void ViewerApp::write_status_file(const RunStatus& status) {
+    char line[256];
+    std::snprintf(line, sizeof line, "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d\n",
+                  std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
+                  static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(help_visible_),
+                  int(panel_visible_));
+    if (line == status_line_) return;
+    try {
+        write_file_atomic(*options_.status_file, line);
+        status_line_ = line;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+    }
 }
 
 bool ViewerApp::script_step(const PixelRect& rect) {
@@ -277,8 +478,9 @@ bool ViewerApp::script_step(const PixelRect& rect) {
         std::printf("UI frame work (events, panels, upload, draw, swap): median %.1f ms, 95th percentile %.1f ms\n",
                     1e3 * percentile(frame_work_, 0.5), 1e3 * percentile(frame_work_, 0.95));
         std::fflush(stdout);
-        if (!options_.screenshot && !options_.save_scene && options_.frames == 0) return true;
     }
+    // Without an image to write, the latency run is over; an idle run ends in idle_measure_step.
+    if (!options_.screenshot && !options_.save_scene && options_.frames == 0) return options_.measure_idle <= 0;
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int target = model_.settings().render.target_spp;
     const int needed = options_.frames > 0 ? (model_.settings().unlimited ? options_.frames
@@ -301,6 +503,94 @@ bool ViewerApp::script_step(const PixelRect& rect) {
     }
     std::fflush(stdout);
     return true;
+}
+
+bool ViewerApp::draw_frame() {
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    fetch_frame();
+    if (model_.has_scene() && inside_checked_generation_ != model_.generation()) {
+        inside_checked_generation_ = model_.generation();
+        inside_sphere_ = sphere_containing(model_.scene(), model_.camera().position);
+    }
+    draw_panels();
+    draw_status_bar();
+    draw_help();
+    draw_error_flash();
+    handle_input();
+    sync_worker();
+    update_title();
+
+    int fb_w = 0, fb_h = 0;
+    glfwGetFramebufferSize(window_, &fb_w, &fb_h);
+    gl_.Viewport(0, 0, fb_w, fb_h);
+    gl_.ClearColor(0.1f, 0.1f, 0.1f, 1.0f);
+    gl_.Clear(GL_COLOR_BUFFER_BIT);
+    const PixelRect rect = image_rect();
+    if (shown_) display_->draw(rect, fb_w, fb_h, model_.settings().tone);
+    // Scripted runs read the image region back here: what the shader drew, before
+    // the panels are drawn over anything.
+    const bool done = options_.scripted() && script_step(rect);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (done && options_.window_shot) {
+        try {
+            const Rgb8Image window = read_image_region({0, 0, double(fb_w), double(fb_h)});
+            write_image(*options_.window_shot, window);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "error: %s\n", e.what());
+            script_status_ = 1;
+        }
+    }
+    glfwSwapBuffers(window_);
+    return done;
+}
+
+bool ViewerApp::idle_measure_step() {
+    const auto now = Clock::now();
+    if (seconds(now - script_start_) > options_.timeout) {
+        std::fprintf(stderr, "error: scripted run did not finish within %.0f s\n", options_.timeout);
+        script_status_ = 1;
+        return true;
+    }
+    if (!model_.has_scene()) return false;  // script_step reports the error
+    // Phases: 0 rendering to the target, 1 settling, 2 measuring (done), 3 settling after
+    // the pause, 4 measuring (paused).
+    const double settle = 1.0;  // seconds between a change of state and its measurement
+    const double elapsed = seconds(now - idle_phase_start_);
+    if (idle_phase_ == 0) {
+        const RunStatus st = run_status(shown_ && shown_->generation == model_.generation() ? shown_.get() : nullptr,
+                                        model_.settings(), false);
+        if (st.state == RunState::done) {
+            idle_phase_ = 1;
+            idle_phase_start_ = now;
+        }
+        return false;
+    }
+    if (idle_phase_ == 1 || idle_phase_ == 3) {
+        if (elapsed < settle) return false;
+        idle_cpu_start_ = process_cpu_seconds();
+        idle_phase_start_ = now;
+        ++idle_phase_;
+        return false;
+    }
+    if (elapsed < options_.measure_idle) return false;
+    const double cpu = process_cpu_seconds() - idle_cpu_start_;
+    const bool paused = idle_phase_ == 4;
+    std::printf("idle CPU, %s: %.2f%% of a core over %.1f s\n", paused ? "paused" : "done", 100 * cpu / elapsed, elapsed);
+    std::fflush(stdout);
+    if (paused) return true;
+    // Then paused with unlimited refinement: the render thread waits, the window sleeps.
+    edit(Edit::run_control, [](Scene&, ViewerSettings& s) {
+        s.paused = true;
+        s.unlimited = true;
+    });
+    sync_worker();
+    input_seen_ = true;  // draw the new state once
+    idle_phase_ = 3;
+    idle_phase_start_ = now;
+    return false;
 }
 
 int ViewerApp::run() {
@@ -328,43 +618,26 @@ int ViewerApp::run() {
         }
     }
     last_frame_ = Clock::now();
-    while (!glfwWindowShouldClose(window_)) {
-        const auto frame_start = Clock::now();
-        glfwPollEvents();
+    settle_frames_ = kSettleFrames;
+    bool done = false;
+    while (!done && !glfwWindowShouldClose(window_)) {
         poll_watch();
-        ImGui_ImplOpenGL3_NewFrame();
-        ImGui_ImplGlfw_NewFrame();
-        ImGui::NewFrame();
-        draw_panels();
-        handle_input();
         sync_worker();
-        fetch_frame();
-
-        int fb_w = 0, fb_h = 0;
-        glfwGetFramebufferSize(window_, &fb_w, &fb_h);
-        gl_.Viewport(0, 0, fb_w, fb_h);
-        gl_.ClearColor(0.1f, 0.1f, 0.1f, 1.0f);
-        gl_.Clear(GL_COLOR_BUFFER_BIT);
-        const PixelRect rect = image_rect();
-        if (shown_) display_->draw(rect, fb_w, fb_h, model_.settings().tone);
-        // Scripted runs read the image region back here: what the shader drew, before
-        // the panels are drawn over anything.
-        const bool done = options_.scripted() && script_step(rect);
-        ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
-        if (done && options_.window_shot) {
-            try {
-                const Rgb8Image window = read_image_region({0, 0, double(fb_w), double(fb_h)});
-                write_image(*options_.window_shot, window);
-            } catch (const std::exception& e) {
-                std::fprintf(stderr, "error: %s\n", e.what());
-                script_status_ = 1;
-            }
+        if (options_.measure_idle > 0 && idle_measure_step()) break;
+        const auto latest = worker_->latest();
+        const bool new_snapshot = latest && latest->serial != shown_serial_;
+        // Redraw only on input, a new snapshot, or something moving; else sleep until one of
+        // those (the render thread and GLFW wake the wait) or the next poll of the scene file.
+        if (!(input_seen_ || new_snapshot || settle_frames_ > 0 || animating())) {
+            glfwWaitEventsTimeout(kWatchInterval);
+            continue;
         }
-        glfwSwapBuffers(window_);
+        settle_frames_ = input_seen_ ? kSettleFrames : std::max(0, settle_frames_ - 1);
+        input_seen_ = false;
+        const auto frame_start = Clock::now();
+        done = draw_frame();
         if (done) break;
 
-        // Cap the UI rate where swap does not wait for vsync: the render thread needs the cores.
         const auto now = Clock::now();
         const double work = seconds(now - frame_start);
         ui_work_ = ui_work_ > 0 ? 0.9 * ui_work_ + 0.1 * work : work;
@@ -373,14 +646,16 @@ int ViewerApp::run() {
         last_frame_ = now;
         ui_fps_ = 0.9 * ui_fps_ + 0.1 * (interval > 0 ? 1.0 / interval : 0.0);
         if (shown_ && !shown_->finished && frame_intervals_.size() < 100000) frame_intervals_.push_back(interval);
+        // Cap the UI rate where swap does not wait for vsync: the render thread needs the cores.
         // A new snapshot ends the wait early (the render thread posts an empty event).
         for (double left = kFrameInterval - seconds(Clock::now() - frame_start); left > 0.001;
              left = kFrameInterval - seconds(Clock::now() - frame_start)) {
             glfwWaitEventsTimeout(left);
-            const auto latest = worker_->latest();
-            if (latest && latest->serial != shown_serial_ && seconds(Clock::now() - frame_start) >= kMinFrameInterval)
+            const auto newest = worker_->latest();
+            if (newest && newest->serial != shown_serial_ && seconds(Clock::now() - frame_start) >= kMinFrameInterval)
                 break;
         }
+        glfwPollEvents();
     }
     return script_status_;
 }

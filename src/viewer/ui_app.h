@@ -15,7 +15,9 @@
 #include "viewer/gl_display.h"
 #include "viewer/gl_functions.h"
 #include "viewer/model.h"
+#include "viewer/navigation.h"
 #include "viewer/render_worker.h"
+#include "viewer/status.h"
 
 struct GLFWwindow;
 
@@ -24,7 +26,6 @@ namespace kr::viewer {
 struct ViewOptions {
     std::filesystem::path scene;
     ViewerModel::Overrides overrides;
-    ToneSettings tone;
     bool unlimited = false;
     double stop_seconds = 0, stop_noise = 0;  // --time, --noise
     // Scripted mode: edits applied at start, then the run ends by itself.
@@ -36,8 +37,12 @@ struct ViewOptions {
     std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
     std::optional<std::filesystem::path> window_shot;      // the whole window, panels included
     int measure_latency = 0;  // edits to time, edit to first displayed frame
+    double measure_idle = 0;  // seconds of idle CPU to measure, done and then paused
+    std::optional<std::filesystem::path> status_file;  // the status line, rewritten on change
     double timeout = 600;     // seconds: a scripted run that gets stuck fails
-    bool scripted() const { return frames > 0 || screenshot || save_scene || measure_latency > 0; }
+    bool scripted() const {
+        return frames > 0 || screenshot || save_scene || measure_latency > 0 || measure_idle > 0;
+    }
 };
 
 class ViewerApp {
@@ -54,12 +59,24 @@ private:
     enum class SaveKind { ppm, png, exr, pfm, scene };
 
     // Steps of one UI frame.
+    bool draw_frame();  // true when a scripted run is over
     void poll_watch();
     void sync_worker();
-    void fetch_frame();
+    bool fetch_frame();
     void handle_input();
+    void handle_mouse(const PixelRect& rect);
+    void handle_keys();
     void draw_panels();
+    void draw_status_bar();
+    void draw_help();
+    void draw_error_flash();
+    void update_title();
     PixelRect image_rect() const;
+    double status_bar_height() const;  // framebuffer pixels
+    bool animating() const;            // something moves without input: redraw at the frame rate
+    void request_quit();
+    void toggle_fullscreen();
+    void show_error(std::string message);
     Rgb8Image read_image_region(const PixelRect& rect) const;
 
     // Panels.
@@ -73,8 +90,17 @@ private:
     void panel_stats();
     void panel_save();
     void overwrite_popup();
-
-    bool edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change);
+    void quit_popup();
+    void discard_popup();
+    // Panel fields: mouse drags apply live; typed text applies on Enter or focus loss,
+    // after check_typed_value. True when `v` was changed and should be applied.
+    bool field(const char* label, double* v, int count, float speed, double lo, double hi,
+               const char* format = "%.4g");
+    bool field_int(const char* label, int& v, int lo, int hi);
+    bool edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change,
+              std::string_view field = {}, std::string_view group = {});
+    // Opens `file` now (a reload when it is the current one); with unsaved edits, asks first.
+    void open_scene_asking(const std::filesystem::path& file);
     void open_scene(const std::filesystem::path& file);
     void request_save(SaveKind kind, const std::filesystem::path& path);
     void save_now(SaveKind kind, const std::filesystem::path& path);
@@ -82,6 +108,9 @@ private:
 
     // Scripted mode: true when the run is over (exit status in script_status_).
     bool script_step(const PixelRect& rect);
+    // --measure-idle, run on every wake-up whether or not a frame is drawn: true when over.
+    bool idle_measure_step();
+    void write_status_file(const RunStatus& status);
 
     ViewOptions options_;
     GLFWwindow* window_ = nullptr;
@@ -99,11 +128,34 @@ private:
     Clock::time_point generation_edited_{};  // when the image last changed by an edit
 
     std::string error_;   // last load/edit failure, shown in red until the next success
+    Clock::time_point error_time_{};  // when it was set: flashed at the pointer for a moment
     std::string status_;  // last save message
     bool pick_focus_ = false;
+
+    // Layout and modes.
+    float panel_width_ = 400;  // window points; the user can resize it
+    bool panel_visible_ = true, help_visible_ = false, fullscreen_ = false;
+    int windowed_x_ = 0, windowed_y_ = 0, windowed_w_ = 0, windowed_h_ = 0;
+    std::string title_;
+    std::string status_line_;  // last written to --status-file
+    bool quit_asked_ = false;  // the quit confirmation popup is wanted
+    std::optional<std::filesystem::path> pending_open_;  // open/reload awaiting the discard popup
+    bool open_pending_popup_ = false;
+    std::optional<std::string> inside_sphere_;  // the camera is inside this sphere
+    uint64_t inside_checked_generation_ = 0;
+
+    // Input.
+    DragGesture drags_[3];  // left: orbit, right: pan, middle: dolly
+    TypedFields typed_;
+    Clock::time_point last_motion_{};  // previous frame with motion keys held
+    bool motion_keys_held_ = false;
+    int settle_frames_ = 0;  // frames still to draw after input, so ImGui settles
+    bool input_seen_ = false;   // set by the GLFW callbacks
+    int submitted_target_ = 0;
     std::string image_path_, png_path_, hdr_path_, scene_path_;
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending_save_;
-    std::vector<std::filesystem::path> scene_list_;
+    std::vector<std::filesystem::path> scene_list_;  // the folders listed (empty: list again)
+    std::vector<SceneChoice> scene_choices_;
 
     // UI frame timing for the Stats panel and --measure-latency.
     double ui_fps_ = 0;
@@ -120,6 +172,13 @@ private:
     std::vector<double> latencies_;  // seconds
     std::vector<int> latency_scales_;
     Clock::time_point script_start_{};
+    int idle_phase_ = 0;  // --measure-idle: 0 waiting for done, 1 measuring done, 2 paused wait, 3 measuring paused
+    Clock::time_point idle_phase_start_{};
+    double idle_cpu_start_ = 0;
+
+public:
+    void note_input() { input_seen_ = true; }
+    void on_close_request();
 };
 
 }  // namespace kr::viewer

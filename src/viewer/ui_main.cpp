@@ -19,7 +19,9 @@ Usage:
 Opens SCENE.json (default: res/scenes/assignment_03.json) in a window that refines the
 image pass by pass. The panels on the right edit camera, lens, lights, materials, tone
 map and renderer; any edit that changes the image restarts at once from a
-low-resolution preview. The scene file is watched and reloaded when it changes.
+low-resolution preview. The status bar shows the state, spp, progress and noise. The
+scene file is watched and reloaded when it changes (asking first if there are unsaved
+edits). In the window, F1 or ? lists the keys and mouse controls.
 
 Options:
   --spp N               target samples per pixel (default: the file's "samples")
@@ -31,7 +33,8 @@ Options:
   --allocation NAME     adaptive | uniform (samples per pixel and pass)
   --light-sampling NAME brief | brief-area | cone | area
   --seed N              random seed (default 0)
-  --tonemap NAME        sigmoid | linear         --exposure E      sigmoid exposure
+  --tonemap NAME        sigmoid | linear         --exposure EV     stops, -10..10
+                        (default: the scene's "display" block, else sigmoid and 0)
 Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run):
   --aperture A          make the camera a thin lens of aperture radius A
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
@@ -41,6 +44,10 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --save-scene OUT.json then save the edited scene
   --window-shot OUT.ppm and the whole window, panels included (.png: as PNG)
   --measure-latency N   time N orbit edits from the edit to the first frame on screen
+  --measure-idle S      once done, the process's CPU over S seconds with no input; then
+                        paused (unlimited), the same again; printed as % of a core
+  --status-file FILE    rewrite FILE with the status line (state, spp, target, generation,
+                        unsaved edits) whenever it changes: for scripts driving the window
   --timeout S           fail a scripted run after S seconds (default 600)
 )";
 
@@ -70,8 +77,9 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--estimator") o.overrides.estimator = parse_name(arg, value(), estimator_names);
         else if (arg == "--allocation") o.overrides.allocation = parse_name(arg, value(), allocation_names);
         else if (arg == "--light-sampling") o.overrides.light_sampling = parse_name(arg, value(), light_sampling_names);
-        else if (arg == "--tonemap") o.tone.op = parse_name(arg, value(), tonemap_names);
-        else if (arg == "--exposure") o.tone.exposure = parse_number(arg, value(), 1e-6, 1e6);
+        else if (arg == "--tonemap") o.overrides.tonemap = parse_name(arg, value(), tonemap_names);
+        else if (arg == "--exposure")
+            o.overrides.exposure = parse_number(arg, value(), -kMaxExposureStops, kMaxExposureStops);
         else if (arg == "--unlimited") o.unlimited = true;
         else if (arg == "--time") o.stop_seconds = parse_number(arg, value(), 0, kMaxSeconds, true);
         else if (arg == "--noise") o.stop_noise = parse_number(arg, value(), kMinNoise, kMaxNoise);
@@ -83,6 +91,8 @@ ViewOptions parse(int argc, char** argv, bool& help) {
         else if (arg == "--save-scene") o.save_scene = value();
         else if (arg == "--window-shot") o.window_shot = value();
         else if (arg == "--measure-latency") o.measure_latency = parse_int(arg, value(), 1, 10000);
+        else if (arg == "--measure-idle") o.measure_idle = parse_number(arg, value(), 0.1, 3600);
+        else if (arg == "--status-file") o.status_file = value();
         else if (arg == "--timeout") o.timeout = parse_number(arg, value(), 1, 1e7);
         else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
         else if (have_scene) throw UsageError{"view opens one scene; got a second: " + quote_user_text(arg)};

@@ -1,0 +1,54 @@
+// What the status bar and the window title say about the render, computed without GL
+// from the newest snapshot and the settings, so the rules are unit-tested.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/scene.h"
+#include "viewer/model.h"
+#include "viewer/render_worker.h"
+
+namespace kr::viewer {
+
+enum class RunState { starting, rendering, paused, done, error };
+inline constexpr EnumNames<RunState, 5> run_state_names{{"starting", "rendering", "paused", "done", "error"}};
+
+struct RunStatus {
+    RunState state = RunState::starting;
+    int spp = 0, target = 0;
+    bool unlimited = false;
+    bool preview = false;      // the newest frame is a low-resolution preview
+    double progress = -1;      // 0..1 towards the first stop rule to be met; -1: no rule
+    double eta = -1;           // seconds to it; -1: unknown
+    double elapsed = 0;        // render seconds of this image
+    double mrays_per_second = 0;
+    double noise = -1;         // estimated relative RMS error; -1 before 2 spp
+    std::string rule;          // "target", "time" or "noise": the rule progress is towards
+};
+
+// `frame`: the newest snapshot of the current generation (null before the first).
+// `has_error`: a load or edit failure is being shown (the last good image stays).
+RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error);
+
+// "assignment_03.json - 12/64 spp - rendering", with " (edited)" after the name when the
+// scene has unsaved edits.
+std::string window_title(std::string_view scene_name, const RunStatus& status, bool dirty);
+
+// A number being typed into a panel field: keystrokes only change the held value; it is
+// applied once, when the field is left (Enter or focus loss), so typing -20 never applies -2.
+class TypedFields {
+public:
+    void hold(unsigned id, const double* values, int count) { held_[id].assign(values, values + count); }
+    bool holding(unsigned id) const { return held_.count(id) != 0; }
+    // The value to apply when field `id` is left, and forgets it.
+    std::optional<std::vector<double>> take(unsigned id);
+
+private:
+    std::map<unsigned, std::vector<double>> held_;
+};
+
+}  // namespace kr::viewer

@@ -1,0 +1,398 @@
+// The viewer's behaviour a new user meets first, without a window: a click is not a drag,
+// key motion per second, the target spp keeps the samples, the status bar's state, typed
+// values apply once, undo/redo, reset view, the reload choice, the Open list, the camera
+// inside a sphere. The same rules drive the window (tests/test_viewer_window.cpp).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "scene/load.h"
+#include "viewer/files.h"
+#include "viewer/model.h"
+#include "viewer/navigation.h"
+#include "viewer/render_worker.h"
+#include "viewer/status.h"
+
+namespace fs = std::filesystem;
+using namespace kr;
+using namespace kr::viewer;
+
+namespace {
+
+fs::path scene_file(int n) {
+    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
+}
+
+ViewerModel model_of(int n) {
+    ViewerModel m;
+    m.load(scene_file(n));
+    return m;
+}
+
+void move_camera_x(ViewerModel& m, double x, const char* group = "") {
+    ASSERT_TRUE(m.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].position.x = x; },
+                       nullptr, "camera position", group));
+}
+
+double yaw_degrees(const Camera& c) {
+    const Vec3 o = c.position - c.target;
+    return std::atan2(o.x, o.z) * 180 / kPi;
+}
+
+}  // namespace
+
+// Defect 1: a press and release with a pixel of jitter, or a pointer that jumps between
+// events, never orbits.
+TEST(DragGesture, JitterBelowTheThresholdIsAClick) {
+    Camera cam = model_of(3).camera();
+    DragGesture g;
+    g.press(100, 100);
+    double dx = 0, dy = 0;
+    EXPECT_FALSE(g.move(101, 100, cam, dx, dy));
+    EXPECT_FALSE(g.move(100, 101, cam, dx, dy));
+    EXPECT_FALSE(g.move(100 + kDragThresholdPixels, 100, cam, dx, dy));
+    EXPECT_FALSE(g.dragging);
+    g.release();
+    EXPECT_FALSE(g.move(300, 300, cam, dx, dy));  // released: moving is not dragging
+}
+
+TEST(DragGesture, OffsetIsFromWhereTheDragStartedNotThePreviousEvent) {
+    Camera cam = model_of(3).camera();
+    DragGesture g;
+    g.press(100, 100);
+    double dx = 1, dy = 1;
+    // A pointer that jumps 200 pixels between events starts the drag there: no offset yet.
+    ASSERT_TRUE(g.move(300, 100, cam, dx, dy));
+    EXPECT_EQ(dx, 0);
+    EXPECT_EQ(dy, 0);
+    Camera moved = cam;
+    moved.position.x += 5;  // the camera during the drag; the drag keeps its start camera
+    ASSERT_TRUE(g.move(310, 96, moved, dx, dy));
+    EXPECT_EQ(dx, 10);
+    EXPECT_EQ(dy, -4);
+    EXPECT_EQ(g.start_camera.position, cam.position);
+    // The same position reported again is the same offset: events do not accumulate.
+    ASSERT_TRUE(g.move(310, 96, moved, dx, dy));
+    EXPECT_EQ(dx, 10);
+    Camera a = g.start_camera, b = g.start_camera;
+    orbit_drag(a, dx, dy);
+    orbit_drag(b, dx, dy);
+    EXPECT_EQ(a.position, b.position);
+}
+
+// Defect 10: held keys move at a rate per second, whatever the frame rate.
+TEST(KeyMotion, SameMotionAtAnyFrameRate) {
+    const Camera start = model_of(3).camera();
+    KeyMotion keys;
+    keys.orbit_x = 1;
+    auto held = [&](int frames, double seconds) {
+        Camera c = start;
+        for (int i = 0; i < frames; ++i) apply_key_motion(c, keys, seconds / frames, 512);
+        return c;
+    };
+    const Camera at30 = held(15, 0.5), at120 = held(60, 0.5), at60 = held(30, 0.5);
+    EXPECT_NEAR(length(at30.position - at120.position), 0, 1e-9);
+    EXPECT_NEAR(length(at60.position - at120.position), 0, 1e-9);
+    // Half a second turns kKeyOrbitDegreesPerSecond / 2 (30 degrees), not 52.
+    double turned = yaw_degrees(at60) - yaw_degrees(start);
+    turned = std::remainder(turned, 360.0);
+    EXPECT_NEAR(std::abs(turned), kKeyOrbitDegreesPerSecond * 0.5, 1e-9);
+}
+
+// Defect 10: a camera orbited into a wall sphere is named.
+TEST(CameraInside, NamesTheSphereAroundTheCamera) {
+    for (int n = 1; n <= 8; ++n) {
+        const ViewerModel m = model_of(n);
+        EXPECT_FALSE(sphere_containing(m.scene(), m.camera().position)) << "scene " << n;
+    }
+    const ViewerModel m = model_of(3);
+    const Primitive& p = m.scene().primitives[0];
+    const Shape& s = m.scene().shapes[size_t(p.shape)];
+    const auto inside = sphere_containing(m.scene(), s.centre);
+    ASSERT_TRUE(inside);
+    EXPECT_EQ(*inside, s.id);
+}
+
+// Defect 2: a new target keeps the samples; only the stratified estimator, whose strata
+// depend on the target, restarts.
+TEST(TargetSpp, ChangingTheTargetKeepsTheImage) {
+    ViewerModel m = model_of(3);
+    const uint64_t g = m.generation();
+    const auto prepared = m.prepared();
+    ASSERT_TRUE(m.set_target_spp(65));
+    EXPECT_EQ(m.generation(), g);
+    EXPECT_EQ(m.prepared(), prepared);
+    EXPECT_EQ(m.settings().render.target_spp, 65);
+    EXPECT_EQ(m.scene_for_saving().renderer.samples, 65);
+    ASSERT_TRUE(m.set_target_spp(4));
+    EXPECT_EQ(m.generation(), g);
+    ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.estimator = Estimator::stratified; }));
+    const uint64_t g2 = m.generation();
+    ASSERT_TRUE(m.set_target_spp(16));
+    EXPECT_EQ(m.generation(), g2 + 1);
+}
+
+TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
+    Scene authored = load_scene_file(scene_file(2)).scene;
+    authored.renderer.width = 20;
+    authored.renderer.height = 16;
+    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 2;
+    RenderWorker worker;
+    worker.submit({1, scene, settings});
+    auto wait_for = [&](auto done) {
+        std::shared_ptr<const Snapshot> f = worker.latest();
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        while (!(f && done(*f)) && std::chrono::steady_clock::now() < deadline)
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+        return f;
+    };
+    const auto first = wait_for([](const Snapshot& s) { return s.finished; });
+    ASSERT_TRUE(first && first->spp == 2);
+    worker.set_target_spp(4);
+    // Every frame after the raise is a full-resolution continuation: 3, then 4 passes.
+    int last_spp = 2;
+    std::shared_ptr<const Snapshot> f = first;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f->finished && f->spp == 4) && std::chrono::steady_clock::now() < deadline) {
+        f = worker.wait_newer(f->serial, std::chrono::milliseconds(500));
+        EXPECT_EQ(f->scale, 1);
+        EXPECT_EQ(f->generation, 1u);
+        EXPECT_GE(f->spp, last_spp);
+        last_spp = f->spp;
+    }
+    ASSERT_TRUE(f->finished);
+    EXPECT_EQ(f->spp, 4);
+    EXPECT_EQ(f->target_spp, 4);
+    // The same image as four plain passes: the two first were kept, not re-rendered.
+    RenderState plain(20, 16);
+    for (int i = 0; i < 4; ++i) render_pass(*scene, settings, plain);
+    const Image expected = plain.radiance();
+    for (size_t i = 0; i < expected.pixels.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            ASSERT_NEAR(f->radiance.pixels[i][k], expected.pixels[i][k], 1e-12 * (1 + expected.pixels[i][k]));
+    // A target below the count taken: nothing more is rendered.
+    worker.set_target_spp(3);
+    const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
+    EXPECT_EQ(more->serial, f->serial);
+}
+
+// Defect 3: the status bar's state and progress.
+TEST(RunStatus, StateProgressAndTargetChanges) {
+    ViewerSettings s;
+    s.render.target_spp = 64;
+    EXPECT_EQ(run_status(nullptr, s, false).state, RunState::starting);
+    EXPECT_EQ(run_status(nullptr, s, true).state, RunState::error);
+    Snapshot f;
+    f.spp = 16;
+    f.full_seconds = 8;  // 0.5 s a pass
+    f.seconds = 8.2;
+    f.rays = 16000000;
+    f.relative_error = 0.04;
+    RunStatus st = run_status(&f, s, false);
+    EXPECT_EQ(st.state, RunState::rendering);
+    EXPECT_DOUBLE_EQ(st.progress, 0.25);
+    EXPECT_DOUBLE_EQ(st.eta, 48 * 0.5);
+    EXPECT_DOUBLE_EQ(st.mrays_per_second, 2);
+    EXPECT_DOUBLE_EQ(st.noise, 0.04);
+    s.paused = true;
+    EXPECT_EQ(run_status(&f, s, false).state, RunState::paused);
+    s.paused = false;
+    // Done at 64; a raised target (65) renders on; a lowered one (below 116 done) is done.
+    f.spp = 64;
+    f.finished = true;
+    f.stopped_by = "spp";
+    EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
+    s.render.target_spp = 65;
+    EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
+    f.spp = 116;
+    f.finished = false;
+    f.stopped_by = "";
+    s.render.target_spp = 64;
+    EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
+    s.unlimited = true;
+    EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
+    // The noise rule: 4% now, 2% wanted: four times the passes, 1/4 of the way.
+    s.stop_noise = 0.02;
+    st = run_status(&f, s, false);
+    EXPECT_EQ(st.rule, "noise");
+    EXPECT_DOUBLE_EQ(st.progress, 0.25);
+    EXPECT_EQ(window_title("assignment_03.json", run_status(&f, s, false), true),
+              "keithray - assignment_03.json (edited) - 116 spp (unlimited) - rendering");
+}
+
+// Defect 4: a typed value is applied once, on Enter or focus loss; a refused one names the
+// field and keeps the previous value.
+TEST(TypedValue, AppliedOnceWhenTheFieldIsLeft) {
+    ViewerModel m = model_of(3);
+    TypedFields typed;
+    const uint64_t g = m.generation();
+    for (double keystroke : {-2.0, -20.0}) typed.hold(7, &keystroke, 1);  // "-2", then "-20"
+    EXPECT_TRUE(typed.holding(7));
+    EXPECT_EQ(m.generation(), g);  // nothing applied while typing
+    const auto value = typed.take(7);
+    ASSERT_TRUE(value);
+    EXPECT_EQ((*value)[0], -20);
+    EXPECT_FALSE(typed.take(7));
+    move_camera_x(m, (*value)[0]);
+    EXPECT_EQ(m.generation(), g + 1);  // one restart, for the value typed
+    EXPECT_EQ(m.camera().position.x, -20);
+}
+
+TEST(TypedValue, RefusedEditNamesTheFieldAndKeepsThePreviousValue) {
+    const double fov = -20;
+    const auto why = check_typed_value("fov (deg)", &fov, 1, 0.5, 179.5);
+    ASSERT_TRUE(why);
+    EXPECT_EQ(*why, "fov (deg): -20 is below the minimum 0.5; the previous value is kept");
+    const double nan = std::nan("");
+    EXPECT_TRUE(check_typed_value("eta", &nan, 1, 0.25, 4));
+    const double ok[3] = {0, 1, 2};
+    EXPECT_FALSE(check_typed_value("position", ok, 3, -10, 10));
+
+    ViewerModel m = model_of(3);
+    const Camera before = m.camera();
+    std::string error;
+    EXPECT_FALSE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) {
+        Camera& c = s.cameras[size_t(s.camera)];
+        c.position = c.target;
+    }, &error, "camera position"));
+    EXPECT_EQ(error.rfind("camera position: ", 0), 0u) << error;
+    EXPECT_NE(error.find("previous value is kept"), std::string::npos) << error;
+    EXPECT_EQ(error.find("assignment_03.json"), std::string::npos) << error;  // not the file's fault
+    EXPECT_EQ(m.camera().position, before.position);
+    EXPECT_FALSE(m.dirty());
+    EXPECT_FALSE(m.can_undo());
+}
+
+// Defect 6: undo and redo of every scene and settings edit; one drag is one step.
+TEST(UndoRedo, EditsUndoAndRedoInOrder) {
+    ViewerModel m = model_of(3);
+    const double x0 = m.camera().position.x;
+    const uint64_t g0 = m.generation();
+    move_camera_x(m, 1);
+    ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) { s.tone.exposure = 1.5; }));
+    ASSERT_TRUE(m.set_target_spp(99));
+    ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));  // not a step
+    EXPECT_TRUE(m.dirty());
+
+    ASSERT_TRUE(m.undo());  // the target
+    EXPECT_NE(m.settings().render.target_spp, 99);
+    EXPECT_TRUE(m.settings().paused);  // pausing is left alone
+    const uint64_t g = m.generation();
+    ASSERT_TRUE(m.undo());  // the exposure: display only, the samples stay
+    EXPECT_EQ(m.settings().tone.exposure, 0);
+    EXPECT_EQ(m.generation(), g);
+    ASSERT_TRUE(m.undo());  // the camera: the image restarts
+    EXPECT_EQ(m.camera().position.x, x0);
+    EXPECT_EQ(m.generation(), g + 1);
+    EXPECT_NE(m.prepared()->camera.position.x, 1);
+    EXPECT_FALSE(m.can_undo());
+    EXPECT_FALSE(m.dirty());  // back to the file's state
+
+    ASSERT_TRUE(m.redo());
+    EXPECT_EQ(m.camera().position.x, 1);
+    EXPECT_EQ(m.prepared()->camera.position.x, 1);
+    ASSERT_TRUE(m.redo());
+    EXPECT_EQ(m.settings().tone.exposure, 1.5);
+    // A new edit drops the redo steps.
+    move_camera_x(m, 2);
+    EXPECT_FALSE(m.can_redo());
+    EXPECT_GT(m.generation(), g0);
+}
+
+TEST(UndoRedo, OneDragIsOneStep) {
+    ViewerModel m = model_of(3);
+    const double x0 = m.camera().position.x;
+    for (int i = 1; i <= 10; ++i) move_camera_x(m, i, "orbit");
+    m.seal_undo_step();
+    for (int i = 11; i <= 12; ++i) move_camera_x(m, i, "orbit");
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.camera().position.x, 10);
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.camera().position.x, x0);
+    EXPECT_FALSE(m.can_undo());
+}
+
+TEST(UndoRedo, ResetViewReturnsToTheFilesCamera) {
+    ViewerModel m = model_of(3);
+    const Camera file = m.camera();
+    ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { orbit(s.cameras[size_t(s.camera)], 20, 5); }));
+    ASSERT_TRUE(m.edit(Edit::lens, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].alpha = 0.3; }));
+    const uint64_t g = m.generation();
+    ASSERT_TRUE(m.reset_view());
+    EXPECT_EQ(m.camera().position, file.position);
+    EXPECT_EQ(m.camera().alpha, file.alpha);
+    EXPECT_EQ(m.generation(), g + 1);
+    ASSERT_TRUE(m.undo());  // and it can be undone
+    EXPECT_EQ(m.camera().alpha, 0.3);
+}
+
+// Defect 5: a change of the file on disk reloads at once only without unsaved edits.
+TEST(ReloadChoice, AsksOnlyWithUnsavedEdits) {
+    ViewerModel m = model_of(3);
+    EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
+    ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));
+    EXPECT_EQ(m.on_file_changed(), WatchAction::reload);  // pausing is not an edit to keep
+    move_camera_x(m, 3);
+    EXPECT_EQ(m.on_file_changed(), WatchAction::ask);
+    m.mark_saved();
+    EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
+    move_camera_x(m, 4);
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.on_file_changed(), WatchAction::reload);  // undone back to the saved state
+    ASSERT_TRUE(m.redo());
+    EXPECT_EQ(m.on_file_changed(), WatchAction::ask);
+    // "Reload": the file's scene, no undo history, nothing unsaved.
+    m.load(scene_file(3));
+    EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
+    EXPECT_FALSE(m.can_undo());
+}
+
+// Defect 7: the display settings come from the scene file and go back into it.
+TEST(DisplaySettings, ModelTakesAndSavesTheDisplayBlock) {
+    Scene scene = load_scene_file(scene_file(3)).scene;
+    scene.display.tonemap = ToneMap::linear;
+    scene.display.exposure = -1.5;
+    ViewerModel m;
+    m.set_scene(scene);
+    EXPECT_EQ(m.settings().tone.tonemap, ToneMap::linear);
+    EXPECT_EQ(m.settings().tone.exposure, -1.5);
+    ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) { s.tone = {ToneMap::sigmoid, 2.25}; }));
+    EXPECT_EQ(m.scene_for_saving().display.tonemap, ToneMap::sigmoid);
+    EXPECT_EQ(m.scene_for_saving().display.exposure, 2.25);
+    EXPECT_EQ(m.settings().tone.exposure_scale(), std::exp2(2.25));
+    // Command-line overrides win over the file.
+    ViewerModel::Overrides o;
+    o.exposure = 1;
+    ViewerModel n;
+    n.set_overrides(o);
+    n.set_scene(scene);
+    EXPECT_EQ(n.settings().tone.exposure, 1);
+    EXPECT_EQ(n.settings().tone.tonemap, ToneMap::linear);
+}
+
+// Defect 9: one entry per scene file, however its folder is spelled.
+TEST(SceneChoices, EachFileOnceWithItsFolderWhenNamesClash) {
+    const fs::path dir = fs::temp_directory_path() / ("keithray_choices_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "a");
+    fs::create_directories(dir / "b");
+    for (const char* f : {"a/one.json", "a/two.json", "b/one.json"}) std::ofstream(dir / f) << "{}";
+    fs::create_directory_symlink(dir / "a", dir / "link");
+    const auto choices = scene_choices({dir / "a", dir / "b" / ".." / "a", dir / "link", dir / "b"});
+    ASSERT_EQ(choices.size(), 3u);
+    EXPECT_EQ(choices[0].path.filename(), "one.json");
+    EXPECT_EQ(choices[1].label, "two.json");
+    EXPECT_NE(choices[0].label.find((dir / "a").string()), std::string::npos) << choices[0].label;
+    EXPECT_NE(choices[2].label.find((dir / "b").string()), std::string::npos) << choices[2].label;
+    // The brief's scenes listed from the working folder and the install path: once each.
+    const auto brief = scene_choices({fs::path(KEITHRAY_RES_DIR) / "scenes", fs::path(KEITHRAY_RES_DIR) / ".." / "res" / "scenes"});
+    EXPECT_EQ(brief.size(), scene_choices({fs::path(KEITHRAY_RES_DIR) / "scenes"}).size());
+    fs::remove_all(dir);
+}
