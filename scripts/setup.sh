@@ -9,7 +9,7 @@ packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           libembree-dev
           # the viewer (keithray view) and its offscreen display (render --gl), and
           # the X server its window test runs under
-          libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xauth
+          libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev libstb-dev xvfb xdotool xauth
           # the sanitizer and fuzzing builds (scripts/check_sanitizers.sh): clang, its
           # sanitizer and libFuzzer runtimes, its OpenMP runtime (whose archer tool makes
           # OpenMP visible to ThreadSanitizer) and llvm-symbolizer for the reports' stacks
