@@ -46,7 +46,11 @@ jitter_click)
     ;;
 drag)
     # A real drag past the threshold does orbit (the control for jitter_click).
-    xdotool mousedown 1 mousemove_relative 30 0 mousemove_relative 30 0 mouseup 1
+    # Held across frames: the window samples the pointer once per frame it draws.
+    xdotool mousedown 1; sleep 0.3
+    xdotool mousemove_relative 30 0; sleep 0.3
+    xdotool mousemove_relative 30 0; sleep 0.3
+    xdotool mouseup 1
     xdotool key F1
     wait_for 'help=1' || exit 1
     ;;
@@ -59,7 +63,7 @@ esc)
     xdotool key Escape
     ;;
 esc_unsaved)
-    xdotool key Right  # an edit: orbit a little
+    xdotool keydown Right; sleep 0.3; xdotool keyup Right  # an edit: orbit a little
     wait_for 'dirty=1' || exit 1
     xdotool key Escape  # asks instead of quitting
     xdotool key F1
