@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <sstream>
 #include <regex>
 #include <string>
 
@@ -112,4 +114,56 @@ TEST_F(ViewerWindow, BrokenSceneFailsScriptedRunWithItsError) {
     EXPECT_EQ(v.status, 1);
     EXPECT_NE(v.err.find("bad.json"), std::string::npos) << v.err;
     EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+}
+
+// Real X input events (xdotool) on the real window, through tests/viewer_input.sh, which
+// waits on the viewer's --status-file for each condition (bounded, never a fixed time).
+namespace {
+
+std::map<std::string, std::string> drive(const fs::path& dir, const std::string& scenario, int scene_number) {
+    const std::string script = (fs::path(KEITHRAY_RES_DIR) / ".." / "tests" / "viewer_input.sh").string();
+    const kr::test::CommandResult r = kr::test::run_command(
+        "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' bash '" + script + "' " + scenario + " '" + KEITHRAY_EXE +
+            "' '" + (fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(scene_number) + ".json")).string() +
+            "' '" + dir.string() + "'",
+        dir);
+    std::map<std::string, std::string> out;
+    std::istringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);)
+        if (const size_t eq = line.find('='); eq != std::string::npos) out[line.substr(0, eq)] = line.substr(eq + 1);
+    out["status"] = std::to_string(r.status);
+    return out;
+}
+
+bool have_xdotool() { return std::system("command -v xdotool >/dev/null 2>&1") == 0; }
+
+}  // namespace
+
+TEST_F(ViewerWindow, ClickWithOnePixelJitterLeavesTheImage) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "jitter_click", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["generation_after"], r["generation_before"]);  // no orbit, no restart
+    EXPECT_EQ(r["spp_after"], r["spp_before"]);
+    // The control: a real drag does orbit.
+    r = drive(dir, "drag", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_NE(r["generation_after"], r["generation_before"]);
+}
+
+TEST_F(ViewerWindow, RaisingTheTargetKeepsTheSamplesAndTheTitleShowsSpp) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "raise_target", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["title"], "keithray - assignment_03.json - 2/2 spp - done");
+    // The target is saved with the scene, so it counts as an unsaved edit.
+    EXPECT_EQ(r["title_after"], "keithray - assignment_03.json (edited) - 4/4 spp - done");
+    EXPECT_EQ(r["generation_after"], r["generation_before"]);  // continued, not restarted
+}
+
+TEST_F(ViewerWindow, EscQuits) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "esc", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["exit_status"], "0");
 }

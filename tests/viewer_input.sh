@@ -1,0 +1,83 @@
+#!/bin/bash
+# Drives a real `keithray view` window with real X input events (xdotool), for
+# tests/test_viewer_window.cpp. Run inside xvfb-run. Usage:
+#   viewer_input.sh SCENARIO KEITHRAY SCENE WORKDIR
+# Prints "key=value" lines the test checks. Never waits for time: every wait polls the
+# viewer's --status-file (or the process) for a condition, bounded by a generous limit.
+set -u
+scenario=$1 keithray=$2 scene=$3 dir=$4
+status="$dir/status.txt"
+limit=${VIEWER_INPUT_LIMIT:-240}  # seconds for any one condition, on a loaded machine
+
+"$keithray" view "$scene" --spp 2 --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
+pid=$!
+trap 'kill $pid 2>/dev/null' EXIT
+
+# wait_for REGEX: until the status line matches (or the viewer exits, or the limit passes).
+wait_for() {
+    local end=$((SECONDS + limit))
+    while ((SECONDS < end)); do
+        [[ -f $status ]] && grep -Eq "$1" "$status" && return 0
+        kill -0 $pid 2>/dev/null || { echo "error=viewer exited waiting for $1"; return 1; }
+        sleep 0.1
+    done
+    echo "error=timed out waiting for $1 (status: $(cat "$status" 2>/dev/null))"
+    return 1
+}
+field() { sed -E "s/.*\b$1=([^ ]*).*/\1/" "$status"; }
+
+wid=$(xdotool search --sync --name '^keithray' | head -1)
+[[ -n $wid ]] || { echo "error=no window"; exit 1; }
+wait_for 'state=done' || exit 1
+xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
+# Over the image (left part of the window, clear of the panel and the status bar).
+xdotool mousemove --window "$wid" 250 330 && sleep 0.2
+echo "title=$(xdotool getwindowname "$wid")"
+echo "generation_before=$(field generation)"
+echo "spp_before=$(field spp)"
+
+case $scenario in
+jitter_click)
+    # Press, one pixel of jitter, release: a click, not an orbit.
+    xdotool mousedown 1 mousemove_relative 1 0 mousemove_relative -- -1 1 mouseup 1
+    # Then F1 toggles the help: once it shows, every event before it was handled.
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    ;;
+drag)
+    # A real drag past the threshold does orbit (the control for jitter_click).
+    # Held across frames: the window samples the pointer once per frame it draws.
+    xdotool mousedown 1; sleep 0.3
+    xdotool mousemove_relative 30 0; sleep 0.3
+    xdotool mousemove_relative 30 0; sleep 0.3
+    xdotool mouseup 1
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    ;;
+raise_target)
+    xdotool key bracketright  # target 2 -> 4
+    wait_for 'state=done spp=4 target=4' || exit 1
+    echo "title_after=$(xdotool getwindowname "$wid")"
+    ;;
+esc)
+    xdotool key Escape
+    ;;
+esc_unsaved)
+    xdotool keydown Right; sleep 0.3; xdotool keyup Right  # an edit: orbit a little
+    wait_for 'dirty=1' || exit 1
+    xdotool key Escape  # asks instead of quitting
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    kill -0 $pid 2>/dev/null && echo "running_after_esc=1"
+    ;;
+esac
+echo "generation_after=$(field generation)"
+echo "spp_after=$(field spp)"
+
+if [[ $scenario == esc ]]; then
+    end=$((SECONDS + limit))
+    while kill -0 $pid 2>/dev/null && ((SECONDS < end)); do sleep 0.1; done
+    if kill -0 $pid 2>/dev/null; then echo "error=still running after Esc"; exit 1; fi
+    wait $pid
+    echo "exit_status=$?"
+fi
