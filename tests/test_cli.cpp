@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <string>
 
 #include "core/image.h"
+#include "core/image_hdr.h"
 #include "core/image_io.h"
 #include "test_util.h"
 
@@ -123,6 +125,37 @@ TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
     // Linear tone mapping scales the brightest channel to 255.
     const kr::Rgb8Image d = kr::read_ppm(dir / "d.ppm");
     EXPECT_EQ(*std::max_element(d.bytes.begin(), d.bytes.end()), 255);
+}
+
+// The scene's display block is what `render` writes, and --exposure / --tonemap override it:
+// a scene saved from the viewer renders headless to the image the window showed.
+TEST_F(Cli, DisplayBlockAppliesAndFlagsOverrideIt) {
+    const fs::path plain = write_scene("plain.json");
+    std::string text = read_file(plain);
+    const size_t at = text.find("\"renderer\"");
+    ASSERT_NE(at, std::string::npos);
+    text.insert(at, R"("display": {"exposure": 1.5}, )");
+    const fs::path brighter = write("brighter.json", text);
+    const auto render = [&](const fs::path& scene, const std::string& flags, const std::string& out) {
+        const CliRun r = cli("render '" + scene.string() + "' --spp 2 " + flags + " -q -o '" + (dir / out).string() + "'");
+        EXPECT_EQ(r.status, 0) << r.err;
+        return read_file(dir / out);
+    };
+    const std::string base = render(plain, "", "base.ppm");
+    const std::string from_file = render(brighter, "", "file.ppm");
+    EXPECT_NE(from_file, base);
+    EXPECT_EQ(render(plain, "--exposure 1.5", "flag.ppm"), from_file);
+    EXPECT_EQ(render(brighter, "--exposure 0", "back.ppm"), base);
+    // Exposure EV scales radiance by 2^EV before the sigmoid: the same as the EXR's radiance
+    // tone mapped at that scale.
+    ASSERT_EQ(cli("render '" + plain.string() + "' --spp 2 -q -o '" + (dir / "r.exr").string() + "'").status, 0);
+    const kr::Rgb8Image expected =
+        kr::tonemap(kr::read_hdr(dir / "r.exr").radiance(), kr::ToneMap::sigmoid, std::exp2(1.5));
+    const kr::Rgb8Image got = kr::read_ppm(dir / "file.ppm");
+    ASSERT_EQ(got.bytes.size(), expected.bytes.size());
+    int worst = 0;
+    for (size_t i = 0; i < got.bytes.size(); ++i) worst = std::max(worst, std::abs(int(got.bytes[i]) - int(expected.bytes[i])));
+    EXPECT_LE(worst, 1);  // float radiance in the EXR: at most one step where rounding lands on a boundary
 }
 
 TEST_F(Cli, BadSceneGivesOneMessageAndNoOutput) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -332,6 +333,28 @@ TEST_F(LoadErrors, UnknownKey) {
     // "light" belongs to emissive primitives only.
     expect_error(edit(kBaseScene, R"("material": "red"},)", R"("material": "red", "light": "lamp"},)"),
                  "/scene/primitives/0/light", "unknown key \"light\"");
+}
+
+// The optional display block: tone map and exposure in stops, read as strictly as the rest.
+TEST_F(LoadErrors, DisplayBlockIsOptionalAndStrict) {
+    const LoadedScene plain = load_ok(kBaseScene);
+    EXPECT_EQ(plain.scene.display.tonemap, ToneMap::sigmoid);
+    EXPECT_EQ(plain.scene.display.exposure, 0.0);
+    auto with_display = [](const std::string& block) {
+        return edit(kBaseScene, R"("renderer": {)", R"("display": )" + block + R"(, "renderer": {)");
+    };
+    const LoadedScene loaded = load_ok(with_display(R"({"tonemap": "linear", "exposure": -1.5})"));
+    EXPECT_TRUE(loaded.warnings.empty());
+    EXPECT_EQ(loaded.scene.display.tonemap, ToneMap::linear);
+    EXPECT_EQ(loaded.scene.display.exposure, -1.5);
+    EXPECT_EQ(loaded.scene.display.exposure_scale(), std::exp2(-1.5));
+    expect_error(with_display(R"({"tonemap": "filmic"})"), "/scene/display/tonemap",
+                 "unknown tone map \"filmic\"; expected \"sigmoid\" or \"linear\"");
+    expect_error(with_display(R"({"exposure": 10.5})"), "/scene/display/exposure",
+                 "expected a number of stops in [-10, 10], got 10.5");
+    expect_error(with_display(R"({"exposure": "bright"})"), "/scene/display/exposure", "expected a number");
+    expect_error(with_display(R"({"gamma": 2.2})"), "/scene/display/gamma", "unknown key \"gamma\"");
+    expect_error(with_display("3"), "/scene/display", "display settings");
 }
 
 TEST_F(LoadErrors, DanglingMaterialId) {
