@@ -31,26 +31,36 @@ wid=$(xdotool search --sync --name '^keithray' | head -1)
 wait_for 'state=done' || exit 1
 xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
 # Over the image (left part of the window, clear of the panel and the status bar).
-xdotool mousemove --window "$wid" 250 330 && sleep 0.2
+xdotool mousemove --window "$wid" 250 330
+wait_for 'pointer=250,330' || exit 1
 echo "title=$(xdotool getwindowname "$wid")"
 echo "generation_before=$(field generation)"
 echo "spp_before=$(field spp)"
 
 case $scenario in
 jitter_click)
-    # Press, one pixel of jitter, release: a click, not an orbit.
-    xdotool mousedown 1 mousemove_relative 1 0 mousemove_relative -- -1 1 mouseup 1
+    # Press, one pixel of jitter each way while held, release: a click, not an orbit. Each
+    # step waits until a frame has seen it (the window reads the pointer once per frame).
+    xdotool mousedown 1
+    wait_for 'press=1 pointer=250,330' || exit 1
+    xdotool mousemove_relative 1 0
+    wait_for 'press=1 pointer=251,330' || exit 1
+    xdotool mousemove_relative -- -1 1
+    wait_for 'press=1 pointer=250,331' || exit 1
+    xdotool mouseup 1
+    wait_for 'press=0' || exit 1
     # Then F1 toggles the help: once it shows, every event before it was handled.
     xdotool key F1
     wait_for 'help=1' || exit 1
     ;;
 drag)
     # A real drag past the threshold does orbit (the control for jitter_click).
-    # Held across frames: the window samples the pointer once per frame it draws.
-    xdotool mousedown 1; sleep 0.3
-    xdotool mousemove_relative 30 0; sleep 0.3
-    xdotool mousemove_relative 30 0; sleep 0.3
+    xdotool mousedown 1
+    wait_for 'press=1 pointer=250,330' || exit 1
+    xdotool mousemove_relative 30 0
+    wait_for 'dirty=1' || exit 1
     xdotool mouseup 1
+    wait_for 'press=0' || exit 1
     xdotool key F1
     wait_for 'help=1' || exit 1
     ;;

@@ -42,7 +42,7 @@ void install_input_callbacks(GLFWwindow* w) {
     glfwSetCursorPosCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
     glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int, int, int) { app_of(win)->note_input(); });
     glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
-    glfwSetKeyCallback(w, [](GLFWwindow* win, int, int, int, int) { app_of(win)->note_input(); });
+    glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int) { app_of(win)->note_key(key, action); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
     glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
     glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
@@ -237,10 +237,19 @@ Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
     return out;
 }
 
+void ViewerApp::note_key(int key, int action) {
+    input_seen_ = true;
+    if (action == GLFW_PRESS && key_presses_.size() < 64) key_presses_.push_back(key);
+}
+
 void ViewerApp::handle_input() {
-    if (!model_.has_scene()) return;
+    if (!model_.has_scene()) {
+        key_presses_.clear();
+        return;
+    }
     handle_mouse(image_rect());
     handle_keys();
+    key_presses_.clear();
     // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
     const ImGuiIO& io = ImGui::GetIO();
     const bool holding = io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || ImGui::IsAnyItemActive() ||
@@ -311,7 +320,11 @@ void ViewerApp::handle_mouse(const PixelRect& rect) {
 void ViewerApp::handle_keys() {
     ImGuiIO& io = ImGui::GetIO();
     const auto now = Clock::now();
-    auto pressed = [](int key) { return ImGui::IsKeyPressed(key, false); };
+    // A press this frame, whether ImGui saw the key down or it was released before the frame.
+    auto pressed = [&](int key) {
+        return ImGui::IsKeyPressed(key, false) ||
+               std::find(key_presses_.begin(), key_presses_.end(), key) != key_presses_.end();
+    };
     // Keys that work even while a field has the keyboard: none but these window keys.
     if (pressed(GLFW_KEY_F11)) toggle_fullscreen();
     if (pressed(GLFW_KEY_F1)) help_visible_ = !help_visible_;
@@ -420,11 +433,16 @@ void ViewerApp::update_title() {
 }
 
 void ViewerApp::write_status_file(const RunStatus& status) {
-    char line[256];
-    std::snprintf(line, sizeof line, "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d\n",
+    // press: the left button is down on the image as the last frame saw it; pointer: where
+    // that frame saw the pointer (window points). Scripts wait on these before the next event.
+    const ImGuiIO& io = ImGui::GetIO();
+    char line[320];
+    std::snprintf(line, sizeof line,
+                  "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(help_visible_),
-                  int(panel_visible_));
+                  int(panel_visible_), int(drags_[0].pressed), int(std::lround(io.MousePos.x)),
+                  int(std::lround(io.MousePos.y)));
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);

@@ -176,8 +176,14 @@ private:
     Clock::time_point idle_phase_start_{};
     double idle_cpu_start_ = 0;
 
+    // Keys pressed since the last frame, as GLFW reported them. ImGui 1.86 (Debian 12) keeps
+    // only whether a key is down at each frame, so a press and release between two frames
+    // (a short tap on a busy machine) never shows in ImGui::IsKeyPressed.
+    std::vector<int> key_presses_;
+
 public:
     void note_input() { input_seen_ = true; }
+    void note_key(int key, int action);
     void on_close_request();
 };
 
