@@ -167,3 +167,13 @@ TEST_F(ViewerWindow, EscQuits) {
     ASSERT_EQ(r.count("error"), 0u) << r["error"];
     EXPECT_EQ(r["exit_status"], "0");
 }
+
+// With unsaved edits, Esc asks before quitting: the window is still there, and the F1 sent
+// after it was handled (events are handled in order).
+TEST_F(ViewerWindow, EscWithUnsavedEditsAsksFirst) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "esc_unsaved", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["running_after_esc"], "1");
+    EXPECT_NE(r["generation_after"], r["generation_before"]);  // the held arrow key orbited
+}

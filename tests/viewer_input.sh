@@ -73,8 +73,9 @@ esc)
     xdotool key Escape
     ;;
 esc_unsaved)
-    xdotool keydown Right; sleep 0.3; xdotool keyup Right  # an edit: orbit a little
+    xdotool keydown Right  # an edit: orbit a little, for as long as it takes a frame to see it
     wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
     xdotool key Escape  # asks instead of quitting
     xdotool key F1
     wait_for 'help=1' || exit 1
