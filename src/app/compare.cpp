@@ -166,27 +166,20 @@ int run_compare(int argc, char** argv) {
         auto add = [&](const char* text) { figures += figures.empty() ? text : std::string(", ") + text; };
         const ImageErrors errors = pair_errors(test, reference);
         const double db = psnr(test.rgb8, reference.rgb8);
-        std::snprintf(buf, sizeof buf, "psnr %.2f dB", db);
-        add(buf);
-        if (opt.min_psnr) {
-            agree &= db >= *opt.min_psnr;
-            std::snprintf(buf, sizeof buf, "(min %g)", *opt.min_psnr);
-            figures += std::string(" ") + buf;
-        }
-        std::snprintf(buf, sizeof buf, "rmse %.4g", errors.rmse);
-        add(buf);
-        if (opt.max_rmse) {
-            agree &= errors.rmse <= *opt.max_rmse;
-            std::snprintf(buf, sizeof buf, "(max %g)", *opt.max_rmse);
-            figures += std::string(" ") + buf;
-        }
-        std::snprintf(buf, sizeof buf, "relmse %.4g", errors.relmse);
-        add(buf);
-        if (opt.max_relmse) {
-            agree &= errors.relmse <= *opt.max_relmse;
-            std::snprintf(buf, sizeof buf, "(max %g)", *opt.max_relmse);
-            figures += std::string(" ") + buf;
-        }
+        // One figure, then its threshold where one was given: "rmse 0.01 (max 0.02)".
+        auto figure = [&](const char* name, const char* format, double value, const char* bound_name,
+                          const std::optional<double>& bound, bool within) {
+            std::snprintf(buf, sizeof buf, format, value);
+            add((std::string(name) + " " + buf).c_str());
+            if (!bound) return;
+            agree &= within;
+            std::snprintf(buf, sizeof buf, " (%s %g)", bound_name, *bound);
+            figures += buf;
+        };
+        figure("psnr", "%.2f dB", db, "min", opt.min_psnr, opt.min_psnr && db >= *opt.min_psnr);
+        figure("rmse", "%.4g", errors.rmse, "max", opt.max_rmse, opt.max_rmse && errors.rmse <= *opt.max_rmse);
+        figure("relmse", "%.4g", errors.relmse, "max", opt.max_relmse,
+               opt.max_relmse && errors.relmse <= *opt.max_relmse);
         std::optional<StatisticalResult> stats;
         if (opt.statistical) {
             for (const InputImage* in : {&test, &reference})
