@@ -325,21 +325,29 @@ void ViewerApp::handle_keys() {
         return ImGui::IsKeyPressed(key, false) ||
                std::find(key_presses_.begin(), key_presses_.end(), key) != key_presses_.end();
     };
-    // Keys that work even while a field has the keyboard: none but these window keys.
-    if (pressed(GLFW_KEY_F11)) toggle_fullscreen();
-    if (pressed(GLFW_KEY_F1)) help_visible_ = !help_visible_;
-    if (io.WantTextInput || ImGui::IsAnyItemActive()) {
+    // The window keys, in the order they were pressed: taps that reach one frame together
+    // (a busy machine) act as they would one frame each (F1 then Esc shows and closes the
+    // help; Esc then F1 asks to quit, then shows the help). F1 and F11 work even while a
+    // field has the keyboard.
+    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
+    for (const int key : key_presses_) {
+        if (key == GLFW_KEY_F11) toggle_fullscreen();
+        else if (key == GLFW_KEY_F1) help_visible_ = !help_visible_;
+        else if (typing) continue;
+        else if (key == GLFW_KEY_ESCAPE) {
+            if (help_visible_) help_visible_ = false;
+            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) request_quit();
+        } else if (key == GLFW_KEY_TAB) {
+            panel_visible_ = !panel_visible_;
+        }
+    }
+    if (typing) {
         motion_keys_held_ = false;
         return;
     }
     bool question = false;
     for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
     if (question) help_visible_ = !help_visible_;
-    if (pressed(GLFW_KEY_ESCAPE)) {
-        if (help_visible_) help_visible_ = false;
-        else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) request_quit();
-    }
-    if (pressed(GLFW_KEY_TAB)) panel_visible_ = !panel_visible_;
     if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
         const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
         if (redo ? model_.redo() : model_.undo()) {
