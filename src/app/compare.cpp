@@ -123,6 +123,14 @@ CompareOptions parse_compare(int argc, char** argv) {
     return o;
 }
 
+// A file that could not be read or compared: one line, exit 1. Called in a catch block:
+// running out of memory goes on to main(), which says what there was not enough memory for.
+int failed(const std::exception& e) {
+    if (dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e)) throw;
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+}
+
 }  // namespace
 
 int run_psnr(int argc, char** argv) {
@@ -140,13 +148,8 @@ int run_psnr(int argc, char** argv) {
             std::printf("%.2f\n", psnr(test.rgb8, reference.rgb8));
         }
         return 0;
-    } catch (const std::bad_alloc&) {
-        throw;  // main() says what there was not enough memory for
-    } catch (const std::length_error&) {
-        throw;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
-        return 1;
+        return failed(e);
     }
 }
 
@@ -210,13 +213,8 @@ int run_compare(int argc, char** argv) {
                     show_user_text(opt.reference).c_str(),
                     figures.c_str());
         return agree ? 0 : 1;
-    } catch (const std::bad_alloc&) {
-        throw;  // main() says what there was not enough memory for
-    } catch (const std::length_error&) {
-        throw;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
-        return 1;
+        return failed(e);
     }
 }
 

@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <vector>
 
-#include <stb/stb_easy_font.h>
 
 namespace kr {
 
@@ -40,23 +39,10 @@ struct Canvas {
             rect(x - thickness / 2, y - thickness / 2, x - thickness / 2 + thickness, y - thickness / 2 + thickness, c);
         }
     }
-    // Text at (x, y) (top left), each font unit `scale` pixels; stb_easy_font gives quads.
     void text(double x, double y, const std::string& s, Rgb c, int scale = 2) {
-        std::vector<char> buffer(s.size() * 300 + 64);
-        std::string copy = s;
-        const int quads = stb_easy_font_print(0, 0, copy.data(), nullptr, buffer.data(), int(buffer.size()));
-        const float* v = reinterpret_cast<const float*>(buffer.data());
-        for (int q = 0; q < quads; ++q) {
-            // Four vertices of 16 bytes (x, y, z, colour); corners 0 and 2 are opposite.
-            const float* a = v + q * 16;
-            const float* b = a + 8;
-            rect(int(x + a[0] * scale), int(y + a[1] * scale), int(x + b[0] * scale), int(y + b[1] * scale), c);
-        }
+        draw_text(image, x, y, s, {c.r, c.g, c.b}, scale);
     }
-    static int text_width(const std::string& s, int scale = 2) {
-        std::string copy = s;
-        return stb_easy_font_width(copy.data()) * scale;
-    }
+    static int text_width(const std::string& s, int scale = 2) { return kr::text_width(s, scale); }
 };
 
 std::string decade_label(int exponent) {

@@ -1,7 +1,11 @@
 #include "core/image.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
+
+#include <stb/stb_easy_font.h>
 
 #include "core/text.h"
 
@@ -117,6 +121,31 @@ Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height)
         out.bytes[3 * i] = out.bytes[3 * i + 1] = out.bytes[3 * i + 2] = g;
     }
     return out;
+}
+
+void draw_text(Rgb8Image& image, double x, double y, const std::string& text, const std::array<uint8_t, 3>& colour,
+               double scale) {
+    std::vector<char> buffer(text.size() * 300 + 64);  // stb_easy_font: at most 270 bytes a character
+    std::string copy = text;
+    const int quads = stb_easy_font_print(0, 0, copy.data(), nullptr, buffer.data(), int(buffer.size()));
+    const float* v = reinterpret_cast<const float*>(buffer.data());
+    for (int q = 0; q < quads; ++q) {
+        // Four vertices of 16 bytes (x, y, z, colour); corners 0 and 2 are opposite.
+        const float* a = v + q * 16;
+        const float* b = a + 8;
+        const int x0 = std::max(0, int(x + a[0] * scale)), y0 = std::max(0, int(y + a[1] * scale));
+        const int x1 = std::min(image.width, int(x + b[0] * scale)), y1 = std::min(image.height, int(y + b[1] * scale));
+        for (int py = y0; py < y1; ++py)
+            for (int px = x0; px < x1; ++px) {
+                uint8_t* p = &image.bytes[3 * (size_t(py) * size_t(image.width) + size_t(px))];
+                p[0] = colour[0], p[1] = colour[1], p[2] = colour[2];
+            }
+    }
+}
+
+int text_width(const std::string& text, double scale) {
+    std::string copy = text;
+    return int(stb_easy_font_width(copy.data()) * scale);
 }
 
 double psnr(const Rgb8Image& a, const Rgb8Image& b) {

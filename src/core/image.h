@@ -1,6 +1,7 @@
 // Radiance images, tone mapping, blur, PSNR. Their files: core/image_io.h.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <vector>
@@ -50,6 +51,12 @@ Image box_blur(const Image& src, int radius);
 
 // The brief's depth map: each pixel shows 1 - d/(1+d) as grey.
 Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height);
+
+// Text on an 8-bit image (plot labels, colour bars) with stb_easy_font: `text` with its top
+// left at (x, y), each font unit `scale` pixels, clipped to the image. text_width: its width.
+void draw_text(Rgb8Image& image, double x, double y, const std::string& text, const std::array<uint8_t, 3>& colour,
+               double scale = 2);
+int text_width(const std::string& text, double scale = 2);
 
 // Peak signal-to-noise ratio in dB of two same-sized 8-bit images (99 when identical).
 double psnr(const Rgb8Image& a, const Rgb8Image& b);

@@ -4,7 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -247,50 +246,15 @@ std::array<uint8_t, 3> viridis(double v) {
     return out;
 }
 
-// A 3x5 pixel font for the colour bar's numbers: five rows of three bits, top row first.
-constexpr const char* kGlyphChars = "0123456789.-+e";
-constexpr std::array<std::array<uint8_t, 5>, 14> kGlyphs{{{7, 5, 5, 5, 7},
-                                                         {2, 6, 2, 2, 7},
-                                                         {7, 1, 7, 4, 7},
-                                                         {7, 1, 7, 1, 7},
-                                                         {5, 5, 7, 1, 1},
-                                                         {7, 4, 7, 1, 7},
-                                                         {7, 4, 7, 5, 7},
-                                                         {7, 1, 1, 1, 1},
-                                                         {7, 5, 7, 5, 7},
-                                                         {7, 5, 7, 1, 7},
-                                                         {0, 0, 0, 0, 2},
-                                                         {0, 0, 7, 0, 0},
-                                                         {0, 2, 7, 2, 0},
-                                                         {7, 4, 6, 4, 7}}};
-constexpr int kGlyphScale = 2, kGlyphAdvance = 4 * kGlyphScale;
-
-// Draws `text` in white with its top-left corner at (x, y); characters without a glyph are skipped.
-void draw_text(Rgb8Image& img, int x, int y, const std::string& text) {
-    for (char c : text) {
-        const char* found = std::strchr(kGlyphChars, c);
-        if (found && c != '\0') {
-            const auto& glyph = kGlyphs[size_t(found - kGlyphChars)];
-            for (int row = 0; row < 5 * kGlyphScale; ++row)
-                for (int col = 0; col < 3 * kGlyphScale; ++col) {
-                    const int px = x + col, py = y + row;
-                    if (px < 0 || py < 0 || px >= img.width || py >= img.height) continue;
-                    if (!((glyph[size_t(row / kGlyphScale)] >> (2 - col / kGlyphScale)) & 1)) continue;
-                    uint8_t* p = &img.bytes[3 * (size_t(py) * size_t(img.width) + size_t(px))];
-                    p[0] = p[1] = p[2] = 255;
-                }
-        }
-        x += kGlyphAdvance;
-    }
-}
-
 }  // namespace
 
 Rgb8Image false_colour(const std::vector<float>& error, int width, int height, double scale) {
     if (width <= 0 || height <= 0 || error.size() != size_t(width) * size_t(height))
         throw std::invalid_argument("false_colour: error values do not match the image size");
     // The picture, then under it a gap, the bar and a row of labels, on black.
-    constexpr int kGap = 4, kBar = 12, kLabel = 5 * kGlyphScale, kMargin = 8;
+    // Labels in stb_easy_font at 1.4 pixels a unit: its digits' 7 units fit the 10-pixel row.
+    constexpr int kGap = 4, kBar = 12, kLabel = 10, kMargin = 8;
+    constexpr double kLabelScale = 1.4;
     Rgb8Image img;
     img.width = std::max(width, 160);
     img.height = height + kGap + kBar + kGap + kLabel + kGap;
@@ -310,8 +274,9 @@ Rgb8Image false_colour(const std::vector<float>& error, int width, int height, d
     char label[32];
     std::snprintf(label, sizeof label, "%.3g", scale);
     const int label_top = bar_top + kBar + kGap;
-    draw_text(img, bar_left, label_top, "0");
-    draw_text(img, bar_right - int(std::strlen(label)) * kGlyphAdvance + kGlyphScale, label_top, label);
+    constexpr std::array<uint8_t, 3> kWhite{255, 255, 255};
+    draw_text(img, bar_left, label_top, "0", kWhite, kLabelScale);
+    draw_text(img, bar_right - text_width(label, kLabelScale), label_top, label, kWhite, kLabelScale);
     return img;
 }
 
