@@ -368,7 +368,7 @@ TEST(DisplaySettings, ModelTakesAndSavesTheDisplayBlock) {
     EXPECT_EQ(m.scene_for_saving().display.exposure, 2.25);
     EXPECT_EQ(m.settings().tone.exposure_scale(), std::exp2(2.25));
     // Command-line overrides win over the file.
-    ViewerModel::Overrides o;
+    RenderOptions o;
     o.exposure = 1;
     ViewerModel n;
     n.set_overrides(o);

@@ -27,6 +27,7 @@
 #include "core/image_io.h"
 #include "core/image_hdr.h"
 #include "render/aov.h"
+#include "render/options.h"
 #include "render/render.h"
 #include "scene/load.h"
 #include "viewer/gl_offscreen.h"
@@ -37,7 +38,7 @@ using namespace kr;
 
 namespace {
 
-constexpr const char* kUsage = R"(keithray: a progressive ray tracer for sphere scenes
+constexpr const char* kUsageHead = R"(keithray: a progressive ray tracer for sphere scenes
 
 Usage:
   keithray render [SCENE.json ...] [options]
@@ -54,34 +55,12 @@ With no SCENE, renders every *.json in res/scenes/. Defaults come from each scen
 file's renderer block; the options below override them.
 
 Options:
-  --spp N               samples per pixel, 1..16777216 (default: the file's "samples";
-                        with --time or --noise, an upper bound, else at most 65536 passes)
-  --time SECONDS        render as many passes as fit in SECONDS, in (0, 1e6] (checked
-                        between passes)
-  --noise X             stop when the estimated relative RMS error of the image falls
-                        below X, in [1e-4, 1] (e.g. 0.01); adaptive: passes go to the
-                        noisiest pixels
-  --integrator NAME     wrt | pt | pt-naive (default: the file's renderer type;
-                        pt-naive samples no area light, only point lights)
-  --estimator NAME      where samples come from: uniform | stratified | sobol
-                        (default: sobol, Owen-scrambled Sobol in every dimension;
-                        stratified is the brief's sub-pixel strata; docs/accuracy.md)
-  --allocation NAME     how a pass spreads its samples: adaptive | uniform (default:
-                        adaptive, each pixel's share in proportion to its estimated
-                        noise after 8 passes, the same total; --spp N is then the
-                        mean per pixel; stratified always gets uniform)
-  --light-sampling NAME spherical lights: brief | brief-area | cone | area (default:
-                        brief, the integral of the brief's reference images, importance
-                        sampled; brief-area is the brief's own uniform sampling of it;
-                        cone and area are exact: docs/fidelity.md, docs/accuracy.md)
-  --depth N             maximum ray depth, 0..20 (default: the file's "depth")
-  --tonemap NAME        sigmoid | linear (default: the scene's "display" block, else sigmoid)
-  --exposure EV         exposure in stops, -10..10: radiance x 2^EV before the tone map
-                        (default: the scene's "display" block, else 0)
-  --gl                  tone map through the viewer's GLSL display shaders in an
+)";
+
+// The options only render takes; the shared ones (render/options.h) come before them.
+constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map through the viewer's GLSL display shaders in an
                         offscreen OSMesa framebuffer (no display, no GPU needed)
   --blur R              box blur of radius R pixels on the radiance, 0..4096 (default: 0)
-  --seed N              random seed, 0..2^62 (default: 0); same seed, same image
   --threads N           worker threads, 1..4096 (default: all cores)
   --kernels NAME        how paths are traced: best | double | any | off (default: best,
                         in SIMD lanes where the CPU has AVX2: eight in single precision
@@ -93,6 +72,8 @@ Options:
                         the radiance and OUT-depth.pfm the distances as float PFMs
   -q, --quiet           no progress bar
   -h, --help            this text
+
+With --time or --noise and no --spp, a render stops after at most 65536 passes.
 
 Output: an 8-bit binary PPM (a PNG if the name ends in .png) and, beside it, the depth map
 (1 - d/(1+d)) as NAME-depth.ppm (or .png), both replaced together or neither (a
@@ -108,18 +89,14 @@ Exit status: 0 on success, 1 if a scene failed to load, render or be written (or
 could not be written), 2 on bad usage.
 )";
 
+// keithray's and render's --help: the flags render shares with view from their table.
+std::string usage() { return kUsageHead + shared_flags_help() + kRenderOnlyOptions; }
+
 struct Options {
     std::vector<fs::path> scenes;
-    std::optional<int> spp, depth, threads;
-    double time_limit = 0, noise = 0;  // 0: rule off
-    std::optional<Integrator> integrator;
-    std::optional<Estimator> estimator;
-    std::optional<Allocation> allocation;
-    std::optional<LightSampling> light_sampling;
-    std::optional<ToneMap> tonemap;  // default: the scene's display block
-    std::optional<double> exposure;  // EV stops; default: the scene's display block
+    RenderOptions render;  // the flags view takes too: render/options.h
+    std::optional<int> threads;
     int blur = 0;
-    uint64_t seed = 0;
     std::optional<fs::path> output;
     bool quiet = false;
     bool gl = false;  // tone map on the viewer's display path (OSMesa)
@@ -131,20 +108,11 @@ Options parse_options(int argc, char** argv) {
     for (ArgCursor args(argc, argv); args.next();) {
         const std::string& arg = args.arg();
         auto value = [&] { return args.value(); };
-        if (arg == "--spp") o.spp = int(parse_integer(arg, value(), 1, kMaxSamples));
-        else if (arg == "--time") o.time_limit = parse_number(arg, value(), 0, kMaxSeconds, true);
-        else if (arg == "--noise") o.noise = parse_number(arg, value(), kMinNoise, kMaxNoise);
-        else if (arg == "--depth") o.depth = int(parse_integer(arg, value(), 0, kMaxDepth));
+        if (read_shared_flag(args, o.render)) continue;
+        if (arg == "-h" || arg == "--help") throw UsageError{};
         else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, kMaxThreads));
         else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, kMaxBlur));
-        else if (arg == "--seed") o.seed = uint64_t(parse_integer(arg, value(), 0, kMaxSeed));
-        else if (arg == "--integrator") o.integrator = parse_name(arg, value(), integrator_names);
-        else if (arg == "--estimator") o.estimator = parse_name(arg, value(), estimator_names);
-        else if (arg == "--allocation") o.allocation = parse_name(arg, value(), allocation_names);
-        else if (arg == "--light-sampling") o.light_sampling = parse_name(arg, value(), light_sampling_names);
-        else if (arg == "--tonemap") o.tonemap = parse_name(arg, value(), tonemap_names);
-        else if (arg == "--exposure") o.exposure = parse_number(arg, value(), -kMaxExposureStops, kMaxExposureStops);
         else if (arg == "-o" || arg == "--output") o.output = value();
         else if (arg == "-q" || arg == "--quiet") o.quiet = true;
         else if (arg == "--gl") o.gl = true;
@@ -202,14 +170,8 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     }
     for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
-    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
-    settings.seed = opt.seed;
-    if (opt.spp) settings.target_spp = *opt.spp;
-    if (opt.integrator) settings.integrator = *opt.integrator;
-    if (opt.estimator) settings.estimator = *opt.estimator;
-    if (opt.allocation) settings.allocation = *opt.allocation;
-    if (opt.light_sampling) settings.light_sampling = *opt.light_sampling;
-    if (opt.depth) settings.max_depth = *opt.depth;
+    // The file's renderer and display blocks, then the command line over them.
+    RenderSettings settings = apply_render_options(opt.render, loaded.scene);
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
     // An EXR holds the depth as a layer; every other output has its depth map beside it.
@@ -247,12 +209,12 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     double last_draw = -1;
     StopRule rule;
-    rule.seconds = opt.time_limit;
-    rule.noise = opt.noise;
-    const bool open_ended = opt.time_limit > 0 || opt.noise > 0;
+    rule.seconds = opt.render.stop_seconds;
+    rule.noise = opt.render.stop_noise;
+    const bool open_ended = opt.render.stop_seconds > 0 || opt.render.stop_noise > 0;
     // Without --spp an open-ended render still ends: a noise target the scene cannot reach
     // in reasonable time stops at the cap (core/limits.h).
-    const bool capped = open_ended && !opt.spp;
+    const bool capped = open_ended && !opt.render.spp;
     rule.max_passes = capped ? kMaxOpenEndedPasses : settings.target_spp;
     stage = "rendering a " + image;
     const StopReason reason = render_until(scene, settings, state, rule, [&](const RenderState& s) {
@@ -294,10 +256,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
             files.push_back({depth_output, encode_pfm_gray(std::vector<float>(depth.begin(), depth.end()),
                                                            state.width, state.height)});
         } else {
-            // The scene's display block, then the command line over it.
-            DisplaySettings display = loaded.scene.display;
-            if (opt.tonemap) display.tonemap = *opt.tonemap;
-            if (opt.exposure) display.exposure = *opt.exposure;
+            const DisplaySettings& display = loaded.scene.display;
             const Rgb8Image shown = opt.gl ? viewer::display_offscreen(radiance, display)
                                            : tonemap(radiance, display.tonemap, display.exposure_scale());
             files.push_back({output, encode_image(output, shown)});
@@ -337,7 +296,7 @@ bool stdout_written() {
 int main(int argc, char** argv) {
     const std::string command = argc > 1 ? argv[1] : "";
     if (command == "-h" || command == "--help" || command == "help") {
-        std::fputs(kUsage, stdout);
+        std::fputs(usage().c_str(), stdout);
         return stdout_written() ? 0 : 1;
     }
     if (command == "bench") {
@@ -364,13 +323,17 @@ int main(int argc, char** argv) {
     if (command == "view") return viewer::run_viewer(argc, argv);
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
-                     command.empty() ? "" : quote_user_text(command, 40).c_str(), kUsage);
+                     command.empty() ? "" : quote_user_text(command, 40).c_str(), usage().c_str());
         return 2;
     }
     Options opt;
     try {
         opt = parse_options(argc, argv);
     } catch (const UsageError& e) {
+        if (e.message.empty()) {  // --help
+            std::fputs(usage().c_str(), stdout);
+            return stdout_written() ? 0 : 1;
+        }
         std::fprintf(stderr, "error: %s\nRun 'keithray --help' for the options.\n", e.message.c_str());
         return 2;
     }

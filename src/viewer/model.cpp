@@ -34,17 +34,9 @@ void ViewerModel::load(const std::filesystem::path& file) {
 void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     auto prepared = prepare(scene, &warnings, prepared_.get());  // throws before anything changes
     ViewerSettings settings = settings_;
-    settings.render = RenderSettings::from_scene(scene.renderer);
-    if (overrides_.spp) settings.render.target_spp = *overrides_.spp;
-    if (overrides_.depth) settings.render.max_depth = std::min(*overrides_.depth, kMaxDepth);
-    if (overrides_.integrator) settings.render.integrator = *overrides_.integrator;
-    if (overrides_.estimator) settings.render.estimator = *overrides_.estimator;
-    if (overrides_.allocation) settings.render.allocation = *overrides_.allocation;
-    if (overrides_.light_sampling) settings.render.light_sampling = *overrides_.light_sampling;
-    if (overrides_.seed) settings.render.seed = *overrides_.seed;
+    // The file's renderer and display blocks with the command line over them, as render does.
+    settings.render = apply_render_options(overrides_, scene);
     settings.tone = scene.display;
-    if (overrides_.tonemap) settings.tone.tonemap = *overrides_.tonemap;
-    if (overrides_.exposure) settings.tone.exposure = *overrides_.exposure;
     file_cameras_ = scene.cameras;
     file_camera_ = scene.camera;
     scene_ = std::move(scene);

@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "render/options.h"
 #include "render/render.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
@@ -99,18 +100,9 @@ public:
     // (type, depth, samples) and its display block with the tone map, as it is saved.
     Scene scene_for_saving() const;
 
-    // Settings kept across loads of another file: those given on the command line.
-    struct Overrides {
-        std::optional<int> spp, depth;
-        std::optional<Integrator> integrator;
-        std::optional<Estimator> estimator;
-        std::optional<Allocation> allocation;
-        std::optional<LightSampling> light_sampling;
-        std::optional<uint64_t> seed;
-        std::optional<ToneMap> tonemap;
-        std::optional<double> exposure;  // EV stops
-    };
-    void set_overrides(const Overrides& overrides) { overrides_ = overrides; }
+    // Settings kept across loads of another file: those given on the command line
+    // (render/options.h; the stop rules in it are the caller's).
+    void set_overrides(const RenderOptions& overrides) { overrides_ = overrides; }
 
 private:
     // One undo step: the state before it, and whether going back changes the image.
@@ -129,7 +121,7 @@ private:
     ViewerSettings settings_;
     std::vector<std::string> warnings_;
     uint64_t generation_ = 0;
-    Overrides overrides_;
+    RenderOptions overrides_;
 
     std::vector<State> undo_, redo_;
     std::string open_group_;  // the group the newest undo step may still absorb

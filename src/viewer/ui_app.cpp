@@ -62,11 +62,11 @@ double percentile(std::vector<double> v, double p) {
 }  // namespace
 
 ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)) {
-    model_.set_overrides(options_.overrides);
+    model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
-        s.stop_seconds = options_.stop_seconds;
-        s.stop_noise = options_.stop_noise;
+        s.stop_seconds = options_.render.stop_seconds;
+        s.stop_noise = options_.render.stop_noise;
     });
     try {
         model_.load(options_.scene);

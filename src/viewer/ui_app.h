@@ -18,32 +18,11 @@
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
 #include "viewer/status.h"
+#include "viewer/view_options.h"
 
 struct GLFWwindow;
 
 namespace kr::viewer {
-
-struct ViewOptions {
-    std::filesystem::path scene;
-    ViewerModel::Overrides overrides;
-    bool unlimited = false;
-    double stop_seconds = 0, stop_noise = 0;  // --time, --noise
-    // Scripted mode: edits applied at start, then the run ends by itself.
-    int frames = 0;  // full-resolution passes to accumulate before the screenshot
-    std::optional<std::pair<double, double>> orbit;        // a left drag of (dx, dy) pixels
-    std::optional<std::pair<double, double>> click_focus;  // Ctrl+click at image pixel (x, y)
-    std::optional<double> aperture;                        // thin lens with this radius
-    std::optional<std::filesystem::path> screenshot;       // image region, read back from GL
-    std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
-    std::optional<std::filesystem::path> window_shot;      // the whole window, panels included
-    int measure_latency = 0;  // edits to time, edit to first displayed frame
-    double measure_idle = 0;  // seconds of idle CPU to measure, done and then paused
-    std::optional<std::filesystem::path> status_file;  // the status line, rewritten on change
-    double timeout = 600;     // seconds: a scripted run that gets stuck fails
-    bool scripted() const {
-        return frames > 0 || screenshot || save_scene || measure_latency > 0 || measure_idle > 0;
-    }
-};
 
 class ViewerApp {
 public:

@@ -1,0 +1,90 @@
+#include "viewer/view_options.h"
+
+#include "core/limits.h"
+
+namespace kr::viewer {
+
+namespace {
+
+constexpr const char* kViewUsageHead = R"(keithray view: the interactive viewer
+
+Usage:
+  keithray view [SCENE.json] [options]
+
+Opens SCENE.json (default: res/scenes/assignment_03.json) in a window that refines the
+image pass by pass. The panels on the right edit camera, lens, lights, materials, tone
+map and renderer; any edit that changes the image restarts at once from a
+low-resolution preview. The status bar shows the state, spp, progress and noise. The
+scene file is watched and reloaded when it changes (asking first if there are unsaved
+edits). In the window, F1 or ? lists the keys and mouse controls.
+
+Options (as for render; they stay in force when another scene is opened):
+)";
+
+constexpr const char* kViewOnlyOptions = R"(  --unlimited           keep refining past the target spp
+  -h, --help            this text
+Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run):
+  --aperture A          make the camera a thin lens of aperture radius A
+  --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
+  --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
+  --frames N            accumulate N full-resolution passes (at most the target spp)
+  --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
+  --save-scene OUT.json then save the edited scene
+  --window-shot OUT.ppm and the whole window, panels included (.png: as PNG)
+  --measure-latency N   time N orbit edits from the edit to the first frame on screen
+  --measure-idle S      once done, the process's CPU over S seconds with no input; then
+                        paused (unlimited), the same again; printed as % of a core
+  --status-file FILE    rewrite FILE with the status line (state, spp, target, generation,
+                        unsaved edits) whenever it changes: for scripts driving the window
+  --timeout S           fail a scripted run after S seconds (default 600)
+)";
+
+std::pair<double, double> parse_pair(const std::string& flag, const std::string& text) {
+    const size_t comma = text.find(',');
+    if (comma == std::string::npos) throw UsageError{flag + " expects X,Y, got " + quote_user_text(text, 40)};
+    return {parse_number(flag, text.substr(0, comma), -1e6, 1e6), parse_number(flag, text.substr(comma + 1), -1e6, 1e6)};
+}
+
+}  // namespace
+
+ViewOptions parse_view_options(int argc, char** argv) {
+    ViewOptions o;
+    bool have_scene = false;
+    for (ArgCursor args(argc, argv); args.next();) {
+        const std::string& arg = args.arg();
+        auto value = [&] { return args.value(); };
+        if (read_shared_flag(args, o.render)) continue;
+        if (arg == "-h" || arg == "--help") o.help = true;
+        else if (arg == "--unlimited") o.unlimited = true;
+        else if (arg == "--aperture") o.aperture = parse_number(arg, value(), 0, 1e9);
+        else if (arg == "--orbit") o.orbit = parse_pair(arg, value());
+        else if (arg == "--click-focus") o.click_focus = parse_pair(arg, value());
+        else if (arg == "--frames") o.frames = int(parse_integer(arg, value(), 1, kMaxSamples));
+        else if (arg == "--screenshot") o.screenshot = value();
+        else if (arg == "--save-scene") o.save_scene = value();
+        else if (arg == "--window-shot") o.window_shot = value();
+        else if (arg == "--measure-latency") o.measure_latency = int(parse_integer(arg, value(), 1, 10000));
+        else if (arg == "--measure-idle") o.measure_idle = parse_number(arg, value(), 0.1, 3600);
+        else if (arg == "--status-file") o.status_file = value();
+        else if (arg == "--timeout") o.timeout = parse_number(arg, value(), 1, 1e7);
+        else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
+        else if (have_scene) throw UsageError{"view opens one scene; got a second: " + quote_user_text(arg)};
+        else {
+            o.scene = arg;
+            have_scene = true;
+        }
+    }
+    if (!have_scene) {
+        o.scene = "res/scenes/assignment_03.json";
+#ifdef KEITHRAY_SCENES_DIR
+        std::error_code ec;
+        if (!std::filesystem::exists(o.scene, ec))
+            o.scene = std::filesystem::path(KEITHRAY_SCENES_DIR) / "assignment_03.json";
+#endif
+    }
+    return o;
+}
+
+std::string view_usage() { return kViewUsageHead + shared_flags_help() + kViewOnlyOptions; }
+
+}  // namespace kr::viewer

@@ -1,0 +1,43 @@
+// `keithray view`'s command line, GL-free so that the tests read it as the viewer does:
+// the flags shared with render (render/options.h) and the viewer's own.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "render/options.h"
+
+namespace kr::viewer {
+
+struct ViewOptions {
+    std::filesystem::path scene;
+    RenderOptions render;  // the flags render takes too: kept across loads of another file
+    bool unlimited = false;
+    // Scripted mode: edits applied at start, then the run ends by itself.
+    int frames = 0;  // full-resolution passes to accumulate before the screenshot
+    std::optional<std::pair<double, double>> orbit;        // a left drag of (dx, dy) pixels
+    std::optional<std::pair<double, double>> click_focus;  // Ctrl+click at image pixel (x, y)
+    std::optional<double> aperture;                        // thin lens with this radius
+    std::optional<std::filesystem::path> screenshot;       // image region, read back from GL
+    std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
+    std::optional<std::filesystem::path> window_shot;      // the whole window, panels included
+    int measure_latency = 0;  // edits to time, edit to first displayed frame
+    double measure_idle = 0;  // seconds of idle CPU to measure, done and then paused
+    std::optional<std::filesystem::path> status_file;  // the status line, rewritten on change
+    double timeout = 600;     // seconds: a scripted run that gets stuck fails
+    bool help = false;        // -h, --help
+    bool scripted() const {
+        return frames > 0 || screenshot || save_scene || measure_latency > 0 || measure_idle > 0;
+    }
+};
+
+// Reads the arguments after "view". Throws UsageError (core/args.h) on bad usage.
+// A flag only view takes is one line here, one in view_usage() and a member above.
+ViewOptions parse_view_options(int argc, char** argv);
+
+// `keithray view --help`: the shared flags from their table, then the viewer's own.
+std::string view_usage();
+
+}  // namespace kr::viewer
