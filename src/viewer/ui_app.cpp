@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <sys/resource.h>
-
 #include <GLFW/glfw3.h>
 #include <imgui.h>
 #include <backends/imgui_impl_glfw.h>
@@ -16,6 +14,7 @@
 #include "scene/load.h"
 #include "scene/save.h"
 #include "viewer/navigation.h"
+#include "viewer/script.h"
 
 namespace kr::viewer {
 
@@ -27,13 +26,6 @@ constexpr double kWatchInterval = 0.25;      // seconds between scene-file polls
 constexpr int kSettleFrames = 3;             // frames drawn after input so ImGui's state settles
 constexpr double kErrorFlashSeconds = 3;     // a refused edit shows at the pointer this long
 constexpr int kMinWindowWidth = 640, kMinWindowHeight = 400;
-
-// Process CPU time (all threads), seconds.
-double process_cpu_seconds() {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
 ViewerApp* app_of(GLFWwindow* w) { return static_cast<ViewerApp*>(glfwGetWindowUserPointer(w)); }
 
@@ -53,15 +45,10 @@ void install_input_callbacks(GLFWwindow* w) {
 
 double seconds(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
 
-double percentile(std::vector<double> v, double p) {
-    if (v.empty()) return 0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, size_t(p * double(v.size() - 1) + 0.5))];
-}
-
 }  // namespace
 
-ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)) {
+ViewerApp::ViewerApp(ViewOptions options)
+    : options_(std::move(options)), latency_(options_.measure_latency), idle_(options_.measure_idle) {
     model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
@@ -425,7 +412,7 @@ bool ViewerApp::animating() const {
     if (io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || motion_keys_held_) return true;
     if (!error_.empty() && seconds(Clock::now() - error_time_) < kErrorFlashSeconds) return true;
     // The latency measurement redraws at the frame rate, as while dragging.
-    return options_.measure_latency > 0 && latency_edits_done_ < options_.measure_latency;
+    return latency_.running();
 }
 
 void ViewerApp::update_title() {
@@ -461,8 +448,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
 }
 
 bool ViewerApp::script_step(const PixelRect& rect) {
-    if (seconds(Clock::now() - script_start_) > options_.timeout) {
-        std::fprintf(stderr, "error: scripted run did not finish within %.0f s\n", options_.timeout);
+    if (script_timed_out(options_, script_start_, Clock::now())) {
         script_status_ = 1;
         return true;
     }
@@ -472,46 +458,19 @@ bool ViewerApp::script_step(const PixelRect& rect) {
         return true;
     }
     const bool current = shown_ && shown_->generation == model_.generation();
-    if (options_.measure_latency > 0 && latency_edits_done_ < options_.measure_latency) {
-        const auto now = Clock::now();
-        if (latency_waiting_for_) {
-            // The frame drawn this iteration is the first of the edited generation.
-            if (current) {
-                latencies_.push_back(seconds(now - latency_edit_time_));
-                latency_scales_.push_back(shown_->scale);
-                latency_waiting_for_.reset();
-                ++latency_edits_done_;
-                latency_next_edit_ = now + std::chrono::milliseconds(300);
-            }
-        } else if (current && shown_->scale == 1 && now >= latency_next_edit_) {
-            // An orbit nudge, as a mouse drag would make, while full-resolution passes run.
-            latency_edit_time_ = now;
-            const double dx = (latency_edits_done_ % 2 == 0) ? 4 : -4;
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) { orbit_drag(s.cameras[size_t(s.camera)], dx, 0); });
-            latency_waiting_for_ = model_.generation();
+    if (latency_.running()) {
+        if (const auto dx = latency_.on_frame(Clock::now(), current, current ? shown_->scale : 0)) {
+            edit(Edit::camera, [&](Scene& s, ViewerSettings&) { orbit_drag(s.cameras[size_t(s.camera)], *dx, 0); });
             sync_worker();  // at once, as handle_input's edits are submitted in the same frame
         }
-        if (latency_edits_done_ < options_.measure_latency) return false;
-        std::printf("latency (edit -> first frame of the new image drawn), %zu edits: median %.1f ms, "
-                    "90th percentile %.1f ms, max %.1f ms; coarsest preview: 1/%d\n",
-                    latencies_.size(), 1e3 * percentile(latencies_, 0.5), 1e3 * percentile(latencies_, 0.9),
-                    1e3 * percentile(latencies_, 1.0),
-                    latency_scales_.empty() ? 1 : *std::max_element(latency_scales_.begin(), latency_scales_.end()));
-        std::printf("UI frame interval while rendering: median %.1f ms, 95th percentile %.1f ms, max %.1f ms "
-                    "(%zu frames)\n",
-                    1e3 * percentile(frame_intervals_, 0.5), 1e3 * percentile(frame_intervals_, 0.95),
-                    1e3 * percentile(frame_intervals_, 1.0), frame_intervals_.size());
-        std::printf("UI frame work (events, panels, upload, draw, swap): median %.1f ms, 95th percentile %.1f ms\n",
-                    1e3 * percentile(frame_work_, 0.5), 1e3 * percentile(frame_work_, 0.95));
+        if (latency_.running()) return false;
+        std::fputs(latency_.report().c_str(), stdout);
         std::fflush(stdout);
     }
     // Without an image to write, the latency run is over; an idle run ends in idle_measure_step.
     if (!options_.screenshot && !options_.save_scene && options_.frames == 0) return options_.measure_idle <= 0;
     // The screenshot waits for the render thread, never for time: N whole passes.
-    const int target = model_.settings().render.target_spp;
-    const int needed = options_.frames > 0 ? (model_.settings().unlimited ? options_.frames
-                                                                          : std::min(options_.frames, target))
-                                           : target;
+    const int needed = script_passes_needed(options_, model_.settings());
     if (!(current && shown_->scale == 1 && shown_->spp >= needed)) return false;
     try {
         if (options_.screenshot) {
@@ -575,73 +534,31 @@ bool ViewerApp::draw_frame() {
 
 bool ViewerApp::idle_measure_step() {
     const auto now = Clock::now();
-    if (seconds(now - script_start_) > options_.timeout) {
-        std::fprintf(stderr, "error: scripted run did not finish within %.0f s\n", options_.timeout);
+    if (script_timed_out(options_, script_start_, now)) {
         script_status_ = 1;
         return true;
     }
     if (!model_.has_scene()) return false;  // script_step reports the error
-    // Phases: 0 rendering to the target, 1 settling, 2 measuring (done), 3 settling after
-    // the pause, 4 measuring (paused).
-    const double settle = 1.0;  // seconds between a change of state and its measurement
-    const double elapsed = seconds(now - idle_phase_start_);
-    if (idle_phase_ == 0) {
-        const RunStatus st = run_status(shown_ && shown_->generation == model_.generation() ? shown_.get() : nullptr,
+    const RunStatus status = run_status(shown_ && shown_->generation == model_.generation() ? shown_.get() : nullptr,
                                         model_.settings(), false);
-        if (st.state == RunState::done) {
-            idle_phase_ = 1;
-            idle_phase_start_ = now;
-        }
-        return false;
+    const IdleMeasure::Step step = idle_.step(now, status.state == RunState::done);
+    if (step == IdleMeasure::Step::pause) {
+        edit(Edit::run_control, [](Scene&, ViewerSettings& s) {
+            s.paused = true;
+            s.unlimited = true;
+        });
+        sync_worker();
+        input_seen_ = true;  // draw the new state once
     }
-    if (idle_phase_ == 1 || idle_phase_ == 3) {
-        if (elapsed < settle) return false;
-        idle_cpu_start_ = process_cpu_seconds();
-        idle_phase_start_ = now;
-        ++idle_phase_;
-        return false;
-    }
-    if (elapsed < options_.measure_idle) return false;
-    const double cpu = process_cpu_seconds() - idle_cpu_start_;
-    const bool paused = idle_phase_ == 4;
-    std::printf("idle CPU, %s: %.2f%% of a core over %.1f s\n", paused ? "paused" : "done", 100 * cpu / elapsed, elapsed);
-    std::fflush(stdout);
-    if (paused) return true;
-    // Then paused with unlimited refinement: the render thread waits, the window sleeps.
-    edit(Edit::run_control, [](Scene&, ViewerSettings& s) {
-        s.paused = true;
-        s.unlimited = true;
-    });
-    sync_worker();
-    input_seen_ = true;  // draw the new state once
-    idle_phase_ = 3;
-    idle_phase_start_ = now;
-    return false;
+    return step == IdleMeasure::Step::finished;
 }
 
 int ViewerApp::run() {
     script_start_ = Clock::now();
     if (options_.scripted() && model_.has_scene()) {
         // The scripted edits go through the same functions as the mouse and the panels.
-        if (options_.aperture)
-            edit(Edit::lens, [&](Scene& s, ViewerSettings&) {
-                Camera& cam = s.cameras[size_t(s.camera)];
-                cam.type = CameraType::lens;
-                cam.alpha = *options_.aperture;
-            });
-        if (options_.orbit)
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-                orbit_drag(s.cameras[size_t(s.camera)], options_.orbit->first, options_.orbit->second);
-            });
-        if (options_.click_focus) {
-            const Vec2 film = raster_to_camera(options_.click_focus->first + 0.5, options_.click_focus->second + 0.5,
-                                               model_.scene().renderer.width, model_.scene().renderer.height);
-            if (!model_.focus_at(film.x, film.y)) {
-                std::fprintf(stderr, "error: --click-focus: the ray through that pixel hits nothing\n");
-                return 1;
-            }
-            std::printf("focal distance: %.17g\n", model_.camera().focal_distance);
-        }
+        const bool ok = apply_script_edits(options_, model_, [&](Edit kind, const auto& change) { return edit(kind, change); });
+        if (!ok) return 1;
     }
     last_frame_ = Clock::now();
     settle_frames_ = kSettleFrames;
@@ -667,11 +584,10 @@ int ViewerApp::run() {
         const auto now = Clock::now();
         const double work = seconds(now - frame_start);
         ui_work_ = ui_work_ > 0 ? 0.9 * ui_work_ + 0.1 * work : work;
-        if (shown_ && !shown_->finished && frame_work_.size() < 100000) frame_work_.push_back(work);
         const double interval = seconds(now - last_frame_);
         last_frame_ = now;
         ui_fps_ = 0.9 * ui_fps_ + 0.1 * (interval > 0 ? 1.0 / interval : 0.0);
-        if (shown_ && !shown_->finished && frame_intervals_.size() < 100000) frame_intervals_.push_back(interval);
+        if (shown_ && !shown_->finished) latency_.record_frame(work, interval);
         // Cap the UI rate where swap does not wait for vsync: the render thread needs the cores.
         // A new snapshot ends the wait early (the render thread posts an empty event).
         for (double left = kFrameInterval - seconds(Clock::now() - frame_start); left > 0.001;

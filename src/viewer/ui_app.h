@@ -1,5 +1,6 @@
-// The viewer window: GLFW context, display, ImGui panels, input, and the scripted modes
-// (--frames/--screenshot/--measure-latency) that the tests and docs/viewer.md use.
+// The viewer window: GLFW context, display, ImGui panels and input. The scripted modes
+// (viewer/script.h), the latency measurement (viewer/latency.h) and the save dialog
+// (viewer/save_dialog.h, ui_save.cpp) keep their state and logic in their own files.
 #pragma once
 
 #include <chrono>
@@ -14,9 +15,12 @@
 #include "viewer/files.h"
 #include "viewer/gl_display.h"
 #include "viewer/gl_functions.h"
+#include "viewer/latency.h"
 #include "viewer/model.h"
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
+#include "viewer/save_dialog.h"
+#include "viewer/script.h"
 #include "viewer/status.h"
 #include "viewer/view_options.h"
 
@@ -35,7 +39,6 @@ public:
 
 private:
     using Clock = std::chrono::steady_clock;
-    enum class SaveKind { ppm, png, exr, pfm, scene };
 
     // Steps of one UI frame.
     bool draw_frame();  // true when a scripted run is over
@@ -131,29 +134,21 @@ private:
     int settle_frames_ = 0;  // frames still to draw after input, so ImGui settles
     bool input_seen_ = false;   // set by the GLFW callbacks
     int submitted_target_ = 0;
-    std::string image_path_, png_path_, hdr_path_, scene_path_;
+    SavePaths save_paths_;  // the Save panel's fields
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending_save_;
     std::vector<std::filesystem::path> scene_list_;  // the folders listed (empty: list again)
     std::vector<SceneChoice> scene_choices_;
 
-    // UI frame timing for the Stats panel and --measure-latency.
+    // UI frame timing for the Stats panel.
     double ui_fps_ = 0;
     double ui_work_ = 0;                   // seconds of work per UI frame (smoothed)
-    std::vector<double> frame_work_;       // seconds, while rendering
-    std::vector<double> frame_intervals_;  // seconds, while rendering
     Clock::time_point last_frame_{};
 
-    // Scripted-mode state.
+    // Scripted-mode state (viewer/script.h, viewer/latency.h).
     int script_status_ = 0;
-    int latency_edits_done_ = 0;
-    std::optional<uint64_t> latency_waiting_for_;  // generation whose first frame is awaited
-    Clock::time_point latency_edit_time_{}, latency_next_edit_{};
-    std::vector<double> latencies_;  // seconds
-    std::vector<int> latency_scales_;
+    LatencyMeasure latency_;
     Clock::time_point script_start_{};
-    int idle_phase_ = 0;  // --measure-idle: 0 waiting for done, 1 measuring done, 2 paused wait, 3 measuring paused
-    Clock::time_point idle_phase_start_{};
-    double idle_cpu_start_ = 0;
+    IdleMeasure idle_;
 
     // Keys pressed since the last frame, as GLFW reported them. ImGui 1.86 (Debian 12) keeps
     // only whether a key is down at each frame, so a press and release between two frames

@@ -82,18 +82,6 @@ std::string format_duration(double s) {
 
 }  // namespace
 
-void ViewerApp::reset_save_paths() {
-    if (!model_.has_scene()) return;
-    const Scene& scene = model_.scene();
-    fs::path image = scene.output_path();
-    if (image.empty()) image = "keithray.ppm";
-    image_path_ = image.replace_extension(".ppm").string();
-    png_path_ = fs::path(image).replace_extension(".png").string();
-    hdr_path_ = fs::path(image).replace_extension(".exr").string();
-    const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
-    scene_path_ = (source.parent_path() / (source.stem().string() + "-edited.json")).string();
-}
-
 bool ViewerApp::field(const char* label, double* v, int count, float speed, double lo, double hi, const char* format) {
     const ImGuiID id = ImGui::GetID(label);
     std::vector<double> value(v, v + count);
@@ -525,84 +513,6 @@ void ViewerApp::panel_stats() {
     const double passes_per_second = current && shown_->full_seconds > 0 ? shown_->spp / shown_->full_seconds : 0.0;
     ImGui::Text("%.2f passes/s, non-finite samples dropped: %llu", passes_per_second,
                 static_cast<unsigned long long>(current ? shown_->nonfinite_samples : 0));
-}
-
-void ViewerApp::panel_save() {
-    if (!ImGui::CollapsingHeader("Save", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    const bool full = shown_ && shown_->generation == model_.generation() && shown_->scale == 1;
-    ImGui::InputText("image", &image_path_);
-    ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save PPM")) request_save(SaveKind::ppm, image_path_);
-    ImGui::EndDisabled();
-    ImGui::InputText("png", &png_path_);
-    ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save PNG")) request_save(SaveKind::png, png_path_);
-    ImGui::EndDisabled();
-    // The radiance as floats: OpenEXR (R, G, B) or PFM, the path's extension set to match.
-    ImGui::InputText("hdr", &hdr_path_);
-    ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save EXR")) request_save(SaveKind::exr, fs::path(hdr_path_).replace_extension(".exr"));
-    ImGui::SameLine();
-    if (ImGui::Button("Save PFM")) request_save(SaveKind::pfm, fs::path(hdr_path_).replace_extension(".pfm"));
-    ImGui::EndDisabled();
-    ImGui::InputText("scene", &scene_path_);
-    if (ImGui::Button("Save scene JSON")) request_save(SaveKind::scene, scene_path_);
-    ImGui::TextDisabled("messages appear in the status bar");
-}
-
-void ViewerApp::request_save(SaveKind kind, const fs::path& path) {
-    std::error_code ec;
-    if (fs::exists(path, ec)) {
-        // Never overwrite silently: the popup asks.
-        pending_save_ = std::make_pair(kind, path);
-        ImGui::OpenPopup("Overwrite?");
-        return;
-    }
-    save_now(kind, path);
-}
-
-void ViewerApp::overwrite_popup() {
-    if (!ImGui::BeginPopupModal("Overwrite?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
-    ImGui::Text("%s already exists. Overwrite it?", pending_save_ ? pending_save_->second.string().c_str() : "");
-    if (ImGui::Button("Overwrite")) {
-        if (pending_save_) save_now(pending_save_->first, pending_save_->second);
-        pending_save_.reset();
-        ImGui::CloseCurrentPopup();
-    }
-    ImGui::SameLine();
-    if (ImGui::Button("Cancel")) {
-        pending_save_.reset();
-        status_ = "not saved";
-        ImGui::CloseCurrentPopup();
-    }
-    ImGui::EndPopup();
-}
-
-void ViewerApp::save_now(SaveKind kind, const fs::path& path) {
-    try {
-        if (kind == SaveKind::scene) {
-            save_scene_json(model_.scene_for_saving(), path);
-            model_.mark_saved();  // the edits are in a file now
-            // Saving over the watched file should not read like an outside change.
-            std::error_code ec;
-            if (fs::equivalent(path, watch_.file(), ec)) watch_.acknowledge();
-        } else {
-            if (!shown_ || shown_->scale != 1) throw std::runtime_error("no full-resolution image yet");
-            if (kind == SaveKind::exr || kind == SaveKind::pfm) {
-                const HdrImage hdr = hdr_from_radiance(shown_->radiance);
-                write_file_atomic(path, kind == SaveKind::exr ? encode_exr(hdr) : encode_pfm_rgb(hdr));
-                status_ = "saved " + show_user_text(path.string());
-                return;
-            }
-            const ToneSettings& tone = model_.settings().tone;
-            const Rgb8Image image = tonemap(shown_->radiance, tone.tonemap, tone.exposure_scale());
-            if (kind == SaveKind::ppm) write_ppm(path, image);
-            else write_png(path, image);
-        }
-        status_ = "saved " + show_user_text(path.string());
-    } catch (const std::exception& e) {
-        status_ = std::string("save failed: ") + e.what();
-    }
 }
 
 }  // namespace kr::viewer

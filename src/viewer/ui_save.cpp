@@ -1,0 +1,81 @@
+// The Save panel and its overwrite question (ImGui); what it writes: viewer/save_dialog.h.
+#include <filesystem>
+#include <string>
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include "viewer/save_dialog.h"
+#include "viewer/ui_app.h"
+
+namespace kr::viewer {
+
+namespace fs = std::filesystem;
+
+void ViewerApp::reset_save_paths() {
+    if (model_.has_scene()) save_paths_ = SavePaths::for_scene(model_.scene());
+}
+
+void ViewerApp::panel_save() {
+    if (!ImGui::CollapsingHeader("Save", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const bool full = shown_ && shown_->generation == model_.generation() && shown_->scale == 1;
+    ImGui::InputText("image", &save_paths_.image);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save PPM")) request_save(SaveKind::ppm, save_paths_.image);
+    ImGui::EndDisabled();
+    ImGui::InputText("png", &save_paths_.png);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save PNG")) request_save(SaveKind::png, save_paths_.png);
+    ImGui::EndDisabled();
+    // The radiance as floats: OpenEXR (R, G, B) or PFM, the path's extension set to match.
+    ImGui::InputText("hdr", &save_paths_.hdr);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save EXR")) request_save(SaveKind::exr, fs::path(save_paths_.hdr).replace_extension(".exr"));
+    ImGui::SameLine();
+    if (ImGui::Button("Save PFM")) request_save(SaveKind::pfm, fs::path(save_paths_.hdr).replace_extension(".pfm"));
+    ImGui::EndDisabled();
+    ImGui::InputText("scene", &save_paths_.scene);
+    if (ImGui::Button("Save scene JSON")) request_save(SaveKind::scene, save_paths_.scene);
+    ImGui::TextDisabled("messages appear in the status bar");
+}
+
+void ViewerApp::request_save(SaveKind kind, const fs::path& path) {
+    std::error_code ec;
+    if (fs::exists(path, ec)) {
+        // Never overwrite silently: the popup asks.
+        pending_save_ = std::make_pair(kind, path);
+        ImGui::OpenPopup("Overwrite?");
+        return;
+    }
+    save_now(kind, path);
+}
+
+void ViewerApp::overwrite_popup() {
+    if (!ImGui::BeginPopupModal("Overwrite?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    ImGui::Text("%s already exists. Overwrite it?", pending_save_ ? pending_save_->second.string().c_str() : "");
+    if (ImGui::Button("Overwrite")) {
+        if (pending_save_) save_now(pending_save_->first, pending_save_->second);
+        pending_save_.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+        pending_save_.reset();
+        status_ = "not saved";
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+}
+
+void ViewerApp::save_now(SaveKind kind, const fs::path& path) {
+    try {
+        status_ = save_output(kind, path, model_, shown_.get());
+        // Saving over the watched file should not read like an outside change.
+        std::error_code ec;
+        if (kind == SaveKind::scene && fs::equivalent(path, watch_.file(), ec)) watch_.acknowledge();
+    } catch (const std::exception& e) {
+        status_ = std::string("save failed: ") + e.what();
+    }
+}
+
+}  // namespace kr::viewer

@@ -1,0 +1,133 @@
+// The viewer's scripted runs, latency measurement and save dialog, without a window
+// (viewer/script.h, viewer/latency.h, viewer/save_dialog.h).
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+#include "core/image_io.h"
+#include "scene/load.h"
+#include "test_util.h"
+#include "viewer/latency.h"
+#include "viewer/save_dialog.h"
+#include "viewer/script.h"
+
+namespace {
+
+using namespace kr;
+using namespace kr::viewer;
+using Clock = std::chrono::steady_clock;
+using std::chrono::milliseconds;
+
+ViewerModel scene3() {
+    ViewerModel m;
+    m.load(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_03.json");
+    return m;
+}
+
+// Each edit waits for a full-resolution frame, is timed to the first frame of its image,
+// and the next one waits 300 ms; nudges alternate right and left.
+TEST(LatencyMeasure, TimesEachEditToItsFirstFrame) {
+    LatencyMeasure m(2);
+    const Clock::time_point t0{};
+    EXPECT_TRUE(m.running());
+    EXPECT_FALSE(m.on_frame(t0, true, 4));  // a preview: no edit yet
+    EXPECT_EQ(m.on_frame(t0, true, 1), 4.0);
+    EXPECT_FALSE(m.on_frame(t0 + milliseconds(10), false, 1));      // an older image
+    EXPECT_FALSE(m.on_frame(t0 + milliseconds(20), true, 8));       // the first frame: 20 ms at 1/8
+    EXPECT_FALSE(m.on_frame(t0 + milliseconds(100), true, 1));      // before the spacing
+    EXPECT_EQ(m.on_frame(t0 + milliseconds(400), true, 1), -4.0);
+    EXPECT_FALSE(m.on_frame(t0 + milliseconds(440), true, 2));      // 40 ms at 1/2
+    EXPECT_FALSE(m.running());
+    EXPECT_FALSE(m.on_frame(t0 + milliseconds(900), true, 1));
+    m.record_frame(0.002, 0.016);
+    const std::string report = m.report();
+    EXPECT_NE(report.find("2 edits: median 40.0 ms"), std::string::npos) << report;  // nearest rank of {20, 40}
+    EXPECT_NE(report.find("max 40.0 ms; coarsest preview: 1/8"), std::string::npos) << report;
+    EXPECT_NE(report.find("median 16.0 ms, 95th percentile 16.0 ms, max 16.0 ms (1 frames)"), std::string::npos);
+}
+
+// Done, one second to settle, S seconds measured; then the caller pauses, and the same again.
+TEST(IdleMeasure, MeasuresDoneThenAsksToPauseThenFinishes) {
+    IdleMeasure idle(2);
+    const Clock::time_point t0{};
+    EXPECT_EQ(idle.step(t0, false), IdleMeasure::Step::wait);
+    EXPECT_EQ(idle.step(t0 + milliseconds(100), true), IdleMeasure::Step::wait);   // done: settle
+    EXPECT_EQ(idle.step(t0 + milliseconds(1200), true), IdleMeasure::Step::wait);  // measuring from here
+    EXPECT_EQ(idle.step(t0 + milliseconds(2000), true), IdleMeasure::Step::wait);
+    EXPECT_EQ(idle.step(t0 + milliseconds(3300), true), IdleMeasure::Step::pause);
+    EXPECT_EQ(idle.step(t0 + milliseconds(4400), false), IdleMeasure::Step::wait);  // settled: measuring
+    EXPECT_EQ(idle.step(t0 + milliseconds(5000), false), IdleMeasure::Step::wait);
+    EXPECT_EQ(idle.step(t0 + milliseconds(6500), false), IdleMeasure::Step::finished);
+}
+
+TEST(Script, PassesNeededAndTimeout) {
+    ViewOptions o;
+    ViewerSettings s;
+    s.render.target_spp = 8;
+    EXPECT_EQ(script_passes_needed(o, s), 8);
+    o.frames = 20;
+    EXPECT_EQ(script_passes_needed(o, s), 8);
+    s.unlimited = true;
+    EXPECT_EQ(script_passes_needed(o, s), 20);
+    o.timeout = 5;
+    const Clock::time_point t0{};
+    EXPECT_FALSE(script_timed_out(o, t0, t0 + milliseconds(5000)));
+    EXPECT_TRUE(script_timed_out(o, t0, t0 + milliseconds(5001)));
+}
+
+// The scripted edits go through the edit path given, in order, and a focus click on the
+// image centre of scene 3 makes a lens focused on what it hits.
+TEST(Script, EditsGoThroughTheEditPath) {
+    ViewerModel m = scene3();
+    ViewOptions o;
+    o.aperture = 0.25;
+    o.orbit = std::make_pair(30.0, 0.0);
+    o.click_focus = std::make_pair(m.scene().renderer.width / 2.0, m.scene().renderer.height / 2.0);
+    std::vector<Edit> kinds;
+    const Camera before = m.camera();
+    ASSERT_TRUE(apply_script_edits(o, m, [&](Edit kind, const auto& change) {
+        kinds.push_back(kind);
+        return m.edit(kind, change);
+    }));
+    EXPECT_EQ(kinds, (std::vector<Edit>{Edit::lens, Edit::camera}));
+    EXPECT_EQ(m.camera().type, CameraType::lens);
+    EXPECT_EQ(m.camera().alpha, 0.25);
+    EXPECT_TRUE(m.camera().position.x != before.position.x || m.camera().position.z != before.position.z);
+    EXPECT_GT(m.camera().focal_distance, 0);
+}
+
+class SaveDialog : public kr::test::ScratchDirTest {};
+
+TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
+    ViewerModel m = scene3();
+    const SavePaths paths = SavePaths::for_scene(m.scene());
+    EXPECT_EQ(std::filesystem::path(paths.image).extension(), ".ppm");
+    EXPECT_EQ(std::filesystem::path(paths.png).extension(), ".png");
+    EXPECT_EQ(std::filesystem::path(paths.hdr).extension(), ".exr");
+    EXPECT_EQ(std::filesystem::path(paths.scene).filename(), "assignment_03-edited.json");
+
+    // No full-resolution image yet: nothing written.
+    Snapshot preview;
+    preview.scale = 2;
+    EXPECT_THROW(save_output(SaveKind::ppm, dir / "a.ppm", m, &preview), std::exception);
+    EXPECT_THROW(save_output(SaveKind::png, dir / "a.png", m, nullptr), std::exception);
+    EXPECT_FALSE(std::filesystem::exists(dir / "a.ppm"));
+
+    Snapshot full;
+    full.radiance = Image(4, 3);
+    EXPECT_EQ(save_output(SaveKind::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
+    EXPECT_EQ(read_image(dir / "a.ppm").width, 4);
+    save_output(SaveKind::pfm, dir / "a.pfm", m, &full);
+    EXPECT_TRUE(std::filesystem::exists(dir / "a.pfm"));
+
+    // The scene: written as saved, and the model counts as saved.
+    ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; }));
+    ASSERT_TRUE(m.dirty());
+    save_output(SaveKind::scene, dir / "s.json", m, nullptr);
+    EXPECT_FALSE(m.dirty());
+    EXPECT_EQ(load_scene_file(dir / "s.json").scene.renderer.depth, 2);
+}
+
+}  // namespace
