@@ -110,7 +110,12 @@ void append_wrapped(std::string& out, std::string head, std::string_view text) {
 std::string SharedFlag::range_text() const {
     if (kind == FlagKind::name) return names();
     if (kind == FlagKind::integer) return std::to_string((long long)lo) + ".." + std::to_string((long long)hi);
-    return (lo_open ? "(" : "[") + bound_text(lo) + ", " + bound_text(hi) + "]";
+    std::string text(lo_open ? "(" : "[");
+    text += bound_text(lo);
+    text += ", ";
+    text += bound_text(hi);
+    text += "]";
+    return text;
 }
 
 std::span<const SharedFlag> shared_flags() { return kFlags; }
