@@ -20,6 +20,14 @@ namespace {
 constexpr std::string_view kMagic = "keithray checkpoint\n";
 static_assert(sizeof(Color) == 3 * sizeof(double), "checkpoints store Color as three doubles");
 
+// A name as one word of the key ("x86-64-v3 float lanes" -> "x86-64-v3-float-lanes").
+std::string word(std::string_view name) {
+    std::string w(name);
+    for (char& c : w)
+        if (c == ' ') c = '-';
+    return w;
+}
+
 std::string number(double v) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.17g", v);
@@ -96,14 +104,14 @@ CheckpointKey checkpoint_key(const Scene& scene, const RenderScene& prepared, co
     key.scene = fnv1a(scene_to_json(samples_only));
     key.width = scene.renderer.width;
     key.height = scene.renderer.height;
-    key.settings = "integrator=" + std::string(integrator_names.name(settings.integrator)) +
-                   " estimator=" + std::string(estimator_names.name(settings.estimator)) +
-                   " allocation=" + std::string(allocation_names.name(settings.allocation)) +
-                   " light-sampling=" + std::string(light_sampling_names.name(settings.light_sampling)) +
+    key.settings = "integrator=" + word(integrator_names.name(settings.integrator)) +
+                   " estimator=" + word(estimator_names.name(settings.estimator)) +
+                   " allocation=" + word(allocation_names.name(settings.allocation)) +
+                   " light-sampling=" + word(light_sampling_names.name(settings.light_sampling)) +
                    " depth=" + std::to_string(settings.max_depth) + " spp=" + std::to_string(settings.target_spp) +
                    " rr-depth=" + std::to_string(settings.rr_depth) + " seed=" + std::to_string(settings.seed) +
                    // Single- and double-precision lanes round differently.
-                   " kernels=" + std::string(packet_kernels_names.name(packet_kernels(prepared, settings))) +
+                   " kernels=" + word(packet_kernels_names.name(packet_kernels(prepared, settings))) +
                    " noise=" + number(rule.noise) + " min-samples=" + std::to_string(rule.min_samples) +
                    " adapt-every=" + std::to_string(rule.adapt_every);
     return key;
@@ -172,14 +180,16 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     uint64_t checksum;
     std::memcpy(&checksum, bytes.data() + body.size(), sizeof checksum);
     if (fnv1a(body) != checksum) refuse("checkpoint damaged or truncated (its checksum does not match)");
-    if (r.get<uint64_t>() != expected.scene)
-        refuse("checkpoint of another scene (the scene's content differs from the one rendered then)");
+    const auto scene = r.get<uint64_t>();
     const std::string settings(r.text(r.get<uint32_t>()));
-    if (settings != expected.settings) refuse("checkpoint of other settings: " + first_difference(settings, expected.settings));
     const int width = r.get<int32_t>(), height = r.get<int32_t>();
+    // The size first: it is part of the scene too, and the clearer thing to name.
     if (width != expected.width || height != expected.height)
         refuse("checkpoint of a " + std::to_string(width) + "x" + std::to_string(height) + " image; this render is " +
                std::to_string(expected.width) + "x" + std::to_string(expected.height));
+    if (scene != expected.scene)
+        refuse("checkpoint of another scene (the scene's content differs from the one rendered then)");
+    if (settings != expected.settings) refuse("checkpoint of other settings: " + first_difference(settings, expected.settings));
     RenderState restored(width, height);
     const size_t n = restored.sample_count.size();
     restored.passes = r.get<int32_t>();
