@@ -22,6 +22,8 @@ namespace kr {
 struct RankCost {
     double busy_seconds = 0;     // CPU time spent in render_pass (the rank's share of the work)
     double combine_seconds = 0;  // wall time spent exchanging rows (and waiting for the others)
+    double between_seconds = 0;  // wall time between passes: every rank plans the whole image
+    int exchanges = 0;           // passes after which the statistics were exchanged
     uint64_t rays = 0;
 };
 

@@ -126,6 +126,7 @@ public:
             for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i)
                 state.active[i] = mine && (noise_mask_.empty() || noise_mask_[i]);
         }
+        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
         cpu_start_ = cpu_seconds();
     }
 
@@ -133,13 +134,17 @@ public:
         cost_.busy_seconds += cpu_seconds() - cpu_start_;
         state.active.swap(noise_mask_);
         noise_mask_.clear();
+        ++passes_;
+        pass_end_ = wall_seconds();
         if (!statistics && !always_combine_) return;
-        const double start = wall_seconds();
+        const double start = pass_end_;
         const RowDeal deal{rank_, size_, state.width, state.height};
         deal.exchange(state.radiance_sum, true, mine_, gathered_);
         deal.exchange(state.luminance_sq_sum, true, mine_, gathered_);
         deal.exchange(state.sample_count, true, mine_, gathered_);
-        cost_.combine_seconds += wall_seconds() - start;
+        pass_end_ = wall_seconds();
+        cost_.combine_seconds += pass_end_ - start;
+        ++cost_.exchanges;
     }
 
     bool any(bool stop) override {
@@ -155,7 +160,8 @@ private:
     bool always_combine_;
     std::vector<uint8_t> noise_mask_;
     std::vector<char> mine_, gathered_;  // exchange buffers, kept between passes
-    double cpu_start_ = 0;
+    double cpu_start_ = 0, pass_end_ = 0;
+    int passes_ = 0;
 };
 
 }  // namespace
@@ -209,11 +215,14 @@ int Cluster::any_flags(int flags) const {
 
 std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
     if (!mpi_) return {cost};
-    const double mine[3] = {cost.busy_seconds, cost.combine_seconds, double(cost.rays)};
-    std::vector<double> all(leader() ? 3 * size_t(size_) : 0);
-    MPI_Gather(mine, 3, MPI_DOUBLE, all.data(), 3, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    constexpr int kFields = 5;
+    const double mine[kFields] = {cost.busy_seconds, cost.combine_seconds, cost.between_seconds,
+                                  double(cost.exchanges), double(cost.rays)};
+    std::vector<double> all(leader() ? kFields * size_t(size_) : 0);
+    MPI_Gather(mine, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     std::vector<RankCost> costs;
-    for (size_t r = 0; r < all.size(); r += 3) costs.push_back({all[r], all[r + 1], uint64_t(all[r + 2])});
+    for (size_t r = 0; r < all.size(); r += kFields)
+        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4])});
     return costs;
 }
 

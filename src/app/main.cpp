@@ -228,14 +228,16 @@ bool write_checkpoint(const Cluster& cluster, const fs::path& path, const Checkp
     }
 }
 
-// The per-rank line of the summary: busy time (CPU seconds in render_pass), its spread, the
-// rows' exchange and each rank's Mrays/s.
+// The per-rank line of the summary: busy time (CPU seconds in render_pass), its spread, each
+// rank's Mrays/s, the rows' exchange (the slowest rank's wall time in it, waiting included)
+// and the time between passes (planning, the noise rule: every rank does it for the image).
 void print_rank_costs(const std::vector<RankCost>& costs) {
-    double total = 0, slowest = 0, combine = 0;
+    double total = 0, slowest = 0, combine = 0, between = 0;
     for (const RankCost& c : costs) {
         total += c.busy_seconds;
         slowest = std::max(slowest, c.busy_seconds);
         combine = std::max(combine, c.combine_seconds);
+        between = std::max(between, c.between_seconds);
     }
     const double mean = total / double(costs.size());
     std::string busy, speed;
@@ -246,8 +248,10 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
         std::snprintf(buf, sizeof buf, " %.2f", c.busy_seconds > 0 ? double(c.rays) / c.busy_seconds * 1e-6 : 0.0);
         speed += buf;
     }
-    std::printf("  %zu ranks: busy s%s (slowest %+.1f%% of the mean); Mrays/s per busy s%s; exchange %.2f s\n",
-                costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine);
+    std::printf("  %zu ranks: busy s%s (slowest %+.1f%% of the mean); Mrays/s per busy s%s; exchange %.3f s "
+                "after %d passes; between passes %.3f s\n",
+                costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
+                costs.front().exchanges, between);
 }
 
 // Loads, renders and writes one scene. Returns false (after printing why) on failure.
@@ -415,11 +419,12 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
                          show_progress ? "\n" : "", file.c_str(), state.passes, shown(*opt.checkpoint).c_str());
         return false;
     }
-    const std::vector<RankCost> costs =
-        cluster.distributed() ? cluster.gather(RankCost{hooks ? Cluster::cost(*hooks).busy_seconds : 0,
-                                                        hooks ? Cluster::cost(*hooks).combine_seconds : 0,
-                                                        state.rays - rays_before})
-                              : std::vector<RankCost>{};
+    std::vector<RankCost> costs;
+    if (cluster.distributed()) {
+        RankCost mine = hooks ? Cluster::cost(*hooks) : RankCost{};
+        mine.rays = state.rays - rays_before;
+        costs = cluster.gather(mine);
+    }
     uint64_t total_rays = 0, total_nonfinite = 0;
     cluster.gather_state(state, total_rays, total_nonfinite);
     if (!leader) return true;
