@@ -78,19 +78,20 @@ struct RowDeal {
     template <class T>
     void pack(const std::vector<T>& field, std::vector<char>& out) const {
         const size_t row = size_t(width) * sizeof(T);
-        out.resize(size_t(rows_of(rank)) * row);
-        size_t at = 0;
-        for (int y = rank; y < height; y += size, at += row)
-            std::memcpy(out.data() + at, field.data() + size_t(y) * size_t(width), row);
+        const int rows = rows_of(rank);
+        out.resize(size_t(rows) * row);
+#pragma omp parallel for schedule(static)
+        for (int k = 0; k < rows; ++k)
+            std::memcpy(out.data() + size_t(k) * row, field.data() + size_t(rank + k * size) * size_t(width), row);
     }
     template <class T>
     void unpack(const std::vector<char>& all, const std::vector<int>& offsets, std::vector<T>& field) const {
         const size_t row = size_t(width) * sizeof(T);
-        for (int r = 0; r < size; ++r) {
-            size_t at = size_t(offsets[size_t(r)]) * sizeof(T);
-            for (int y = r; y < height; y += size, at += row)
-                std::memcpy(field.data() + size_t(y) * size_t(width), all.data() + at, row);
-        }
+        // Row y is rank (y mod N)'s row y div N.
+#pragma omp parallel for schedule(static)
+        for (int y = 0; y < height; ++y)
+            std::memcpy(field.data() + size_t(y) * size_t(width),
+                        all.data() + size_t(offsets[size_t(y % size)]) * sizeof(T) + size_t(y / size) * row, row);
     }
     // Every rank's rows of `field` in every rank (all) or in rank 0 only. `mine` and
     // `gathered` are buffers kept between calls: fresh pages cost more than the copy.
@@ -118,13 +119,18 @@ public:
     void before_pass(RenderState& state) override {
         // render_pass skips pixels whose mask entry is 0: this rank's rows of the noise
         // rule's mask (all rows' pixels where there is none).
+        const size_t w = size_t(state.width), pixels = w * size_t(state.height);
+        if (owned_.size() != pixels) {
+            owned_.assign(pixels, 0);
+            for (int y = rank_; y < state.height; y += size_) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
+        }
         noise_mask_.swap(state.active);
-        state.active.resize(size_t(state.width) * size_t(state.height));
-        const size_t w = size_t(state.width);
-        for (int y = 0; y < state.height; ++y) {
-            const bool mine = y % size_ == rank_;
-            for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i)
-                state.active[i] = mine && (noise_mask_.empty() || noise_mask_[i]);
+        if (noise_mask_.empty()) {
+            state.active = owned_;
+        } else {
+            state.active.resize(pixels);
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < pixels; ++i) state.active[i] = owned_[i] & noise_mask_[i];
         }
         if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
         cpu_start_ = cpu_seconds();
@@ -159,6 +165,7 @@ private:
     int rank_, size_;
     bool always_combine_;
     std::vector<uint8_t> noise_mask_;
+    std::vector<uint8_t> owned_;  // 1 on this rank's rows
     std::vector<char> mine_, gathered_;  // exchange buffers, kept between passes
     double cpu_start_ = 0, pass_end_ = 0;
     int passes_ = 0;
