@@ -371,6 +371,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     }
     const uint64_t rays_before = state.rays;
     auto last_checkpoint = std::chrono::steady_clock::now();
+    bool checkpoint_written = false;  // the last attempt succeeded (rank 0)
     struct sigaction previous_int {}, previous_term {};
     if (opt.checkpoint) {
         // SIGINT and SIGTERM end the pass under way, write the checkpoint and stop.
@@ -390,7 +391,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
                                                                      last_checkpoint).count() >= opt.checkpoint_every;
             const int flags = cluster.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
             if (flags) {
-                write_checkpoint(cluster, *opt.checkpoint, key, state);
+                checkpoint_written = write_checkpoint(cluster, *opt.checkpoint, key, state);
                 last_checkpoint = std::chrono::steady_clock::now();
             }
             if (flags & 2) return false;
@@ -414,9 +415,9 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     }
     if (reason == StopReason::cancelled) {
         if (leader)
-            std::fprintf(stderr, "%s%s: stopped by a signal after %d passes; no image written; the checkpoint %s holds "
-                         "them (go on with --resume)\n",
-                         show_progress ? "\n" : "", file.c_str(), state.passes, shown(*opt.checkpoint).c_str());
+            std::fprintf(stderr, "%s%s: stopped by a signal after %d passes; no image written; %s %s\n",
+                         show_progress ? "\n" : "", file.c_str(), state.passes, shown(*opt.checkpoint).c_str(),
+                         checkpoint_written ? "holds them (go on with --resume)" : "could not be written (above)");
         return false;
     }
     std::vector<RankCost> costs;
