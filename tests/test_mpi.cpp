@@ -142,3 +142,13 @@ TEST_F(Mpi, RankKilledLeavesNoImageAndAResumableCheckpoint) {
     EXPECT_EQ(bytes("cut.ppm"), bytes("whole.ppm"));
     EXPECT_EQ(bytes("cut-depth.ppm"), bytes("whole-depth.ppm"));
 }
+
+// --time: the ranks agree after every pass, so they stop after the same one (a rank that
+// went on alone would wait for the others in the next exchange until the timeout).
+TEST_F(Mpi, TimeStopsEveryRankAfterTheSamePass) {
+    scene(6, 32, "scene.json");
+    const test::CommandResult r = here(mpirun(3) + "render scene.json --time 0.5 --spp 1000000 -q -o t.ppm");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.err.find("stopped by --time"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "t.ppm"));
+}
