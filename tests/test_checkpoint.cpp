@@ -208,6 +208,14 @@ TEST_F(CheckpointCli, FlagsAreChecked) {
     const fs::path scene = small_scene(8);
     EXPECT_EQ(cli_here("render '" + scene.string() + "' '" + scene.string() + "' --checkpoint c.ckpt").status, 2);
     EXPECT_EQ(cli_here("render '" + scene.string() + "' --every -1 --checkpoint c.ckpt").status, 2);
+    // The checkpoint never replaces the scene file or an output.
+    const std::string before = test::read_file(scene);
+    const test::CommandResult onto_scene = cli_here("render scene.json -q --checkpoint scene.json --every 0");
+    EXPECT_EQ(onto_scene.status, 1);
+    EXPECT_EQ(onto_scene.err, "error: --checkpoint scene.json would overwrite scene.json; nothing written\n");
+    EXPECT_EQ(test::read_file(scene), before);
+    EXPECT_EQ(cli_here("render scene.json -q -o x.ppm --checkpoint x-depth.ppm").status, 1);
+    EXPECT_FALSE(fs::exists(dir / "x.ppm"));
     const test::CommandResult missing = cli_here("render '" + scene.string() + "' -q --resume nowhere.ckpt");
     EXPECT_EQ(missing.status, 1);
     EXPECT_NE(missing.err.find("nowhere.ckpt"), std::string::npos) << missing.err;

@@ -315,6 +315,16 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
                                  same_file(input, scene_file) ? " itself" : "");
                     overwrites_input = true;
                 }
+    // The checkpoint is written during the render: never over a scene file or an output.
+    std::vector<fs::path> kept = opt.scenes;
+    kept.insert(kept.end(), outputs.begin(), outputs.end());
+    if (leader && opt.checkpoint)
+        for (const fs::path& other : kept)
+            if (!overwrites_input && same_file(*opt.checkpoint, other)) {
+                std::fprintf(stderr, "error: --checkpoint %s would overwrite %s; nothing written\n",
+                             shown(*opt.checkpoint).c_str(), shown(other).c_str());
+                overwrites_input = true;
+            }
     if (cluster.broadcast(overwrites_input)) return false;
 
     // Refused before allocating when the render cannot fit in the memory the process may use
