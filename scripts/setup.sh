@@ -11,6 +11,8 @@ packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           libembree-dev
           # PNG reading and writing (src/core/image_io.cpp)
           libstb-dev
+          # Open MPI: one render shared by many processes (mpirun -np N keithray render)
+          libopenmpi-dev openmpi-bin
           # the viewer (keithray view) and its offscreen display (render --gl), and
           # the X server its window tests run under, with xdotool for real input events
           libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev xvfb xdotool xauth

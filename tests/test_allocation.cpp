@@ -16,6 +16,8 @@ using namespace kr;
 
 namespace {
 
+using kr::test::brief_scene;
+
 // A state of `passes` samples per pixel whose luminance has variance 1 on the right half and
 // 0 on the left half of a w x h image (grey samples: luminance = the channel value).
 RenderState two_halves(int w, int h, int passes) {
@@ -37,12 +39,6 @@ RenderSettings adaptive_settings() {
     s.allocation = Allocation::adaptive;
     s.estimator = Estimator::sobol;
     return s;
-}
-
-Scene brief_scene(int n, int size) {
-    Scene scene = load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene;
-    scene.renderer.width = scene.renderer.height = size;
-    return scene;
 }
 
 double mean_squared_error(const Image& a, const Image& b) {

@@ -53,7 +53,7 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
     EXPECT_EQ(r.status, 0);
     for (const char* flag : {"render", "--spp", "--integrator", "wrt", "pt-naive", "--estimator", "uniform",
                              "stratified", "--tonemap", "sigmoid", "linear", "--blur", "--seed", "--threads", "-o",
-                             "--light-sampling", "--depth", "psnr"})
+                             "--light-sampling", "--depth", "psnr", "--checkpoint", "--every", "--resume", "mpirun"})
         EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
 }
 

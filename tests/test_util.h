@@ -92,6 +92,13 @@ protected:
     }
 };
 
+// Scene `n` of the brief (res/scenes/assignment_0n.json) at size x size pixels.
+inline Scene brief_scene(int n, int size) {
+    Scene scene = load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene;
+    scene.renderer.width = scene.renderer.height = size;
+    return scene;
+}
+
 // The relative tolerance of a render's analytic value: the rounding of the single-precision
 // lanes where they trace the scene (packet_kernels), else double's.
 inline double analytic_tolerance(const RenderScene& scene, const RenderSettings& settings) {

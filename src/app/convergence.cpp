@@ -20,6 +20,7 @@
 #include "app/plot.h"
 #include "app/progress.h"
 #include "core/args.h"
+#include "core/hash.h"
 #include "core/image_io.h"
 #include "render/render.h"
 #include "scene/load.h"
@@ -181,11 +182,6 @@ struct Reference {
     std::vector<double> luminance_variance;
     Rgb8Image display;  // sigmoid tone map, as the product writes it
 };
-
-uint64_t fnv1a(const std::string& bytes, uint64_t h = 0xcbf29ce484222325ull) {
-    for (unsigned char c : bytes) h = (h ^ c) * 0x100000001b3ull;
-    return h;
-}
 
 std::string hex(uint64_t v) {
     char buf[24];

@@ -1,6 +1,7 @@
 // keithray: the headless command-line program. A thin loop over the core library.
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <chrono>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <unistd.h>
 
 #include "app/bench.h"
+#include "app/cluster.h"
 #include "app/compare.h"
 #include "app/progress.h"
 #include "core/args.h"
@@ -27,6 +29,7 @@
 #include "core/image_io.h"
 #include "core/image_hdr.h"
 #include "render/aov.h"
+#include "render/checkpoint.h"
 #include "render/options.h"
 #include "render/render.h"
 #include "scene/load.h"
@@ -70,6 +73,13 @@ constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map t
                         (only with a single scene); OUT.png writes PNGs instead;
                         OUT.exr one OpenEXR with the radiance and its layers; OUT.pfm
                         the radiance and OUT-depth.pfm the distances as float PFMs
+  --checkpoint FILE     write the render state to FILE (atomically) at most every
+                        --every seconds and on SIGINT/SIGTERM, which then end the
+                        render without an image (only with a single scene)
+  --every SECONDS       seconds between checkpoints, 0..1e6 (default: 60; 0: every pass)
+  --resume FILE         go on from checkpoint FILE: the image is byte for byte the one
+                        of an uninterrupted render; refused for another scene, other
+                        settings or another size
   -q, --quiet           no progress bar
   -h, --help            this text
 
@@ -83,6 +93,8 @@ the ray missed), albedo.R/G/B and normal.X/Y/Z (first non-specular hit of the pi
 centre's ray), samples (per pixel) and variance.R/G/B (of the mean; left out with
 --blur); NAME.pfm the radiance and NAME-depth.pfm the distances, both or neither.
 One summary line per scene on stdout: spp, seconds, Mrays/s.
+Under mpirun (or srun) the ranks share each render and rank 0 writes; the summary adds
+each rank's busy time and Mrays/s (README.md, "Rendering on many machines").
 A render whose memory estimate exceeds the machine's (or ulimit -v's) memory is refused;
 scene files are at most 64 MiB (README.md, "Limits").
 Exit status: 0 on success, 1 if a scene failed to load, render or be written (or stdout
@@ -101,6 +113,8 @@ struct Options {
     bool quiet = false;
     bool gl = false;  // tone map on the viewer's display path (OSMesa)
     PacketIsa kernels = PacketIsa::best;
+    std::optional<fs::path> checkpoint, resume;
+    double checkpoint_every = 60;
 };
 
 Options parse_options(int argc, char** argv) {
@@ -114,6 +128,9 @@ Options parse_options(int argc, char** argv) {
         else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, kMaxBlur));
         else if (arg == "-o" || arg == "--output") o.output = value();
+        else if (arg == "--checkpoint") o.checkpoint = value();
+        else if (arg == "--every") o.checkpoint_every = parse_number(arg, value(), 0, kMaxSeconds);
+        else if (arg == "--resume") o.resume = value();
         else if (arg == "-q" || arg == "--quiet") o.quiet = true;
         else if (arg == "--gl") o.gl = true;
         else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
@@ -121,6 +138,8 @@ Options parse_options(int argc, char** argv) {
     }
     if (o.output && o.scenes.size() != 1)
         throw UsageError{"-o needs exactly one scene file (it names a single output)"};
+    if ((o.checkpoint || o.resume) && o.scenes.size() != 1)
+        throw UsageError{"--checkpoint and --resume need exactly one scene file (a checkpoint holds one render)"};
     if (o.gl && o.output && (is_exr_path(*o.output) || is_pfm_path(*o.output)))
         throw UsageError{"--gl tone maps for an 8-bit output; an .exr or .pfm output is not tone mapped"};
     return o;
@@ -151,24 +170,90 @@ bool out_of_memory(const std::exception& e) {
     return dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e);
 }
 
+// The signal (SIGINT, SIGTERM) that asked a checkpointed render to stop, else 0.
+volatile std::sig_atomic_t g_stop_signal = 0;
+extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
+
+// Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
+// why where it could not be written; the previous checkpoint then stays as it was.
+bool write_checkpoint(const Cluster& cluster, const fs::path& path, const CheckpointKey& key, RenderState& state) {
+    uint64_t rays = 0, nonfinite = 0;
+    cluster.gather_state(state, rays, nonfinite);
+    if (!cluster.leader()) return true;
+    // The job's counts in the file; this rank's own stay in the state it goes on with.
+    const uint64_t own_rays = state.rays, own_nonfinite = state.nonfinite_samples;
+    state.rays = rays;
+    state.nonfinite_samples = nonfinite;
+    const std::string bytes = encode_checkpoint(key, state);
+    state.rays = own_rays;
+    state.nonfinite_samples = own_nonfinite;
+    try {
+        write_file_atomic(path, bytes);
+        return true;
+    } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "warning: checkpoint not written: %s\n", e.what());
+        return false;
+    }
+}
+
+// The per-rank line of the summary: busy time (CPU seconds in render_pass), its spread, each
+// rank's Mrays/s, the rows' exchange (the slowest rank's wall time in it, waiting included)
+// and the time between passes (planning, the noise rule: every rank does it for the image).
+void print_rank_costs(const std::vector<RankCost>& costs) {
+    double total = 0, slowest = 0, combine = 0, between = 0;
+    for (const RankCost& c : costs) {
+        total += c.busy_seconds;
+        slowest = std::max(slowest, c.busy_seconds);
+        combine = std::max(combine, c.combine_seconds);
+        between = std::max(between, c.between_seconds);
+    }
+    const double mean = total / double(costs.size());
+    std::string busy, speed;
+    for (const RankCost& c : costs) {
+        char buf[64];
+        std::snprintf(buf, sizeof buf, " %.2f", c.busy_seconds);
+        busy += buf;
+        std::snprintf(buf, sizeof buf, " %.2f", c.busy_seconds > 0 ? double(c.rays) / c.busy_seconds * 1e-6 : 0.0);
+        speed += buf;
+    }
+    std::printf("  %zu ranks: busy s%s (slowest %+.1f%% of the mean); Mrays/s per busy s%s; exchange %.3f s "
+                "after %d passes; between passes %.3f s\n",
+                costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
+                costs.front().exchanges, between);
+}
+
 // Loads, renders and writes one scene. Returns false (after printing why) on failure.
 // `stage` says what the work in progress needs memory for, for the caller's message.
-bool render_scene_file(const fs::path& scene_file, const Options& opt, std::string& stage) {
+// Under MPI every rank runs it: rank 0 reads the scene and the checkpoint and sends their
+// bytes, every rank renders its rows, rank 0 gathers the state and writes.
+bool render_scene_file(const fs::path& scene_file, const Options& opt, std::string& stage, const Cluster& cluster) {
     const std::string file = shown(scene_file);
+    const bool leader = cluster.leader();
     LoadedScene loaded;
     RenderScene scene;
     std::vector<std::string> warnings;
     try {
         stage = "the scene";
-        loaded = load_scene_file(scene_file);
+        std::string text;
+        bool read = true;
+        if (leader) try {
+                text = read_scene_text(scene_file);
+            } catch (const SceneError& e) {
+                std::fprintf(stderr, "error: %s\n", e.what());
+                read = false;
+            }
+        if (!cluster.broadcast(read)) return false;
+        cluster.broadcast(text);
+        loaded = parse_scene(text, scene_file);
         warnings = loaded.warnings;
         stage = "the prepared scene and its BVH";
         scene = prepare_scene(loaded.scene, &warnings);
     } catch (const SceneError& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        if (leader) std::fprintf(stderr, "error: %s\n", e.what());
         return false;
     }
-    for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    if (leader)
+        for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
 
     // The file's renderer and display blocks, then the command line over them.
     RenderSettings settings = apply_render_options(opt.render, loaded.scene);
@@ -181,30 +266,45 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     if (!exr) outputs.push_back(depth_output);
     // No input of this command is ever overwritten: not this scene file, nor another one
     // still to be rendered (nor one already rendered).
-    for (const fs::path& input : opt.scenes)
-        for (const fs::path& written : outputs)
-            if (same_file(written, input)) {
-                std::fprintf(stderr, "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
-                             file.c_str(), shown(written).c_str(), shown(input).c_str(),
-                             same_file(input, scene_file) ? " itself" : "");
-                return false;
+    bool overwrites_input = false;
+    if (leader)  // the rank that writes
+        for (const fs::path& input : opt.scenes)
+            for (const fs::path& written : outputs)
+                if (!overwrites_input && same_file(written, input)) {
+                    std::fprintf(stderr,
+                                 "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
+                                 file.c_str(), shown(written).c_str(), shown(input).c_str(),
+                                 same_file(input, scene_file) ? " itself" : "");
+                    overwrites_input = true;
+                }
+    // The checkpoint is written during the render: never over a scene file or an output.
+    std::vector<fs::path> kept = opt.scenes;
+    kept.insert(kept.end(), outputs.begin(), outputs.end());
+    if (leader && opt.checkpoint)
+        for (const fs::path& other : kept)
+            if (!overwrites_input && same_file(*opt.checkpoint, other)) {
+                std::fprintf(stderr, "error: --checkpoint %s would overwrite %s; nothing written\n",
+                             shown(*opt.checkpoint).c_str(), shown(other).c_str());
+                overwrites_input = true;
             }
+    if (cluster.broadcast(overwrites_input)) return false;
 
     // Refused before allocating when the render cannot fit in the memory the process may use
     // (core/memory.h): better at once than after hours, or by the kernel's OOM killer.
     const int width = scene.renderer.width, height = scene.renderer.height;
     const std::string image = std::to_string(width) + "x" + std::to_string(height) + " image";
     const uint64_t needed = render_memory_bytes(width, height, opt.blur > 0);
-    if (const MemoryLimit limit = memory_limit(); needed > limit.bytes) {
-        std::fprintf(stderr, "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)\n",
+    const MemoryLimit limit = memory_limit();
+    if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
+        std::fprintf(stderr, "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)%s\n",
                      file.c_str(), image.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
-                     format_bytes(limit.bytes).c_str());
-        return false;
-    }
+                     format_bytes(limit.bytes).c_str(),
+                     cluster.distributed() ? (" on rank " + std::to_string(cluster.rank())).c_str() : "");
+    if (cluster.any_flags(needed > limit.bytes)) return false;
     stage = "the render state of a " + image;
     RenderState state;
     state.reset(width, height);
-    const bool show_progress = !opt.quiet && ::isatty(STDERR_FILENO);
+    const bool show_progress = leader && !opt.quiet && ::isatty(STDERR_FILENO);
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     double last_draw = -1;
@@ -216,8 +316,58 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     // in reasonable time stops at the cap (core/limits.h).
     const bool capped = open_ended && !opt.render.spp;
     rule.max_passes = capped ? kMaxOpenEndedPasses : settings.target_spp;
+
+    const CheckpointKey key = checkpoint_key(loaded.scene, scene, settings, rule);
+    if (opt.resume) {
+        stage = "the checkpoint of a " + image;
+        std::string bytes, error;
+        if (leader) try {
+                bytes = read_checkpoint_file(*opt.resume, key);
+            } catch (const std::runtime_error& e) {
+                error = e.what();
+            }
+        // Every rank decodes rank 0's bytes and so comes to the same verdict; rank 0 says it.
+        if (error.empty()) {
+            cluster.broadcast(bytes);
+            try {
+                decode_checkpoint(bytes, *opt.resume, key, state);
+            } catch (const std::runtime_error& e) {
+                error = e.what();
+            }
+        }
+        if (cluster.broadcast(!error.empty())) {
+            if (leader) std::fprintf(stderr, "error: --resume %s; nothing rendered\n", error.c_str());
+            return false;
+        }
+        if (!leader) state.rays = state.nonfinite_samples = 0;  // counted once, at rank 0
+    }
+    const uint64_t rays_before = state.rays;
+    auto last_checkpoint = std::chrono::steady_clock::now();
+    bool checkpoint_written = false;  // the last attempt succeeded (rank 0)
+    struct sigaction previous_int {}, previous_term {};
+    if (opt.checkpoint) {
+        // SIGINT and SIGTERM end the pass under way, write the checkpoint and stop.
+        struct sigaction stop {};
+        stop.sa_handler = on_stop_signal;
+        sigemptyset(&stop.sa_mask);
+        ::sigaction(SIGINT, &stop, &previous_int);
+        ::sigaction(SIGTERM, &stop, &previous_term);
+    }
+    const std::unique_ptr<PassHooks> hooks = cluster.deal_rows(open_ended);
+
     stage = "rendering a " + image;
     const StopReason reason = render_until(scene, settings, state, rule, [&](const RenderState& s) {
+        if (opt.checkpoint) {
+            // One decision for every rank: rank 0's clock, any rank's signal.
+            const bool due = leader && std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                                     last_checkpoint).count() >= opt.checkpoint_every;
+            const int flags = cluster.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
+            if (flags) {
+                checkpoint_written = write_checkpoint(cluster, *opt.checkpoint, key, state);
+                last_checkpoint = std::chrono::steady_clock::now();
+            }
+            if (flags & 2) return false;
+        }
         if (show_progress && elapsed() - last_draw > 0.1) {
             if (open_ended) {
                 std::fprintf(stderr, "\r  %d passes  %s  est. error %.4f   ", s.passes, format_seconds(elapsed()).c_str(),
@@ -230,7 +380,29 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
             last_draw = elapsed();
         }
         return true;
-    });
+    }, hooks.get());
+    if (opt.checkpoint) {
+        ::sigaction(SIGINT, &previous_int, nullptr);
+        ::sigaction(SIGTERM, &previous_term, nullptr);
+    }
+    if (reason == StopReason::cancelled) {
+        if (leader)
+            std::fprintf(stderr, "%s%s: stopped by a signal after %d passes; no image written; %s %s\n",
+                         show_progress ? "\n" : "", file.c_str(), state.passes, shown(*opt.checkpoint).c_str(),
+                         checkpoint_written ? "holds them (go on with --resume)" : "could not be written (above)");
+        return false;
+    }
+    std::vector<RankCost> costs;
+    if (cluster.distributed()) {
+        RankCost mine = hooks ? Cluster::cost(*hooks) : RankCost{};
+        mine.rays = state.rays - rays_before;
+        costs = cluster.gather(mine);
+    }
+    uint64_t total_rays = 0, total_nonfinite = 0;
+    cluster.gather_state(state, total_rays, total_nonfinite);
+    if (!leader) return true;
+    state.rays = total_rays;
+    state.nonfinite_samples = total_nonfinite;
     const double seconds = elapsed();
     if (open_ended) {
         const std::string by = reason == StopReason::noise ? "--noise"
@@ -275,8 +447,9 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     std::printf("%s: %dx%d %s %d spp, %.2f s, %.1f Mrays/s (%.1f M rays) -> %s\n",
                 shown(scene_file.filename()).c_str(), state.width, state.height,
                 std::string(integrator_names.name(settings.integrator)).c_str(), state.passes, seconds,
-                seconds > 0 ? double(state.rays) / seconds * 1e-6 : 0.0, double(state.rays) * 1e-6,
+                seconds > 0 ? double(state.rays - rays_before) / seconds * 1e-6 : 0.0, double(state.rays) * 1e-6,
                 shown(output).c_str());
+    if (!costs.empty()) print_rank_costs(costs);
     std::fflush(stdout);
     return true;
 }
@@ -326,23 +499,39 @@ int main(int argc, char** argv) {
                      command.empty() ? "" : quote_user_text(command, 40).c_str(), usage().c_str());
         return 2;
     }
+    // Under mpirun or srun, this process is one rank of the job (app/cluster.h); every rank
+    // parses the same command line, and rank 0 alone speaks for them.
+    std::optional<Cluster> joined;
+    try {
+        joined.emplace(argc, argv);
+    } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        return 1;
+    }
+    const Cluster& cluster = *joined;
     Options opt;
     try {
         opt = parse_options(argc, argv);
     } catch (const UsageError& e) {
         if (e.message.empty()) {  // --help
-            std::fputs(usage().c_str(), stdout);
+            if (cluster.leader()) std::fputs(usage().c_str(), stdout);
             return stdout_written() ? 0 : 1;
         }
-        std::fprintf(stderr, "error: %s\nRun 'keithray --help' for the options.\n", e.message.c_str());
+        if (cluster.leader()) std::fprintf(stderr, "error: %s\nRun 'keithray --help' for the options.\n", e.message.c_str());
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
     set_packet_isa(opt.kernels);
     if (opt.scenes.empty()) {
-        opt.scenes = default_scenes();
+        // Rank 0's list of the bundled scenes, in every rank.
+        std::string names;
+        if (cluster.leader())
+            for (const fs::path& scene : default_scenes()) names += scene.string() + '\0';
+        cluster.broadcast(names);
+        for (size_t at = 0, end; (end = names.find('\0', at)) != std::string::npos; at = end + 1)
+            opt.scenes.emplace_back(names.substr(at, end - at));
         if (opt.scenes.empty()) {
-            std::fprintf(stderr, "error: no scene given and no res/scenes/*.json found\n");
+            if (cluster.leader()) std::fprintf(stderr, "error: no scene given and no res/scenes/*.json found\n");
             return 2;
         }
     }
@@ -350,14 +539,20 @@ int main(int argc, char** argv) {
     for (const fs::path& scene : opt.scenes) {
         std::string stage;
         try {
-            ok = render_scene_file(scene, opt, stage) && ok;
+            ok = render_scene_file(scene, opt, stage, cluster) && ok;
         } catch (const std::exception& e) {
             if (out_of_memory(e))
                 std::fprintf(stderr, "error: %s: not enough memory for %s\n", shown(scene).c_str(), stage.c_str());
             else
                 std::fprintf(stderr, "error: %s: %s\n", shown(scene).c_str(), e.what());
             ok = false;
+            // The other ranks wait for this one in the next exchange: end the job.
+            if (cluster.distributed()) cluster.abort(1);
         }
+        if (g_stop_signal) break;  // a checkpointed render stopped by a signal: no further scene
     }
-    return stdout_written() && ok ? 0 : 1;
+    // Every rank exits with the same status.
+    ok = cluster.any_flags(!(stdout_written() && ok)) == 0;
+    if (g_stop_signal) return 128 + int(g_stop_signal);
+    return ok ? 0 : 1;
 }

@@ -320,20 +320,32 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     return true;
 }
 
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
+    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
+           state.passes >= kAllocationWarmup;
+}
+
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
-                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass) {
+                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass,
+                        PassHooks* hooks) {
     const auto start = std::chrono::steady_clock::now();
-    for (int pass = 0; pass < rule.max_passes; ++pass) {
+    while (state.passes < rule.max_passes) {
         state.plan_pass(settings);
+        if (hooks) hooks->before_pass(state);
         render_pass(scene, settings, state);
+        const int passes = state.passes;
+        const bool noise_check =
+            rule.noise > 0 && passes >= int(rule.min_samples) && passes % rule.adapt_every == 0;
+        if (hooks) hooks->after_pass(state, noise_check || plan_reads_statistics(settings, state));
         if (on_pass && !on_pass(state)) return StopReason::cancelled;
-        if (rule.noise > 0 && pass + 1 >= int(rule.min_samples) && (pass + 1) % rule.adapt_every == 0) {
+        if (noise_check) {
             if (state.relative_error() <= rule.noise) return StopReason::noise;
             // Every pixel within its share means the whole image is within the target too.
             if (state.update_adaptive(rule.noise, rule.min_samples) == 0) return StopReason::noise;
         }
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (rule.seconds > 0 && elapsed >= rule.seconds) return StopReason::time;
+        const bool time_up = rule.seconds > 0 && elapsed >= rule.seconds;
+        if (hooks ? hooks->any(time_up) : time_up) return StopReason::time;
     }
     return StopReason::passes;
 }

@@ -139,10 +139,33 @@ struct StopRule {
 
 enum class StopReason { passes, time, noise, cancelled };
 
-// Runs passes until a rule stops it. `on_pass`, if given, is called after each pass and
-// may return false to cancel.
+// The driver's extension points for a render shared by several processes (app/cluster.h
+// deals pixels to MPI ranks through them). Each pixel's samples are drawn by one process in
+// the single-process order, so the sums are those of one process, bit for bit.
+class PassHooks {
+public:
+    virtual ~PassHooks() = default;
+    // After plan_pass, before render_pass: narrows the pass to this process's pixels.
+    virtual void before_pass(RenderState& state) = 0;
+    // After render_pass: undoes before_pass; when `statistics`, the next step reads the whole
+    // image's statistics (plan_pass, update_adaptive, relative_error), so every process must
+    // then hold every pixel's radiance_sum, luminance_sq_sum and sample_count.
+    virtual void after_pass(RenderState& state, bool statistics) = 0;
+    // One stop decision for all processes: whether any of them says `stop` (e.g. --time).
+    virtual bool any(bool stop) = 0;
+};
+
+// Whether plan_pass reads the image's statistics for the next pass (adaptive allocation
+// after its warm-up).
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state);
+
+// Runs passes until a rule stops it: state.passes counts towards rule.max_passes, so a state
+// restored from a checkpoint (render/checkpoint.h) goes on as if never stopped. `on_pass`,
+// if given, is called after each pass and may return false to cancel; `hooks` spread the
+// passes over processes.
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
-                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass = {});
+                        const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass = {},
+                        PassHooks* hooks = nullptr);
 
 // The camera's image coordinates in [0,1]^2 of a point (x, y) of the raster, where pixel
 // (i, j) spans [i, i+1) x [j, j+1), top row first. The brief's references put each pixel half

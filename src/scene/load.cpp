@@ -868,7 +868,7 @@ LoadedScene parse_scene(std::string_view json_text, const std::filesystem::path&
     }
 }
 
-LoadedScene load_scene_file(const std::filesystem::path& file) {
+std::string read_scene_text(const std::filesystem::path& file) {
     const std::string name = file.string();
     const std::string limit = std::to_string(kMaxSceneFileBytes) + " bytes (" + format_bytes(kMaxSceneFileBytes) + ")";
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(name.c_str(), "rb"), &std::fclose);
@@ -896,8 +896,10 @@ LoadedScene load_scene_file(const std::filesystem::path& file) {
     }
     if (std::ferror(f.get()))
         throw SceneError(name, "", "cannot read scene file: " + std::generic_category().message(errno));
-    return parse_scene(text, file);
+    return text;
 }
+
+LoadedScene load_scene_file(const std::filesystem::path& file) { return parse_scene(read_scene_text(file), file); }
 
 std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& folder) {
     std::vector<std::filesystem::path> found;

@@ -35,6 +35,9 @@ struct LoadedScene {
     std::vector<std::string> warnings;
 };
 
+// Reads a scene file's bytes (at most kMaxSceneFileBytes). Throws SceneError.
+std::string read_scene_text(const std::filesystem::path& file);
+
 // Reads and validates a scene file. Throws SceneError (never anything else for bad input).
 LoadedScene load_scene_file(const std::filesystem::path& file);
 

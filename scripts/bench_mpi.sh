@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Figures for docs/scaling.md: keithray under mpirun on this machine.
+#   ratio:   1 process of 2 threads against mpirun -np 1 and -np 2 of 1 thread each, on one
+#            scene, interleaved, REPEATS rounds; prints each run's seconds and the medians' ratios.
+#   exchange: the per-pass statistics exchange alone (scripts/bench_mpi_exchange.cpp, built
+#            here with mpicxx) at 512x512 and 3840x2160, 2 and 4 ranks.
+#   balance: mpirun -np 4 (oversubscribed, 1 thread each) on scenes 3, 6 and 8 at their own
+#            spp; prints keithray's per-rank summary (busy CPU seconds, slowest vs mean).
+# Usage: scripts/bench_mpi.sh ratio|balance|exchange [REPEATS] [extra render flags]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+exe=build/keithray
+what=${1:-ratio}
+repeats=${2:-3}
+shift $(( $# > 2 ? 2 : $# ))
+root=()
+[ "$(id -u)" = 0 ] && root=(--allow-run-as-root)
+mpi=(mpirun --oversubscribe --bind-to none "${root[@]}" -x OMP_NUM_THREADS=1 -x OMP_WAIT_POLICY=passive)
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+seconds() { sed -n 's/.* spp, \([0-9.]*\) s,.*/\1/p' | head -1; }
+median() { sort -g | awk '{v[NR]=$1} END {print (NR % 2) ? v[(NR+1)/2] : (v[NR/2] + v[NR/2+1]) / 2}'; }
+
+case $what in
+ratio)
+  scene=res/scenes/assignment_03.json
+  : >"$out/threads2"; : >"$out/np1"; : >"$out/np2"
+  for ((i = 0; i < repeats; i++)); do
+    OMP_WAIT_POLICY=passive "$exe" render "$scene" -q --threads 2 -o "$out/a.ppm" "$@" | seconds >>"$out/threads2"
+    "${mpi[@]}" -np 1 "$exe" render "$scene" -q -o "$out/b.ppm" "$@" | seconds >>"$out/np1"
+    "${mpi[@]}" -np 2 "$exe" render "$scene" -q -o "$out/c.ppm" "$@" | seconds >>"$out/np2"
+    cmp -s "$out/a.ppm" "$out/c.ppm" || { echo "bench_mpi: -np 2 image differs from one process's" >&2; exit 1; }
+  done
+  t2=$(median <"$out/threads2"); n1=$(median <"$out/np1"); n2=$(median <"$out/np2")
+  echo "scene $scene $*, $repeats rounds interleaved; seconds per run:"
+  echo "  1 process x 2 threads: $(tr '\n' ' ' <"$out/threads2") median $t2"
+  echo "  mpirun -np 1 x 1 thread: $(tr '\n' ' ' <"$out/np1") median $n1"
+  echo "  mpirun -np 2 x 1 thread: $(tr '\n' ' ' <"$out/np2") median $n2"
+  awk -v t2="$t2" -v n1="$n1" -v n2="$n2" 'BEGIN {
+    printf "  np 2 / threads 2 time: %.3f; speed-up np 1 -> np 2: %.2f\n", n2 / t2, n1 / n2 }'
+  ;;
+balance)
+  for n in 3 6 8; do
+    echo "scene $n, mpirun -np 4 (1 thread each) $*:"
+    "${mpi[@]}" -np 4 "$exe" render res/scenes/assignment_0$n.json -q -o "$out/s$n.ppm" "$@"
+  done
+  ;;
+exchange)
+  mpicxx -O2 -o "$out/exchange" scripts/bench_mpi_exchange.cpp
+  for n in 2 4; do
+    for size in "512 512" "3840 2160"; do "${mpi[@]}" -np $n "$out/exchange" $size; done
+  done
+  ;;
+*) echo "usage: $0 ratio|balance|exchange [REPEATS] [render flags]" >&2; exit 2 ;;
+esac

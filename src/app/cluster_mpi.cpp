@@ -1,0 +1,265 @@
+// Cluster over MPI (Open MPI): the only file that includes mpi.h.
+#include <mpi.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <chrono>
+#include <cstdint>
+#include <stdexcept>
+
+#include "app/cluster.h"
+
+namespace kr {
+
+namespace {
+
+// Whether a launcher started this process: Open MPI's mpirun, PMIx (srun --mpi=pmix) or PMI.
+bool launched_by_mpi() {
+    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
+        if (std::getenv(name)) return true;
+    return false;
+}
+
+double cpu_seconds() {
+    timespec t{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double wall_seconds() {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Counts of T as MPI counts: in bytes (MPI_BYTE, which MPI copies fastest) while the whole
+// image's bytes fit an int, else in elements of a contiguous type (from about 8K images).
+template <class T>
+class Counted {
+public:
+    explicit Counted(size_t total) : scale_(total * sizeof(T) <= size_t(INT32_MAX) ? int(sizeof(T)) : 1) {
+        if (scale_ == 1) {
+            MPI_Type_contiguous(int(sizeof(T)), MPI_BYTE, &type_);
+            MPI_Type_commit(&type_);
+        }
+    }
+    ~Counted() {
+        if (scale_ == 1) MPI_Type_free(&type_);
+    }
+    MPI_Datatype type() const { return type_; }
+    int count(size_t elements) const { return int(elements) * scale_; }
+    std::vector<int> counts(const std::vector<int>& elements) const {
+        std::vector<int> c(elements);
+        for (int& v : c) v *= scale_;
+        return c;
+    }
+
+private:
+    int scale_;
+    MPI_Datatype type_ = MPI_BYTE;
+};
+
+// Rows dealt round-robin: rank r holds rows r, r+N, r+2N, ...; packed in that order.
+struct RowDeal {
+    int rank, size, width, height;
+    int rows_of(int r) const { return r < height ? (height - r + size - 1) / size : 0; }
+    std::vector<int> counts() const {  // pixels per rank
+        std::vector<int> c(static_cast<size_t>(size));
+        for (int r = 0; r < size; ++r) c[size_t(r)] = rows_of(r) * width;
+        return c;
+    }
+    std::vector<int> offsets(const std::vector<int>& counts) const {
+        std::vector<int> o(counts.size(), 0);
+        for (size_t r = 1; r < counts.size(); ++r) o[r] = o[r - 1] + counts[r - 1];
+        return o;
+    }
+    // This rank's rows of `field`, packed in order into `out`.
+    template <class T>
+    void pack(const std::vector<T>& field, std::vector<char>& out) const {
+        const size_t row = size_t(width) * sizeof(T);
+        const int rows = rows_of(rank);
+        out.resize(size_t(rows) * row);
+#pragma omp parallel for schedule(static)
+        for (int k = 0; k < rows; ++k)
+            std::memcpy(out.data() + size_t(k) * row, field.data() + size_t(rank + k * size) * size_t(width), row);
+    }
+    template <class T>
+    void unpack(const std::vector<char>& all, const std::vector<int>& offsets, std::vector<T>& field) const {
+        const size_t row = size_t(width) * sizeof(T);
+        // Row y is rank (y mod N)'s row y div N.
+#pragma omp parallel for schedule(static)
+        for (int y = 0; y < height; ++y)
+            std::memcpy(field.data() + size_t(y) * size_t(width),
+                        all.data() + size_t(offsets[size_t(y % size)]) * sizeof(T) + size_t(y / size) * row, row);
+    }
+    // Every rank's rows of `field` in every rank (all) or in rank 0 only. `mine` and
+    // `gathered` are buffers kept between calls: fresh pages cost more than the copy.
+    template <class T>
+    void exchange(std::vector<T>& field, bool all, std::vector<char>& mine, std::vector<char>& gathered) const {
+        const Counted<T> as(field.size());
+        const std::vector<int> counts = this->counts(), offsets = this->offsets(counts);
+        const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
+        if (all || rank == 0) gathered.resize(field.size() * sizeof(T));
+        pack(field, mine);
+        if (all)
+            MPI_Allgatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(),
+                           mpi_counts.data(), mpi_offsets.data(), as.type(), MPI_COMM_WORLD);
+        else
+            MPI_Gatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(), mpi_counts.data(),
+                        mpi_offsets.data(), as.type(), 0, MPI_COMM_WORLD);
+        if (all || rank == 0) unpack(gathered, offsets, field);
+    }
+};
+
+class DealtRows final : public PassHooks {
+public:
+    DealtRows(int rank, int size, bool always_combine) : rank_(rank), size_(size), always_combine_(always_combine) {}
+
+    void before_pass(RenderState& state) override {
+        // render_pass skips pixels whose mask entry is 0: this rank's rows of the noise
+        // rule's mask (all rows' pixels where there is none).
+        const size_t w = size_t(state.width), pixels = w * size_t(state.height);
+        if (owned_.size() != pixels) {
+            owned_.assign(pixels, 0);
+            for (int y = rank_; y < state.height; y += size_) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
+        }
+        noise_mask_.swap(state.active);
+        if (noise_mask_.empty()) {
+            state.active = owned_;
+        } else {
+            state.active.resize(pixels);
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < pixels; ++i) state.active[i] = owned_[i] & noise_mask_[i];
+        }
+        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
+        cpu_start_ = cpu_seconds();
+    }
+
+    void after_pass(RenderState& state, bool statistics) override {
+        cost_.busy_seconds += cpu_seconds() - cpu_start_;
+        state.active.swap(noise_mask_);
+        noise_mask_.clear();
+        ++passes_;
+        pass_end_ = wall_seconds();
+        if (!statistics && !always_combine_) return;
+        const double start = pass_end_;
+        const RowDeal deal{rank_, size_, state.width, state.height};
+        deal.exchange(state.radiance_sum, true, mine_, gathered_);
+        deal.exchange(state.luminance_sq_sum, true, mine_, gathered_);
+        deal.exchange(state.sample_count, true, mine_, gathered_);
+        pass_end_ = wall_seconds();
+        cost_.combine_seconds += pass_end_ - start;
+        ++cost_.exchanges;
+    }
+
+    bool any(bool stop) override {
+        int flag = stop, result = 0;
+        MPI_Allreduce(&flag, &result, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
+        return result != 0;
+    }
+
+    RankCost cost_;
+
+private:
+    int rank_, size_;
+    bool always_combine_;
+    std::vector<uint8_t> noise_mask_;
+    std::vector<uint8_t> owned_;  // 1 on this rank's rows
+    std::vector<char> mine_, gathered_;  // exchange buffers, kept between passes
+    double cpu_start_ = 0, pass_end_ = 0;
+    int passes_ = 0;
+};
+
+}  // namespace
+
+Cluster::Cluster(int& argc, char**& argv) {
+    if (!launched_by_mpi()) return;
+    // Only the main thread calls MPI; OpenMP's threads render between the calls.
+    int provided = 0;
+    if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+        throw std::runtime_error("MPI could not start (MPI_Init_thread failed)");
+    mpi_ = true;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+Cluster::~Cluster() {
+    if (mpi_) MPI_Finalize();
+}
+
+void Cluster::abort(int status) const {
+    std::fflush(stdout);
+    std::fflush(stderr);
+    MPI_Abort(MPI_COMM_WORLD, status);
+    std::_Exit(status);
+}
+
+void Cluster::broadcast(std::string& bytes) const {
+    if (!mpi_) return;
+    unsigned long long size = bytes.size();
+    MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+    bytes.resize(size_t(size));
+    // In pieces of at most 1 GiB: MPI counts are ints.
+    constexpr size_t kPiece = size_t(1) << 30;
+    for (size_t at = 0; at < bytes.size(); at += kPiece)
+        MPI_Bcast(bytes.data() + at, int(std::min(kPiece, bytes.size() - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
+}
+
+bool Cluster::broadcast(bool value) const {
+    if (!mpi_) return value;
+    int v = value;
+    MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    return v != 0;
+}
+
+int Cluster::any_flags(int flags) const {
+    if (!mpi_) return flags;
+    int result = 0;
+    MPI_Allreduce(&flags, &result, 1, MPI_INT, MPI_BOR, MPI_COMM_WORLD);
+    return result;
+}
+
+std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
+    if (!mpi_) return {cost};
+    constexpr int kFields = 5;
+    const double mine[kFields] = {cost.busy_seconds, cost.combine_seconds, cost.between_seconds,
+                                  double(cost.exchanges), double(cost.rays)};
+    std::vector<double> all(leader() ? kFields * size_t(size_) : 0);
+    MPI_Gather(mine, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, MPI_COMM_WORLD);
+    std::vector<RankCost> costs;
+    for (size_t r = 0; r < all.size(); r += kFields)
+        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4])});
+    return costs;
+}
+
+void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const {
+    rays = state.rays;
+    nonfinite = state.nonfinite_samples;
+    if (!mpi_) return;
+    const RowDeal deal{rank_, size_, state.width, state.height};
+    std::vector<char> mine, gathered;
+    deal.exchange(state.radiance_sum, false, mine, gathered);
+    deal.exchange(state.depth_sum, false, mine, gathered);
+    deal.exchange(state.luminance_sq_sum, false, mine, gathered);
+    deal.exchange(state.radiance_sq_sum, false, mine, gathered);
+    deal.exchange(state.sample_count, false, mine, gathered);
+    deal.exchange(state.sample_index, false, mine, gathered);
+    const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
+    unsigned long long sum[2] = {0, 0};
+    MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
+    rays = sum[0];
+    nonfinite = sum[1];
+}
+
+std::unique_ptr<PassHooks> Cluster::deal_rows(bool always_combine) const {
+    if (!mpi_) return nullptr;
+    return std::make_unique<DealtRows>(rank_, size_, always_combine);
+}
+
+RankCost Cluster::cost(const PassHooks& hooks) {
+    const auto* dealt = dynamic_cast<const DealtRows*>(&hooks);
+    return dealt ? dealt->cost_ : RankCost{};
+}
+
+}  // namespace kr

@@ -1,0 +1,210 @@
+#include "render/checkpoint.h"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string_view>
+#include <type_traits>
+#include <vector>
+
+#include "core/hash.h"
+#include "core/text.h"
+#include "scene/save.h"
+
+namespace kr {
+
+namespace {
+
+constexpr std::string_view kMagic = "keithray checkpoint\n";
+static_assert(sizeof(Color) == 3 * sizeof(double), "checkpoints store Color as three doubles");
+
+// A name as one word of the key ("x86-64-v3 float lanes" -> "x86-64-v3-float-lanes").
+std::string word(std::string_view name) {
+    std::string w(name);
+    for (char& c : w)
+        if (c == ' ') c = '-';
+    return w;
+}
+
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+class Writer {
+public:
+    std::string bytes;
+    template <class T>
+    void put(const T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        bytes.append(reinterpret_cast<const char*>(&value), sizeof(T));
+    }
+    template <class T>
+    void put_all(const std::vector<T>& values) {
+        bytes.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+    }
+};
+
+class Reader {
+public:
+    Reader(std::string_view bytes, std::string where) : bytes_(bytes), where_(std::move(where)) {}
+    template <class T>
+    T get() {
+        T value;
+        std::memcpy(&value, take(sizeof(T)), sizeof(T));
+        return value;
+    }
+    template <class T>
+    void get_all(std::vector<T>& values, size_t count) {
+        const char* p = take(count * sizeof(T));
+        values.resize(count);
+        std::memcpy(values.data(), p, count * sizeof(T));
+    }
+    std::string_view text(size_t count) { return {take(count), count}; }
+    size_t left() const { return bytes_.size() - at_; }
+
+private:
+    const char* take(size_t count) {
+        if (count > left()) throw std::runtime_error(where_ + ": checkpoint truncated (the file ends early)");
+        const char* p = bytes_.data() + at_;
+        at_ += count;
+        return p;
+    }
+    std::string_view bytes_;
+    std::string where_;
+    size_t at_ = 0;
+};
+
+// The first word of `a` and `b` ("name=value") that differs, as "name=A in the checkpoint,
+// name=B here".
+std::string first_difference(const std::string& checkpoint, const std::string& here) {
+    std::istringstream a(checkpoint), b(here);
+    std::string wa, wb;
+    while (true) {
+        const bool more_a = bool(a >> wa), more_b = bool(b >> wb);
+        if (!more_a && !more_b) return "settings differ";
+        if (!more_a) wa = "(none)";
+        if (!more_b) wb = "(none)";
+        if (wa != wb) return quote_user_text(wa) + " in the checkpoint, " + quote_user_text(wb) + " here";
+    }
+}
+
+}  // namespace
+
+CheckpointKey checkpoint_key(const Scene& scene, const RenderScene& prepared, const RenderSettings& settings,
+                             const StopRule& rule) {
+    // Where the image goes and how it is tone mapped do not change a sample.
+    Scene samples_only = scene;
+    samples_only.renderer.output.clear();
+    samples_only.display = DisplaySettings{};
+    CheckpointKey key;
+    key.scene = fnv1a(scene_to_json(samples_only));
+    key.width = scene.renderer.width;
+    key.height = scene.renderer.height;
+    key.settings = "integrator=" + word(integrator_names.name(settings.integrator)) +
+                   " estimator=" + word(estimator_names.name(settings.estimator)) +
+                   " allocation=" + word(allocation_names.name(settings.allocation)) +
+                   " light-sampling=" + word(light_sampling_names.name(settings.light_sampling)) +
+                   " depth=" + std::to_string(settings.max_depth) + " spp=" + std::to_string(settings.target_spp) +
+                   " rr-depth=" + std::to_string(settings.rr_depth) + " seed=" + std::to_string(settings.seed) +
+                   // Single- and double-precision lanes round differently.
+                   " kernels=" + word(packet_kernels_names.name(packet_kernels(prepared, settings))) +
+                   " noise=" + number(rule.noise) + " min-samples=" + std::to_string(rule.min_samples) +
+                   " adapt-every=" + std::to_string(rule.adapt_every);
+    return key;
+}
+
+std::string read_checkpoint_file(const std::filesystem::path& file, const CheckpointKey& expected) {
+    const std::string where = show_user_text(file.string());
+    const uint64_t pixels = uint64_t(expected.width) * uint64_t(expected.height);
+    // Header, key (bounded generously), sums and counts, the mask and the fractions, checksum.
+    const uint64_t largest = kMagic.size() + 1024 + expected.settings.size() +
+                             pixels * (2 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 1 + sizeof(float));
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+        throw std::runtime_error(where + ": cannot read the checkpoint: " +
+                                 (ec ? ec.message() : std::string("not a regular file")));
+    const uintmax_t size = std::filesystem::file_size(file, ec);
+    if (ec) throw std::runtime_error(where + ": cannot read the checkpoint: " + ec.message());
+    if (size > largest)
+        throw std::runtime_error(where + ": " + std::to_string(size) + " bytes, larger than a checkpoint of this " +
+                                 std::to_string(expected.width) + "x" + std::to_string(expected.height) + " render");
+    std::ifstream f(file, std::ios::binary);
+    std::string bytes(size_t(size), '\0');
+    if (!f.read(bytes.data(), std::streamsize(size))) throw std::runtime_error(where + ": cannot read the checkpoint");
+    return bytes;
+}
+
+std::string encode_checkpoint(const CheckpointKey& key, const RenderState& state) {
+    Writer w;
+    w.bytes.append(kMagic);
+    w.put(kCheckpointVersion);
+    w.put(key.scene);
+    w.put(uint32_t(key.settings.size()));
+    w.bytes.append(key.settings);
+    w.put(int32_t(state.width));
+    w.put(int32_t(state.height));
+    w.put(int32_t(state.passes));
+    w.put(state.rays);
+    w.put(state.nonfinite_samples);
+    w.put_all(state.radiance_sum);
+    w.put_all(state.depth_sum);
+    w.put_all(state.luminance_sq_sum);
+    w.put_all(state.radiance_sq_sum);
+    w.put_all(state.sample_count);
+    w.put_all(state.sample_index);
+    w.put(uint8_t(!state.active.empty()));
+    w.put_all(state.active);
+    w.put(uint8_t(!state.sample_credit.empty()));
+    w.put_all(state.sample_credit);
+    w.put(fnv1a(w.bytes));
+    return std::move(w.bytes);
+}
+
+void decode_checkpoint(const std::string& bytes, const std::filesystem::path& file, const CheckpointKey& expected,
+                       RenderState& state) {
+    const std::string where = show_user_text(file.string());
+    auto refuse = [&](const std::string& why) { throw std::runtime_error(where + ": " + why); };
+    if (bytes.compare(0, kMagic.size(), kMagic) != 0) refuse("not a keithray checkpoint");
+    if (bytes.size() < kMagic.size() + sizeof(uint64_t)) refuse("checkpoint truncated (the file ends early)");
+    Reader r(std::string_view(bytes).substr(kMagic.size()), where);
+    const auto version = r.get<uint32_t>();
+    if (version != kCheckpointVersion)
+        refuse("checkpoint format version " + std::to_string(version) + "; this keithray reads version " +
+               std::to_string(kCheckpointVersion));
+    // The checksum first: a damaged file is named as such, not as another scene.
+    const std::string_view body(bytes.data(), bytes.size() - sizeof(uint64_t));
+    uint64_t checksum;
+    std::memcpy(&checksum, bytes.data() + body.size(), sizeof checksum);
+    if (fnv1a(body) != checksum) refuse("checkpoint damaged or truncated (its checksum does not match)");
+    const auto scene = r.get<uint64_t>();
+    const std::string settings(r.text(r.get<uint32_t>()));
+    const int width = r.get<int32_t>(), height = r.get<int32_t>();
+    // The size first: it is part of the scene too, and the clearer thing to name.
+    if (width != expected.width || height != expected.height)
+        refuse("checkpoint of a " + std::to_string(width) + "x" + std::to_string(height) + " image; this render is " +
+               std::to_string(expected.width) + "x" + std::to_string(expected.height));
+    if (scene != expected.scene)
+        refuse("checkpoint of another scene (the scene's content differs from the one rendered then)");
+    if (settings != expected.settings) refuse("checkpoint of other settings: " + first_difference(settings, expected.settings));
+    RenderState restored(width, height);
+    const size_t n = restored.sample_count.size();
+    restored.passes = r.get<int32_t>();
+    restored.rays = r.get<uint64_t>();
+    restored.nonfinite_samples = r.get<uint64_t>();
+    r.get_all(restored.radiance_sum, n);
+    r.get_all(restored.depth_sum, n);
+    r.get_all(restored.luminance_sq_sum, n);
+    r.get_all(restored.radiance_sq_sum, n);
+    r.get_all(restored.sample_count, n);
+    r.get_all(restored.sample_index, n);
+    if (r.get<uint8_t>()) r.get_all(restored.active, n);
+    if (r.get<uint8_t>()) r.get_all(restored.sample_credit, n);
+    if (r.left() != sizeof(uint64_t) || restored.passes < 0) refuse("checkpoint damaged (unexpected layout)");
+    state = std::move(restored);
+}
+
+}  // namespace kr

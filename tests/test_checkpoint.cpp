@@ -1,0 +1,222 @@
+// Checkpoints (render/checkpoint.h): a render stopped after k passes and resumed from its
+// checkpoint is bit for bit the uninterrupted one; a checkpoint of another scene, other
+// settings or another size, or a damaged one, is refused with one line naming the file and
+// what differs. And on the command line: SIGINT writes the checkpoint and no image, and
+// --resume finishes the same bytes.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <thread>
+
+#include "render/checkpoint.h"
+#include "scene/save.h"
+#include "test_util.h"
+
+namespace fs = std::filesystem;
+using namespace kr;
+
+namespace {
+
+void expect_same_state(const RenderState& a, const RenderState& b) {
+    EXPECT_EQ(a.passes, b.passes);
+    EXPECT_EQ(a.rays, b.rays);
+    EXPECT_EQ(a.sample_count, b.sample_count);
+    EXPECT_EQ(a.sample_index, b.sample_index);
+    EXPECT_EQ(a.active, b.active);
+    EXPECT_EQ(a.depth_sum, b.depth_sum);
+    EXPECT_EQ(a.luminance_sq_sum, b.luminance_sq_sum);
+    size_t differ = 0;
+    for (size_t i = 0; i < a.radiance_sum.size(); ++i)
+        differ += a.radiance_sum[i].x != b.radiance_sum[i].x || a.radiance_sum[i].y != b.radiance_sum[i].y ||
+                  a.radiance_sum[i].z != b.radiance_sum[i].z || a.radiance_sq_sum[i].x != b.radiance_sq_sum[i].x;
+    EXPECT_EQ(differ, 0u);
+}
+
+struct Case {
+    const char* name;
+    Allocation allocation;
+    Estimator estimator;
+    double noise;
+};
+
+}  // namespace
+
+// Stopped after k passes (before the adaptive warm-up, inside it, after the noise rule's
+// first mask), through the bytes of a checkpoint, then on to the end: the same state as
+// never stopping.
+TEST(Checkpoint, ResumedRenderIsTheUninterruptedOne) {
+    const Scene authored = test::brief_scene(6, 16);
+    const RenderScene scene = prepare_scene(authored);
+    for (const Case& c : {Case{"uniform", Allocation::uniform, Estimator::sobol, 0},
+                          Case{"adaptive", Allocation::adaptive, Estimator::sobol, 0},
+                          Case{"adaptive noise", Allocation::adaptive, Estimator::sobol, 0.05},
+                          Case{"stratified", Allocation::uniform, Estimator::stratified, 0}}) {
+        SCOPED_TRACE(c.name);
+        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.allocation = c.allocation;
+        settings.estimator = c.estimator;
+        settings.target_spp = 36;
+        StopRule rule;
+        rule.max_passes = 36;
+        rule.noise = c.noise;
+        rule.min_samples = 8;
+        RenderState whole(16, 16);
+        render_until(scene, settings, whole, rule);
+        ASSERT_EQ(whole.passes, 36);
+        // The noise rule's mask and the allocation's carried fractions are in play.
+        EXPECT_EQ(whole.active.empty(), c.noise == 0);
+        EXPECT_EQ(whole.sample_credit.empty(), c.allocation == Allocation::uniform);
+        const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
+        for (int k : {3, 10, 25}) {
+            StopRule first = rule;
+            first.max_passes = k;
+            RenderState part(16, 16);
+            render_until(scene, settings, part, first);
+            RenderState resumed;
+            decode_checkpoint(encode_checkpoint(key, part), "part.ckpt", key, resumed);
+            render_until(scene, settings, resumed, rule);
+            expect_same_state(whole, resumed);
+        }
+    }
+}
+
+// Each refusal is one line naming the file and what differs; the state is left untouched.
+TEST(Checkpoint, RefusesAnotherSceneSettingsSizeOrDamage) {
+    const Scene authored = test::brief_scene(6, 8);
+    const RenderScene scene = prepare_scene(authored);
+    const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    StopRule rule;
+    rule.max_passes = 2;
+    RenderState state(8, 8);
+    render_until(scene, settings, state, rule);
+    const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
+    const std::string bytes = encode_checkpoint(key, state);
+
+    auto refusal = [&](const std::string& file_bytes, const CheckpointKey& expected) -> std::string {
+        RenderState target(8, 8);
+        try {
+            decode_checkpoint(file_bytes, "run/r.ckpt", expected, target);
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(target.passes, 0);
+            return e.what();
+        }
+        return "(accepted)";
+    };
+    auto expect_refused = [&](const std::string& message, const std::string& what) {
+        EXPECT_EQ(message.rfind("run/r.ckpt: ", 0), 0u) << message;
+        EXPECT_NE(message.find(what), std::string::npos) << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    };
+    EXPECT_EQ(refusal(bytes, key), "(accepted)");
+
+    Scene moved = authored;
+    moved.renderer.depth += 1;
+    expect_refused(refusal(bytes, checkpoint_key(moved, scene, settings, rule)), "another scene");
+    // Where the image goes and its tone map do not change a sample: still accepted.
+    Scene renamed = authored;
+    renamed.renderer.output = "elsewhere.ppm";
+    EXPECT_EQ(refusal(bytes, checkpoint_key(renamed, scene, settings, rule)), "(accepted)");
+
+    RenderSettings other = settings;
+    other.seed = 7;
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, other, rule)), "\"seed=0\" in the checkpoint, \"seed=7\" here");
+    StopRule noisier = rule;
+    noisier.noise = 0.5;
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, noisier)), "noise=");
+
+    Scene larger = authored;
+    larger.renderer.width = 9;
+    expect_refused(refusal(bytes, checkpoint_key(larger, scene, settings, rule)), "checkpoint of a 8x8 image; this render is 9x8");
+
+    expect_refused(refusal(bytes.substr(0, bytes.size() / 2), key), "checksum");
+    std::string flipped = bytes;
+    flipped[flipped.size() / 2] ^= 1;
+    expect_refused(refusal(flipped, key), "checksum");
+    std::string newer = bytes;
+    newer[20] = 9;  // the version, after the 20-byte magic
+    expect_refused(refusal(newer, key), "version 9");
+    expect_refused(refusal("P6 1 1 255\n...", key), "not a keithray checkpoint");
+}
+
+namespace {
+
+class CheckpointCli : public test::ScratchDirTest {
+protected:
+    // A small copy of scene 6 (path tracing, glass and an area light) in the scratch folder.
+    fs::path small_scene(int size) {
+        Scene scene = test::brief_scene(6, size);
+        scene.renderer.output = (dir / "out.ppm").string();  // beside the scene file
+        const fs::path file = dir / "scene.json";
+        save_scene_json(scene, file);
+        return file;
+    }
+    // keithray run in the scratch folder (relative outputs and checkpoints land there).
+    test::CommandResult cli_here(const std::string& args) {
+        return test::run_command("cd '" + dir.string() + "' && '" + KEITHRAY_EXE + "' " + args, dir);
+    }
+};
+
+}  // namespace
+
+// SIGINT during a checkpointed render: exit 130, no image, a checkpoint; --resume then
+// writes the bytes of the render never interrupted.
+TEST_F(CheckpointCli, InterruptedAndResumedIsByteForByteTheWholeRender) {
+    const fs::path scene = small_scene(48);
+    const std::string common = "render '" + scene.string() + "' --spp 3000 -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.ppm").status, 0);
+
+    const fs::path checkpoint = dir / "r.ckpt";
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        const std::string cmd = "cd '" + dir.string() + "' && exec '" + std::string(KEITHRAY_EXE) + "' " + common +
+                                "-o cut.ppm --checkpoint r.ckpt --every 0 2>cut.err";
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    // The first checkpoint is written after the first pass; the signal comes after it.
+    for (int i = 0; i < 60000 && !fs::exists(checkpoint); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ::kill(child, SIGINT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status)) << status;
+    ASSERT_EQ(WEXITSTATUS(status), 130) << "the render ended before the signal: " << test::read_file(dir / "cut.err");
+    EXPECT_NE(test::read_file(dir / "cut.err").find("stopped by a signal"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "cut.ppm"));
+    EXPECT_FALSE(fs::exists(dir / "cut-depth.ppm"));
+
+    const test::CommandResult resumed = cli_here(common + "-o cut.ppm --resume r.ckpt");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
+    EXPECT_EQ(test::read_file(dir / "cut-depth.ppm"), test::read_file(dir / "whole-depth.ppm"));
+
+    // Another seed: refused, one line naming the flag, the file and the difference.
+    const test::CommandResult refused = cli_here(common + "--seed 3 -o other.ppm --resume r.ckpt");
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_EQ(refused.err, "error: --resume r.ckpt: checkpoint of other settings: \"seed=0\" in the checkpoint, "
+                           "\"seed=3\" here; nothing rendered\n");
+    EXPECT_FALSE(fs::exists(dir / "other.ppm"));
+}
+
+TEST_F(CheckpointCli, FlagsAreChecked) {
+    const fs::path scene = small_scene(8);
+    EXPECT_EQ(cli_here("render '" + scene.string() + "' '" + scene.string() + "' --checkpoint c.ckpt").status, 2);
+    EXPECT_EQ(cli_here("render '" + scene.string() + "' --every -1 --checkpoint c.ckpt").status, 2);
+    // The checkpoint never replaces the scene file or an output.
+    const std::string before = test::read_file(scene);
+    const test::CommandResult onto_scene = cli_here("render scene.json -q --checkpoint scene.json --every 0");
+    EXPECT_EQ(onto_scene.status, 1);
+    EXPECT_EQ(onto_scene.err, "error: --checkpoint scene.json would overwrite scene.json; nothing written\n");
+    EXPECT_EQ(test::read_file(scene), before);
+    EXPECT_EQ(cli_here("render scene.json -q -o x.ppm --checkpoint x-depth.ppm").status, 1);
+    EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+    const test::CommandResult missing = cli_here("render '" + scene.string() + "' -q --resume nowhere.ckpt");
+    EXPECT_EQ(missing.status, 1);
+    EXPECT_NE(missing.err.find("nowhere.ckpt"), std::string::npos) << missing.err;
+}
