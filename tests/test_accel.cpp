@@ -7,7 +7,8 @@
 
 #include "core/image.h"
 #include "core/sampling.h"
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "test_util.h"
 
@@ -308,9 +309,11 @@ test::SceneBuilder scaled_room(double scale, int balls) {
     return b;
 }
 
-Image render_image(const RenderScene& scene, int spp, Integrator integrator = Integrator::pt) {
+Image render_image(const RenderScene& scene, int spp, Integrator integrator = Integrator::pt,
+                   PacketIsa kernels = PacketIsa::best) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.integrator = integrator;
+    settings.kernels = kernels;
     settings.target_spp = spp;
     RenderState state(scene.renderer.width, scene.renderer.height);
     for (int i = 0; i < spp; ++i) render_pass(scene, settings, state);
@@ -390,21 +393,17 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
 // where every length keeps its square a normal float (float_lanes_fit), the double ones at
 // every scale; their images are the one-path image to the lanes' rounding.
 TEST(Accel, ExtremeScalesInTheLanes) {
-    set_packet_isa(PacketIsa::one_path);
-    const Image unit = render_image(scaled_room(1, 4).build(), 2);
+    const Image unit = render_image(scaled_room(1, 4).build(), 2, Integrator::pt, PacketIsa::one_path);
     for (double scale : {1e-100, 1e-40, 1e-20, 1e-13, 1e-6, 1.0, 1e6, 1e13, 1e20, 1e30, 1e100}) {
         const RenderScene scene = scaled_room(scale, 4).build();
         char where[32];
         std::snprintf(where, sizeof where, "scale %g", scale);
         EXPECT_EQ(float_lanes_fit(scene), scale >= 1e-6 && scale <= 1e6) << where;
-        set_packet_isa(PacketIsa::one_path);
-        const Image one_path = render_image(scene, 2);
-        set_packet_isa(PacketIsa::best);
+        const Image one_path = render_image(scene, 2, Integrator::pt, PacketIsa::one_path);
         const Image lanes = render_image(scene, 2);
         EXPECT_LE(largest_relative_difference(one_path, unit), 1e-9) << where;
         // Single precision moves a rare sample by more (a path's decision near a boundary):
         // a thousandth of the brightest pixel, against the whole of it for a wrong image.
         EXPECT_LE(largest_relative_difference(lanes, one_path), float_lanes_fit(scene) ? 1e-3 : 1e-9) << where;
     }
-    set_packet_isa(PacketIsa::best);
 }

@@ -7,7 +7,8 @@
 #include <numeric>
 #include <omp.h>
 
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "test_util.h"
 #include "viewer/accumulator.h"

@@ -7,7 +7,8 @@
 
 #include "core/image.h"
 #include "core/image_io.h"
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 
 using namespace kr;

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "render/render.h"
+#include "render/progressive.h"
 #include "test_util.h"
 
 using namespace kr;

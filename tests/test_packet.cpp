@@ -14,7 +14,8 @@
 #include <ostream>
 #include <vector>
 
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "test_util.h"
 
@@ -105,11 +106,14 @@ RenderScene brief_scene(int n) {
         load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
 }
 
-// The kernels a test runs with, set for its duration.
+// The kernels a test runs with: its settings' `kernels`.
 class Packet : public ::testing::TestWithParam<PacketIsa> {
 protected:
-    void SetUp() override { set_packet_isa(GetParam()); }
-    void TearDown() override { set_packet_isa(PacketIsa::best); }
+    RenderSettings settings_of(const RenderScene& scene) const {
+        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.kernels = GetParam();
+        return settings;
+    }
 };
 
 }  // namespace
@@ -127,19 +131,19 @@ INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, Pack
 // a time whatever the switch says.
 TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
     const RenderScene brief = brief_scene(6);
-    const RenderSettings settings = RenderSettings::from_scene(brief.renderer);
+    RenderSettings settings = RenderSettings::from_scene(brief.renderer);
     EXPECT_TRUE(float_lanes_fit(brief));
     RenderScene wide_lens = brief;  // rays from up to 1e4 away: beyond 4096 radii of 0.5
     wide_lens.camera.lens_radius = 1e4;
     EXPECT_FALSE(float_lanes_fit(wide_lens));
-    set_packet_isa(PacketIsa::any);
+    settings.kernels = PacketIsa::any;
     EXPECT_EQ(packet_kernels(brief, settings), PacketKernels::x86_64);
-    set_packet_isa(PacketIsa::one_path);
+    settings.kernels = PacketIsa::one_path;
     EXPECT_EQ(packet_kernels(brief, settings), PacketKernels::one_path);
-    set_packet_isa(PacketIsa::double_lanes);
+    settings.kernels = PacketIsa::double_lanes;
     const PacketKernels v3 = packet_kernels(brief, settings);
     EXPECT_TRUE(v3 == PacketKernels::x86_64_v3 || v3 == PacketKernels::one_path);
-    set_packet_isa(PacketIsa::best);
+    settings.kernels = PacketIsa::best;
     const PacketKernels best = packet_kernels(brief, settings);
     EXPECT_EQ(best, v3 == PacketKernels::x86_64_v3 ? PacketKernels::x86_64_v3_float : PacketKernels::one_path);
     std::printf("best on this CPU: %s\n", std::string(packet_kernels_names.name(best)).c_str());
@@ -178,7 +182,7 @@ TEST_P(Packet, SameSamplesAsOneByOne) {
             for (LightSampling light :
                  {LightSampling::brief, LightSampling::brief_area, LightSampling::cone, LightSampling::area})
                 for (Integrator integrator : {Integrator::pt, Integrator::pt_naive}) {
-                    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+                    RenderSettings settings = settings_of(scene);
                     settings.estimator = estimator;
                     settings.light_sampling = light;
                     settings.integrator = integrator;
@@ -235,7 +239,7 @@ TEST_P(Packet, PointLightsEveryMaterialAndPartialPackets) {
     ASSERT_EQ(scene.area_lights.size(), 4u);
     ASSERT_EQ(scene.area_lights.back().select_prob, 0.0);
     for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area}) {
-        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        RenderSettings settings = settings_of(scene);
         settings.light_sampling = light;
         for (int count : {1, 2, 3, 4, 5, 100}) {
             const Agreement a = compare(scene, settings, count == 100 ? 8 : 200, count);
@@ -250,7 +254,7 @@ TEST_P(Packet, PointLightsEveryMaterialAndPartialPackets) {
 TEST_P(Packet, RenderPassImageIsOneByOnes) {
     for (int n : {3, 8}) {
         const RenderScene scene = brief_scene(n);
-        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        RenderSettings settings = settings_of(scene);
         RenderState state(64, 64);
         for (int pass = 0; pass < 2; ++pass) render_pass(scene, settings, state);
         // The same samples, one by one, in the order render_pass draws them.
@@ -306,7 +310,7 @@ TEST_P(Packet, CameraRaysAreOneByOnes) {
                 samplers[size_t(k)] = &*together[size_t(k)];
             }
             Ray rays[kCount];
-            camera_rays(scene, width, height, xs, ys, samplers.data(), kCount, rays);
+            camera_rays(scene, settings_of(scene), width, height, xs, ys, samplers.data(), kCount, rays);
             for (int k = 0; k < kCount; ++k) {
                 Sampler& sampler = *alone[size_t(k)];
                 const Ray one = camera_ray_one_by_one(scene, width, height, xs[k], ys[k], sampler);
@@ -333,7 +337,7 @@ TEST_P(Packet, CameraSamplesAreOneByOnes) {
         for (Estimator estimator : {Estimator::sobol, Estimator::uniform})
             for (int count : {1, 3, 9, 64, 130}) {
                 scene.camera.lens_radius = lens_radius;
-                RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+                RenderSettings settings = settings_of(scene);
                 settings.estimator = estimator;
                 const double tolerance = lane_tolerance(scene, settings);
                 const size_t n = static_cast<size_t>(count);

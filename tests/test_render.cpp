@@ -4,7 +4,8 @@
 #include <cmath>
 #include <omp.h>
 
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "test_util.h"
 
 using namespace kr;
@@ -317,8 +318,8 @@ TEST(Dielectric, LightInsideGlassInTheLanes) {
     const RenderScene scene = b.build();
     const double expected = (1 - fresnel_dielectric(1, 1 / eta)) * le / (eta * eta);
     for (PacketIsa isa : {PacketIsa::best, PacketIsa::double_lanes, PacketIsa::one_path}) {
-        set_packet_isa(isa);
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.kernels = isa;
         settings.allocation = Allocation::uniform;
         RenderState state(16, 16);
         const int passes = 64;
@@ -330,5 +331,4 @@ TEST(Dielectric, LightInsideGlassInTheLanes) {
         const double p = expected / (le / (eta * eta)), stderr_mean = le / (eta * eta) * std::sqrt(p * (1 - p) / n);
         EXPECT_NEAR(mean, expected, 5 * stderr_mean) << int(isa);
     }
-    set_packet_isa(PacketIsa::best);
 }

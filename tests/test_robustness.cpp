@@ -20,7 +20,8 @@
 #include "core/image.h"
 #include "core/image_io.h"
 #include "render/camera.h"
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "test_util.h"
 

@@ -12,7 +12,7 @@
 #include "core/sampling.h"
 #include "render/lanes.h"
 #include "render/light.h"
-#include "render/render.h"
+#include "render/settings.h"
 #include "test_util.h"
 
 using namespace kr;

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <string>
 
-#include "render/render.h"
+#include "render/progressive.h"
 #include "scene/load.h"
 #include "scene/save.h"
 

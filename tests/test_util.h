@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "render/render.h"
+#include "render/trace.h"
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "scene/scene.h"

@@ -229,10 +229,6 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
 // sees exactly 0.1 in every sample. In double: the single-precision lanes would hand in
 // float(0.1), and the accumulation is what this checks.
 TEST(Accumulation, RenderPassPathStaysExact) {
-    struct DoubleLanes {  // for this test only, whichever way it ends
-        DoubleLanes() { set_packet_isa(PacketIsa::double_lanes); }
-        ~DoubleLanes() { set_packet_isa(PacketIsa::best); }
-    } double_lanes;
     test::SceneBuilder b;
     b.scene.renderer.width = b.scene.renderer.height = 1;
     b.emitter({0, 0, 0}, 100, Color(0.1, 0.3, 0.7), b.material(MaterialType::diffuse));
@@ -240,6 +236,7 @@ TEST(Accumulation, RenderPassPathStaysExact) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.max_depth = 0;
     settings.target_spp = 1;
+    settings.kernels = PacketIsa::double_lanes;
     Accumulator acc;
     acc.reset(1, 1);
     for (int i = 0; i < 1000000; ++i) ASSERT_TRUE(acc.render_pass(scene, settings));

@@ -14,7 +14,7 @@
 #include <thread>
 #include <vector>
 
-#include "render/render.h"
+#include "render/settings.h"
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "viewer/edit.h"

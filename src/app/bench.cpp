@@ -16,7 +16,8 @@
 
 #include "core/args.h"
 #include "core/file_write.h"
-#include "render/render.h"
+#include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 
 namespace fs = std::filesystem;
@@ -189,7 +190,8 @@ int bench_throughput(const BenchOptions& o) {
             scene.accel_backend = o.accel.front();
             scene.build_accel();
         }
-        const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.kernels = o.kernels;
         const int spp = std::max(1, int(std::lround(settings.target_spp * o.fraction)));
         const int w = scene.renderer.width, h = scene.renderer.height;
         std::vector<double> seconds, mrays, pass_ms;
@@ -236,6 +238,7 @@ int bench_stress(const BenchOptions& o) {
         }
         RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
         settings.target_spp = 4;
+        settings.kernels = o.kernels;
         for (int run = 0; run < o.runs; ++run)
             for (size_t k = 0; k < o.accel.size(); ++k) {
                 const Timing t = time_render(scenes[k], settings, o.size, o.size, 4);
@@ -270,7 +273,6 @@ int run_bench(int argc, char** argv) {
         return report_usage(e, kBenchUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
-    set_packet_isa(o.kernels);
     if (o.write_stress > 0) {
         std::error_code ec;
         if (fs::exists(o.write_path, ec)) {

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "render/render.h"
+#include "render/progressive.h"
 
 namespace kr {
 

@@ -22,7 +22,7 @@
 #include "core/args.h"
 #include "core/hash.h"
 #include "core/image_io.h"
-#include "render/render.h"
+#include "render/progressive.h"
 #include "scene/load.h"
 
 namespace fs = std::filesystem;

@@ -31,7 +31,7 @@
 #include "render/aov.h"
 #include "render/checkpoint.h"
 #include "render/options.h"
-#include "render/render.h"
+#include "render/progressive.h"
 #include "scene/load.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
@@ -257,6 +257,7 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
 
     // The file's renderer and display blocks, then the command line over them.
     RenderSettings settings = apply_render_options(opt.render, loaded.scene);
+    settings.kernels = opt.kernels;
 
     const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
     // An EXR holds the depth as a layer; every other output has its depth map beside it.
@@ -521,7 +522,6 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
-    set_packet_isa(opt.kernels);
     if (opt.scenes.empty()) {
         // Rank 0's list of the bundled scenes, in every rank.
         std::string names;

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "core/image_hdr.h"
-#include "render/render.h"
+#include "render/progressive.h"
 
 namespace kr {
 

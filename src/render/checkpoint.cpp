@@ -11,6 +11,7 @@
 
 #include "core/hash.h"
 #include "core/text.h"
+#include "render/trace.h"
 #include "scene/save.h"
 
 namespace kr {

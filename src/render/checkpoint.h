@@ -17,7 +17,7 @@
 #include <filesystem>
 #include <string>
 
-#include "render/render.h"
+#include "render/progressive.h"
 #include "scene/scene.h"
 
 namespace kr {

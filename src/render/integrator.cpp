@@ -5,6 +5,7 @@
 
 #include "render/material.h"
 #include "render/path.h"
+#include "render/trace.h"
 
 namespace kr {
 

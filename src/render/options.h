@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "core/args.h"
-#include "render/render.h"
+#include "render/progressive.h"
 #include "scene/scene.h"
 
 namespace kr {

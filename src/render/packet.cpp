@@ -14,10 +14,9 @@
 // per step; tests/test_packet.cpp), the double ones elsewhere. Without AVX2 paths are traced
 // one at a time: GCC emulates what SSE2 lacks (64-bit compares, per-lane shifts, 32-bit
 // multiplies) lane by lane, so the kernels for any CPU are 2.5 times slower than one path at
-// a time (docs/performance.md); they run only when set_packet_isa asks for them, for tests
-// and comparisons.
+// a time (docs/performance.md); they run only when the settings' `kernels` ask for them, for
+// tests and comparisons.
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -26,6 +25,7 @@
 #include "core/sampling.h"
 #include "render/lanes.h"
 #include "render/path.h"
+#include "render/trace.h"
 
 #ifdef KR_X86_64_V3
 #include <immintrin.h>
@@ -86,8 +86,6 @@ namespace packet_f8 {
 
 namespace {
 
-std::atomic<PacketIsa> packet_isa{PacketIsa::best};
-
 bool cpu_has_v3() {
 #ifdef KR_X86_64_V3
     static const bool has = [] {
@@ -100,10 +98,10 @@ bool cpu_has_v3() {
 #endif
 }
 
-// The kernels the CPU and set_packet_isa pick, before a scene has a say (camera rays are the
+// The kernels the CPU and the settings pick, before a scene has a say (camera rays are the
 // double lanes' in both kinds of v3 lanes).
-PacketKernels isa_kernels() {
-    switch (packet_isa.load(std::memory_order_relaxed)) {
+PacketKernels isa_kernels(const RenderSettings& settings) {
+    switch (settings.kernels) {
     case PacketIsa::best: return cpu_has_v3() ? PacketKernels::x86_64_v3_float : PacketKernels::one_path;
     case PacketIsa::double_lanes: return cpu_has_v3() ? PacketKernels::x86_64_v3 : PacketKernels::one_path;
     case PacketIsa::any: return PacketKernels::x86_64;
@@ -113,8 +111,6 @@ PacketKernels isa_kernels() {
 }
 
 }  // namespace
-
-void set_packet_isa(PacketIsa isa) { packet_isa.store(isa); }
 
 bool float_lanes_fit(const RenderScene& scene) {
     // Geometry: the largest distance is bounded by the camera's (its lens included) and the
@@ -144,14 +140,14 @@ bool float_lanes_fit(const RenderScene& scene) {
 
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
     if (!packets_apply(scene, settings)) return PacketKernels::one_path;
-    const PacketKernels kernels = isa_kernels();
+    const PacketKernels kernels = isa_kernels(settings);
     if (kernels == PacketKernels::x86_64_v3_float && !float_lanes_fit(scene)) return PacketKernels::x86_64_v3;
     return kernels;
 }
 
-void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
-                 Sampler* const* samplers, int count, Ray* rays) {
-    switch (isa_kernels()) {
+void camera_rays(const RenderScene& scene, const RenderSettings& settings, int width, int height, const int* xs,
+                 const int* ys, Sampler* const* samplers, int count, Ray* rays) {
+    switch (isa_kernels(settings)) {
 #ifdef KR_X86_64_V3
     case PacketKernels::x86_64_v3_float:
     case PacketKernels::x86_64_v3: return packet_v3::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
@@ -194,7 +190,7 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
     Ray rays[kSampleBatch];
     for (int first = 0; first < count; first += kSampleBatch) {
         const int n = std::min(kSampleBatch, count - first);
-        camera_rays(scene, width, height, xs + first, ys + first, samplers + first, n, rays);
+        camera_rays(scene, settings, width, height, xs + first, ys + first, samplers + first, n, rays);
         trace_samples(scene, settings, rays, samplers + first, n, results + first);
     }
 }

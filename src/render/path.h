@@ -4,7 +4,8 @@
 #pragma once
 
 #include "render/material.h"
-#include "render/render.h"
+#include "render/render_scene.h"
+#include "render/settings.h"
 
 namespace kr {
 

@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "render/render.h"
+#include "render/progressive.h"
 
 namespace kr::viewer {
 

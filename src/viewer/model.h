@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "render/options.h"
-#include "render/render.h"
+#include "render/settings.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
 #include "viewer/edit.h"

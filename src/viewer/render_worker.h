@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "core/image.h"
-#include "render/render.h"
+#include "render/progressive.h"
 
 namespace kr::viewer {
 

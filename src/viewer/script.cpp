@@ -5,6 +5,7 @@
 
 #include <sys/resource.h>
 
+#include "render/trace.h"
 #include "viewer/navigation.h"
 
 namespace kr::viewer {

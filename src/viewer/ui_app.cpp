@@ -11,6 +11,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "core/image_io.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "scene/save.h"
 #include "viewer/navigation.h"

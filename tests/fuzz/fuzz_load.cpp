@@ -18,7 +18,7 @@
 #include <string_view>
 #include <vector>
 
-#include "render/render.h"
+#include "render/progressive.h"
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "scene/save.h"

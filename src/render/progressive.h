@@ -1,5 +1,6 @@
 // The progressive rendering API: settings + state + render_pass(), which adds one sample to
-// every pixel. The CLI loops over it; the viewer calls it from its render thread.
+// every pixel, and render_until, the one driver of passes (plan, pass, merge, stop rules)
+// under the CLI, the viewer's render thread and MPI ranks.
 #pragma once
 
 #include <array>
@@ -9,40 +10,10 @@
 #include <vector>
 
 #include "core/image.h"
-#include "core/rng.h"
-#include "core/sampling.h"
-#include "render/light.h"
 #include "render/render_scene.h"
-#include "render/sampler.h"
+#include "render/settings.h"
 
 namespace kr {
-
-enum class Integrator { wrt, pt, pt_naive };
-inline constexpr EnumNames<Integrator, 3> integrator_names{{"wrt", "pt", "pt-naive"}};
-
-// Distance recorded in the depth map for a primary ray that hits nothing.
-inline constexpr double kMissDepth = 1e6;
-
-// How a pass spreads its samples over the pixels: one each, or (adaptive) as many in total,
-// each pixel's share in proportion to its estimated noise, once every pixel has a few
-// samples. The brief's stratified estimator needs exactly its s samples per pixel, so it
-// always gets one each.
-enum class Allocation { uniform, adaptive };
-inline constexpr EnumNames<Allocation, 2> allocation_names{{"uniform", "adaptive"}};
-
-struct RenderSettings {
-    Integrator integrator = Integrator::pt;
-    Estimator estimator = Estimator::sobol;
-    Allocation allocation = Allocation::adaptive;
-    LightSampling light_sampling = LightSampling::brief;
-    int max_depth = 6;          // scattering events per path, 0..kMaxDepth
-    int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
-    int rr_depth = 3;           // Russian roulette from this many scattering events on
-    uint64_t seed = 0;
-
-    // Defaults from the scene file's renderer block.
-    static RenderSettings from_scene(const RendererSettings& renderer);
-};
 
 struct RenderState {
     int width = 0, height = 0;
@@ -166,69 +137,5 @@ bool plan_reads_statistics(const RenderSettings& settings, const RenderState& st
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                         const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass = {},
                         PassHooks* hooks = nullptr);
-
-// The camera's image coordinates in [0,1]^2 of a point (x, y) of the raster, where pixel
-// (i, j) spans [i, i+1) x [j, j+1), top row first. The brief's references put each pixel half
-// a pixel left of and half a pixel below that square (measured on all eight scenes: the
-// discs of scene 5's lights sit 0.5 px right of and 0.5 px above ours, and shifting our
-// renders so raised PSNR by 1.2 to 4 dB everywhere; docs/fidelity.md), so the camera sees
-// (x - 1/2, y + 1/2).
-inline Vec2 raster_to_camera(double x, double y, int width, int height) {
-    return {(x - 0.5) / width, (y + 0.5) / height};
-}
-
-// One radiance sample for a camera ray, for tests and tools: the integrator the settings name.
-struct SampleResult {
-    Color radiance;
-    double primary_distance = kMissDepth;
-    uint64_t rays = 0;
-};
-// `sampler` has given the sub-pixel and lens numbers already (or none, for a hand-made ray).
-SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settings, const Ray& ray,
-                          Sampler& sampler);
-// The camera rays of `count` samples of pixels (xs[i], ys[i]) of a width x height image, each
-// sampler having given nothing yet: it gives the sub-pixel position and the lens numbers
-// (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp, where packet_kernels()
-// below has lanes) for Sobol samplers and a pinhole, each ray as one at a time gives it up
-// to rounding.
-void camera_rays(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
-                 Sampler* const* samplers, int count, Ray* rays);
-
-// `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
-// camera rays in SIMD lanes (packet.cpp: eight paths in single precision, or four in double,
-// as packet_kernels() below says), a lane starting the next sample as its path ends, where
-// the scene is one leaf of our BVH; anything else goes one by one through trace_sample.
-// render_pass hands it up to kSampleBatch samples: the more, the less time lanes idle at the
-// batch's end.
-inline constexpr int kSampleBatch = 64;
-void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
-                   int count, SampleResult* results);
-
-// camera_rays, then trace_samples: `count` camera samples at pixels (xs, ys). The
-// single-precision lanes make a pinhole's camera rays themselves, eight at a time, for
-// Sobol samplers (the same samples; packet.cpp).
-void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
-                          const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
-
-// How camera_rays and trace_samples trace (packet.cpp), process-wide. `best`: in SIMD lanes
-// with the kernels built for x86-64-v3 where the CPU has AVX2 and FMA, else one path at a
-// time (the kernels built for any x86-64 CPU are slower than that); eight paths in single
-// precision where the scene's sizes fit it (float_lanes_fit), else four in double. `double`:
-// always the four double lanes where the CPU has them; `any`: in lanes with the kernels for
-// any CPU; `one_path`: one at a time. The last three are for tests and comparisons.
-enum class PacketIsa { best, double_lanes, any, one_path };
-inline constexpr EnumNames<PacketIsa, 4> packet_isa_names{{"best", "double", "any", "off"}};
-void set_packet_isa(PacketIsa isa);
-// What trace_samples runs for path tracing with these settings on this scene, as
-// set_packet_isa, the CPU and the scene decide.
-enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path };
-inline constexpr EnumNames<PacketKernels, 4> packet_kernels_names{
-    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path"}};
-PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
-// Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
-// distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
-// within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
-// inside their range (2^-60 to 2^60; a light of 1e30 is double's).
-bool float_lanes_fit(const RenderScene& scene);
 
 }  // namespace kr

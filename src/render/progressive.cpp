@@ -1,4 +1,4 @@
-#include "render/render.h"
+#include "render/progressive.h"
 
 #include <algorithm>
 #include <chrono>
@@ -6,6 +6,8 @@
 #include <optional>
 
 #include <omp.h>
+
+#include "render/trace.h"
 
 namespace kr {
 
