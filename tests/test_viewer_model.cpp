@@ -211,18 +211,23 @@ TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
 }
 
 // 10^6 samples of 0.1 (not representable): a naive double sum drifts by 1.3e-11 relative,
-// the viewer's accumulation must not.
+// RenderState::merge (the viewer's accumulation) must not.
 TEST(Accumulation, NoDriftAfterAMillionSamples) {
-    Accumulator acc;
-    acc.reset(1, 1);
+    RenderState totals(1, 1);
     RenderState pass(1, 1);
     pass.radiance_sum[0] = Color(0.1, 0.7, 1.0 / 3.0);
     pass.sample_count[0] = 1;
-    for (int i = 0; i < 1000000; ++i) acc.add(pass);
-    const Color mean = acc.mean().pixels[0];
+    for (int i = 0; i < 1000000; ++i) totals.merge(pass);
+    const Color mean = totals.radiance().pixels[0];
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], pass.radiance_sum[0][k], 1e-12 * pass.radiance_sum[0][k]);
-    EXPECT_EQ(acc.passes(), 1000000);
-    EXPECT_EQ(acc.totals().sample_count[0], 1000000u);
+    EXPECT_EQ(totals.passes, 1000000);
+    EXPECT_EQ(totals.sample_count[0], 1000000u);
+    // A scratch state cleared for its next pass keeps its sample indices.
+    pass.sample_index[0] = 7;
+    pass.clear_sums();
+    EXPECT_EQ(pass.radiance_sum[0].x, 0.0);
+    EXPECT_EQ(pass.sample_count[0], 0u);
+    EXPECT_EQ(pass.sample_index[0], 7u);
 }
 
 // The same through render_pass: the camera inside an emitter of radiance 0.1 with depth 0

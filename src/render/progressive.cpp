@@ -37,6 +37,62 @@ void RenderState::reset(int w, int h) {
     sample_credit.clear();
     for (auto& scratch : allocation_scratch) scratch.clear();
     sobol_keys.clear();
+    merged_raw_.clear();
+    merged_compensation_.clear();
+}
+
+namespace {
+
+// Neumaier's variant of Kahan summation: also exact when the addend is the larger term.
+inline void add_compensated(double& sum, double& compensation, double x) {
+    const double t = sum + x;
+    if (std::abs(sum) >= std::abs(x)) compensation += (sum - t) + x;
+    else compensation += (x - t) + sum;
+    sum = t;
+}
+
+}  // namespace
+
+void RenderState::merge(const RenderState& pass) {
+    const size_t n = radiance_sum.size();
+    if (merged_raw_.size() != n) {
+        merged_raw_ = radiance_sum;
+        merged_compensation_.assign(n, Color());
+    }
+    // Every pixel on its own: the same sums for any thread count.
+#pragma omp parallel for schedule(static)
+    for (long k = 0; k < long(n); ++k) {
+        const size_t i = size_t(k);
+        if (pass.sample_count[i] == 0) continue;
+        Color& sum = merged_raw_[i];
+        Color& c = merged_compensation_[i];
+        add_compensated(sum.x, c.x, pass.radiance_sum[i].x);
+        add_compensated(sum.y, c.y, pass.radiance_sum[i].y);
+        add_compensated(sum.z, c.z, pass.radiance_sum[i].z);
+        radiance_sum[i] = sum + c;
+        depth_sum[i] += pass.depth_sum[i];
+        luminance_sq_sum[i] += pass.luminance_sq_sum[i];
+        radiance_sq_sum[i] += pass.radiance_sq_sum[i];
+        sample_count[i] += pass.sample_count[i];
+    }
+    rays += pass.rays;
+    nonfinite_samples += pass.nonfinite_samples;
+    ++passes;
+}
+
+void RenderState::clear_sums() {
+    // In parallel: at 512x512 these loops took a tenth of a cheap scene's pass.
+#pragma omp parallel for schedule(static)
+    for (long k = 0; k < long(radiance_sum.size()); ++k) {
+        const size_t i = size_t(k);
+        radiance_sum[i] = Color();
+        depth_sum[i] = 0.0;
+        luminance_sq_sum[i] = 0.0;
+        radiance_sq_sum[i] = Color();
+        sample_count[i] = 0u;
+    }
+    rays = 0;
+    nonfinite_samples = 0;
 }
 
 uint64_t render_memory_bytes(int width, int height, bool blurred) {
@@ -327,6 +383,15 @@ bool plan_reads_statistics(const RenderSettings& settings, const RenderState& st
            state.passes >= kAllocationWarmup;
 }
 
+bool noise_check_due(const StopRule& rule, int passes) {
+    return rule.noise > 0 && passes >= int(rule.min_samples) && passes % rule.adapt_every == 0;
+}
+
+bool noise_target_met(RenderState& state, const StopRule& rule) {
+    // Every pixel within its share means the whole image is within the target too.
+    return state.relative_error() <= rule.noise || state.update_adaptive(rule.noise, rule.min_samples) == 0;
+}
+
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                         const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass,
                         PassHooks* hooks) {
@@ -335,16 +400,10 @@ StopReason render_until(const RenderScene& scene, const RenderSettings& settings
         state.plan_pass(settings);
         if (hooks) hooks->before_pass(state);
         render_pass(scene, settings, state);
-        const int passes = state.passes;
-        const bool noise_check =
-            rule.noise > 0 && passes >= int(rule.min_samples) && passes % rule.adapt_every == 0;
+        const bool noise_check = noise_check_due(rule, state.passes);
         if (hooks) hooks->after_pass(state, noise_check || plan_reads_statistics(settings, state));
         if (on_pass && !on_pass(state)) return StopReason::cancelled;
-        if (noise_check) {
-            if (state.relative_error() <= rule.noise) return StopReason::noise;
-            // Every pixel within its share means the whole image is within the target too.
-            if (state.update_adaptive(rule.noise, rule.min_samples) == 0) return StopReason::noise;
-        }
+        if (noise_check && noise_target_met(state, rule)) return StopReason::noise;
         const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const bool time_up = rule.seconds > 0 && elapsed >= rule.seconds;
         if (hooks ? hooks->any(time_up) : time_up) return StopReason::time;

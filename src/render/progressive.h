@@ -69,6 +69,22 @@ struct RenderState {
     // for the budget; fractions carry over between passes. Parallel over rows, with the rows'
     // sums added in order: the plan does not depend on threads.
     void plan_pass(const RenderSettings& settings);
+
+    // Adds a state that holds whole passes of the same pixels (the viewer renders each pass
+    // into a scratch state and merges it, so a cancelled pass adds nothing): the radiance with
+    // Neumaier-compensated sums (a naive double sum of 10^6 samples of 0.1 is off by 1.3e-11
+    // relative; this stays within an ulp or two), the other sums and the counters plainly,
+    // and one pass more.
+    void merge(const RenderState& pass);
+    // Zeroes the per-pixel sums and counters of samples kept, keeping sample_index (so the next
+    // pass draws the next samples), the adaptive mask and the Sobol keys: a scratch state
+    // ready for its next pass.
+    void clear_sums();
+
+private:
+    // merge()'s running radiance sums before correction and their corrections, per pixel
+    // (empty until the first merge); radiance_sum holds their corrected total.
+    std::vector<Color> merged_raw_, merged_compensation_;
 };
 
 // The bytes per pixel a RenderState holds once every buffer is in use: the six sums and
@@ -109,6 +125,14 @@ struct StopRule {
 };
 
 enum class StopReason { passes, time, noise, cancelled };
+
+// The noise rule of a StopRule, as every driver of passes applies it: checked after pass
+// `passes` when the rule has a target, from min_samples passes on and every adapt_every
+// passes (the adaptive mask is updated at the same checks).
+bool noise_check_due(const StopRule& rule, int passes);
+// The check itself: true when the image's estimated relative error is within the target, or
+// no pixel is above its share of it; otherwise updates `state`'s adaptive mask.
+bool noise_target_met(RenderState& state, const StopRule& rule);
 
 // The driver's extension points for a render shared by several processes (app/cluster.h
 // deals pixels to MPI ranks through them). Each pixel's samples are drawn by one process in

@@ -1,7 +1,7 @@
-// The viewer's accumulation buffer. Each pass renders one sample per pixel into a scratch
-// kr::RenderState (so samples, RNG streams and seeding are exactly the core renderer's),
-// then adds it to running sums with Neumaier compensation: a naive double sum of 10^6
-// samples of 0.1 is off by 1.3e-11 relative; this one stays within an ulp or two.
+// The viewer's accumulation buffer. Each pass renders into a scratch kr::RenderState (so
+// samples, RNG streams and seeding are exactly the core renderer's), which
+// RenderState::merge adds to the totals with compensated sums only when the pass completes:
+// an edit that cancels a pass leaves the totals as they were.
 #pragma once
 
 #include <atomic>
@@ -22,17 +22,14 @@ public:
     bool render_pass(const RenderScene& scene, const RenderSettings& settings,
                      const std::atomic<bool>* stop = nullptr);
 
-    // Adaptive sampling towards relative error `target` (RenderState::update_adaptive on the
-    // totals): later passes sample only the pixels still above their share. Returns their
-    // count; 0 means the image meets the target. clear_adaptive() samples every pixel again.
-    size_t update_adaptive(double target);
+    // The noise rule (noise_target_met on the totals): true when the image meets the rule's
+    // target; otherwise later passes sample only the pixels still above their share.
+    // clear_adaptive() samples every pixel again.
+    bool noise_target_met(const StopRule& rule);
     void clear_adaptive() {
         scratch_.active.clear();
         totals_.active.clear();
     }
-
-    // Adds a one-pass state: its samples per pixel in `pass.radiance_sum` etc.
-    void add(const RenderState& pass);
 
     // The running totals as a RenderState (radiance_sum holds the compensated sums), for
     // RenderState::relative_error() and the counters.
@@ -46,9 +43,7 @@ public:
 
 private:
     RenderState totals_;
-    std::vector<Color> raw_sum_;       // uncorrected running sums per pixel
-    std::vector<Color> compensation_;  // Neumaier's running correction per pixel
-    RenderState scratch_;              // keeps sample_index across passes: the RNG streams
+    RenderState scratch_;  // keeps sample_index across passes: the RNG streams
 };
 
 }  // namespace kr::viewer

@@ -190,11 +190,10 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = accumulator.mean();
-            // The noise rule as render_until applies it: every 4 passes from 16 on.
-            const int passes = accumulator.passes();
-            if (stop_noise > 0 && passes >= 16 && passes % 4 == 0)
-                noise_met = accumulator.totals().relative_error() <= stop_noise ||
-                            accumulator.update_adaptive(stop_noise) == 0;
+            // The noise rule as render_until applies it.
+            StopRule rule;
+            rule.noise = stop_noise;
+            if (noise_check_due(rule, accumulator.passes())) noise_met = accumulator.noise_target_met(rule);
         }
         const RenderState& totals = accumulator.totals();
         frame->generation = job.generation;
