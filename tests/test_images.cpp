@@ -108,3 +108,41 @@ TEST(ReferenceSensitivity, WrongConventionsFail) {
     for (Light& l : pt.lights) l.power = l.power / (kPi * 4 * kPi);
     EXPECT_LT(psnr(block_average(render(pt, 4), 8), block_average(reference(3), 8)), 20.0);
 }
+
+// The display operators on values whose bytes are known: EV 0 leaves the brief's sigmoid
+// and linear maps as they were; exposure (2^EV) scales radiance before every operator,
+// the linear one included; srgb is the IEC 61966-2-1 curve of the clamped value.
+TEST(ToneMap, ExposureActsOnEveryOperatorAndSrgbFollowsTheCurve) {
+    Image img(4, 1);
+    img.pixels = {Color(1, 2, 0.5), Color(0.002, 0, -1), Color(std::nan(""), 4, 0.25), Color(0.04, 0.7, 0.1)};
+    const auto byte = [](const Rgb8Image& out, int pixel, int channel) {
+        return int(out.bytes[size_t(3 * pixel + channel)]);
+    };
+    // Linear: I / max over the finite pixels' channels (2: the NaN pixel is left out), then
+    // the exposure.
+    const Rgb8Image lin0 = tonemap(img, ToneMap::linear);
+    EXPECT_EQ(byte(lin0, 0, 0), 128);  // 1/2 * 255 = 127.5
+    EXPECT_EQ(byte(lin0, 0, 1), 255);
+    EXPECT_EQ(byte(lin0, 0, 2), 64);   // 0.25 * 255 = 63.75
+    const Rgb8Image lin_up = tonemap(img, ToneMap::linear, 2.0);  // EV +1
+    EXPECT_EQ(byte(lin_up, 0, 0), 255);
+    EXPECT_EQ(byte(lin_up, 0, 2), 128);
+    const Rgb8Image lin_down = tonemap(img, ToneMap::linear, 0.5);  // EV -1
+    EXPECT_EQ(byte(lin_down, 0, 1), 128);
+    EXPECT_EQ(byte(lin_down, 0, 0), 64);
+    // Sigmoid: v e / (1 + v e).
+    EXPECT_EQ(byte(tonemap(img, ToneMap::sigmoid), 0, 0), 128);        // 1/2
+    EXPECT_EQ(byte(tonemap(img, ToneMap::sigmoid, 3.0), 0, 0), 191);   // 3/4 * 255 = 191.25
+    // sRGB: 0.5 -> 0.7354 (188), 0.002 -> 12.92 * 0.002 (7), above 1 -> 255, negative and
+    // NaN -> 0, 0.25 -> 0.5371 (137).
+    const Rgb8Image srgb = tonemap(img, ToneMap::srgb);
+    EXPECT_EQ(byte(srgb, 0, 2), 188);
+    EXPECT_EQ(byte(srgb, 1, 0), 7);
+    EXPECT_EQ(byte(srgb, 0, 1), 255);
+    EXPECT_EQ(byte(srgb, 1, 2), 0);
+    EXPECT_EQ(byte(srgb, 2, 0), 0);
+    EXPECT_EQ(byte(srgb, 2, 2), 137);
+    EXPECT_EQ(byte(tonemap(img, ToneMap::srgb, 2.0), 2, 2), 188);  // EV +1: 0.25 -> 0.5
+    EXPECT_NEAR(srgb_encode(0.0031308), 0.04045, 1e-5);           // the curve's two pieces meet
+    EXPECT_NEAR(1.055 * std::pow(0.0031308, 1 / 2.4) - 0.055, 0.04045, 1e-5);
+}

@@ -349,7 +349,7 @@ TEST_F(LoadErrors, DisplayBlockIsOptionalAndStrict) {
     EXPECT_EQ(loaded.scene.display.exposure, -1.5);
     EXPECT_EQ(loaded.scene.display.exposure_scale(), std::exp2(-1.5));
     expect_error(with_display(R"({"tonemap": "filmic"})"), "/scene/display/tonemap",
-                 "unknown tone map \"filmic\"; expected \"sigmoid\" or \"linear\"");
+                 "unknown tone map \"filmic\"; expected \"sigmoid\", \"linear\" or \"srgb\"");
     expect_error(with_display(R"({"exposure": 10.5})"), "/scene/display/exposure",
                  "expected a number of stops in [-10, 10], got 10.5");
     expect_error(with_display(R"({"exposure": "bright"})"), "/scene/display/exposure", "expected a number");

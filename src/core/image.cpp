@@ -20,21 +20,28 @@ uint8_t quantize_unit(double v) {
 Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure) {
     Rgb8Image out{radiance.width, radiance.height, {}};
     out.bytes.resize(radiance.pixels.size() * 3);
-    double scale = exposure;
-    if (op == ToneMap::linear) {
-        double max_value = 0;
-        for (const Color& c : radiance.pixels)
-            if (is_finite(c)) max_value = std::max(max_value, max_component(c));
-        scale = max_value > 0 ? 1.0 / max_value : 0.0;  // exposure cancels in I / max(I)
-    }
+    const double scale = op == ToneMap::linear ? linear_tonemap_scale(radiance, exposure) : exposure;
     for (size_t i = 0; i < radiance.pixels.size(); ++i) {
         const Color c = radiance.pixels[i] * scale;
         for (int k = 0; k < 3; ++k) {
             const double v = c[k];
-            out.bytes[3 * i + k] = quantize_unit(op == ToneMap::sigmoid ? sigmoid_tonemap(v) : v);
+            double unit = v;
+            switch (op) {
+                case ToneMap::sigmoid: unit = sigmoid_tonemap(v); break;
+                case ToneMap::linear: break;
+                case ToneMap::srgb: unit = v > 0 ? srgb_encode(std::min(v, 1.0)) : v; break;  // NaN stays NaN: 0
+            }
+            out.bytes[3 * i + k] = quantize_unit(unit);
         }
     }
     return out;
+}
+
+double linear_tonemap_scale(const Image& radiance, double exposure) {
+    double max_value = 0;
+    for (const Color& c : radiance.pixels)
+        if (is_finite(c)) max_value = std::max(max_value, max_component(c));
+    return max_value > 0 ? exposure / max_value : 0.0;
 }
 
 namespace {

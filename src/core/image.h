@@ -2,6 +2,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <vector>
@@ -30,13 +31,22 @@ struct Rgb8Image {
 
 // Display tone maps: one table for the loader, the saver, the command lines and the viewer's
 // combos.
-enum class ToneMap { sigmoid, linear };
-inline constexpr EnumNames<ToneMap, 2> tonemap_names{{"sigmoid", "linear"}};
+enum class ToneMap { sigmoid, linear, srgb };
+inline constexpr EnumNames<ToneMap, 3> tonemap_names{{"sigmoid", "linear", "srgb"}};
 
-// Per channel: sigmoid I/(1+I), or linear I/max where max is the largest channel value
-// of the whole image (one scale for all channels, so hues are kept). Then x255 and round,
-// no gamma (the brief's convention). `exposure` scales radiance first.
+// Per channel, after `exposure` (2^EV) scales radiance: sigmoid I/(1+I), or linear I/max
+// where max is the largest channel value of the whole image (one scale for all channels, so
+// hues are kept), both with no gamma (the brief's operators, its references' convention); or
+// srgb: clamped to [0, 1], then the sRGB transfer curve, as HDR viewers display radiance.
+// Then x255 and round. At exposure 1 (EV 0) the brief's operators are exactly its own.
 Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure = 1.0);
+
+// The linear operator's scale: exposure / max over the finite channel values of the image
+// (0 for a black image). The viewer's shader takes it as a uniform.
+double linear_tonemap_scale(const Image& radiance, double exposure = 1.0);
+
+// The sRGB transfer curve (IEC 61966-2-1) of a linear value in [0, 1].
+inline double srgb_encode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
 
 // One channel value of the tone maps above, before quantisation, for callers
 // that tone map themselves (the viewer's shader mirrors this).

@@ -29,12 +29,6 @@ GLuint compile(const GlFunctions& gl, GLenum type, const char* source, const cha
 
 }  // namespace
 
-double linear_scale(const Image& radiance) {
-    double max_value = 0;
-    for (const Color& c : radiance.pixels)
-        if (is_finite(c)) max_value = std::max(max_value, max_component(c));
-    return max_value > 0 ? 1.0 / max_value : 0.0;
-}
 
 Display::Display(const GlFunctions& gl) : gl_(gl) {
     const GLuint vs = compile(gl_, GL_VERTEX_SHADER, kDisplayVertexShader, "shaders/display.vert");
@@ -90,7 +84,7 @@ void Display::upload(const Image& radiance) {
                    texels.data());
     tex_width_ = radiance.width;
     tex_height_ = radiance.height;
-    inv_max_ = linear_scale(radiance);
+    inv_max_ = linear_tonemap_scale(radiance);
 }
 
 void Display::draw(const PixelRect& where, int framebuffer_width, int framebuffer_height,
@@ -103,9 +97,9 @@ void Display::draw(const PixelRect& where, int framebuffer_width, int framebuffe
     const double y1 = 1.0 - 2.0 * (where.y + where.height) / framebuffer_height;
     gl_.UseProgram(program_);
     gl_.Uniform4f(rect_loc_, float(x0), float(y0), float(x1), float(y1));
-    gl_.Uniform1i(op_loc_, tone.tonemap == ToneMap::sigmoid ? 0 : 1);
+    gl_.Uniform1i(op_loc_, int(tone.tonemap));  // the shader's op numbers are ToneMap's order
     gl_.Uniform1f(exposure_loc_, float(tone.exposure_scale()));
-    gl_.Uniform1f(inv_max_loc_, float(inv_max_));
+    gl_.Uniform1f(inv_max_loc_, float(inv_max_ * tone.exposure_scale()));
     gl_.Uniform1i(sampler_loc_, 0);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, texture_);

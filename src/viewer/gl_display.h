@@ -40,7 +40,4 @@ private:
     double inv_max_ = 0;
 };
 
-// 1 / (largest finite channel value), or 0 for a black image: kr::tonemap's linear scale.
-double linear_scale(const Image& radiance);
-
 }  // namespace kr::viewer

@@ -451,10 +451,8 @@ void ViewerApp::panel_tone_map() {
     if (!ImGui::CollapsingHeader("Tone map", ImGuiTreeNodeFlags_DefaultOpen)) return;
     ToneSettings tone = model_.settings().tone;
     bool changed = combo("operator", tone.tonemap, tonemap_names);
-    ImGui::BeginDisabled(tone.tonemap == ToneMap::linear);
     changed |= field("exposure (EV)", &tone.exposure, 1, 0.02f, -kMaxExposureStops, kMaxExposureStops, "%.2f");
-    ImGui::EndDisabled();
-    if (tone.tonemap == ToneMap::linear) ImGui::TextDisabled("linear: I / max(I), exposure cancels (as in render)");
+    if (tone.tonemap == ToneMap::linear) ImGui::TextDisabled("linear: 2^EV I / max(I)");
     if (changed) edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.tone = tone; }, "tone map", "tone map");
 }
 
