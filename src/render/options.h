@@ -12,7 +12,7 @@
 #include <string_view>
 
 #include "core/args.h"
-#include "render/progressive.h"
+#include "render/settings.h"
 #include "scene/scene.h"
 
 namespace kr {
