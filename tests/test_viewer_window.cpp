@@ -14,8 +14,13 @@
 #include <regex>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 #include "core/image.h"
+#include "core/image_compare.h"
 #include "core/image_io.h"
+#include "viewer/compare_view.h"
+#include "viewer/inspect.h"
 #include "scene/load.h"
 #include "test_util.h"
 
@@ -116,6 +121,126 @@ TEST_F(ViewerWindow, BrokenSceneFailsScriptedRunWithItsError) {
     EXPECT_FALSE(fs::exists(dir / "x.ppm"));
 }
 
+// The compare views: the screenshot is what the window shows of the image, computed here on
+// the CPU from the headless render of the same passes (2 spp: the viewer's compensated
+// sums are then the plain ones) and the brief's reference, offered for its scene.
+namespace {
+
+fs::path reference(int n) {
+    return fs::path(KEITHRAY_RES_DIR) / "references" / ("assignment_0" + std::to_string(n) + ".ppm");
+}
+
+}  // namespace
+
+TEST_F(ViewerWindow, SplitViewShowsTheRenderLeftAndTheReferenceRight) {
+    const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(3) + "' --spp 2 --frames 2 --view split --split 0.25 --screenshot '" +
+                                   shot.string() + "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    ASSERT_EQ(keithray("render '" + scene(3) + "' --spp 2 -q -o '" + headless.string() + "'", false).status, 0);
+    const kr::Rgb8Image s = kr::read_ppm(shot), a = kr::read_ppm(headless), b = kr::read_ppm(reference(3));
+    ASSERT_EQ(s.width, 512);
+    ASSERT_EQ(s.height, 512);
+    int worst_a = 0, wrong_b = 0;
+    for (size_t i = 0; i < s.bytes.size(); ++i) {
+        const size_t x = (i / 3) % 512;
+        if (x < 128) worst_a = std::max(worst_a, std::abs(int(s.bytes[i]) - int(a.bytes[i])));
+        else wrong_b += s.bytes[i] != b.bytes[i];
+    }
+    EXPECT_LE(worst_a, 1);   // the display shader's tone map, as in the tests above
+    EXPECT_EQ(wrong_b, 0);   // image B as stored
+    // And they differ: the split shows two images.
+    EXPECT_GT(max_channel_difference(a, b), 10);
+}
+
+TEST_F(ViewerWindow, ErrorViewIsTheFalseColourOfTheErrorAgainstTheReference) {
+    const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(4) + "' --spp 2 --frames 2 --view error --error relative --screenshot '" +
+                                   shot.string() + "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    ASSERT_EQ(keithray("render '" + scene(4) + "' --spp 2 -q -o '" + headless.string() + "'", false).status, 0);
+    const std::vector<float> errors =
+        kr::viewer::pixel_errors(kr::read_ppm(headless), kr::read_ppm(reference(4)), kr::viewer::ErrorMetric::relative);
+    const kr::Rgb8Image expected =
+        kr::false_colour_picture(errors, 512, 512, kr::viewer::robust_scale(errors));
+    const kr::Rgb8Image s = kr::read_ppm(shot);
+    ASSERT_EQ(s.width, 512);
+    EXPECT_EQ(max_channel_difference(s, expected), 0);
+}
+
+TEST_F(ViewerWindow, SamplesViewShowsUniformAllocationAsOneColour) {
+    const fs::path shot = dir / "shot.ppm";
+    const ViewRun v = keithray("view '" + scene(1) + "' --spp 3 --frames 3 --allocation uniform --view samples"
+                                   " --screenshot '" + shot.string() + "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    const kr::Rgb8Image s = kr::read_ppm(shot);
+    const auto top = kr::viridis(1.0);  // every pixel has the most samples: the top colour
+    int wrong = 0;
+    for (size_t i = 0; i < s.bytes.size(); ++i) wrong += s.bytes[i] != top[i % 3];
+    EXPECT_EQ(wrong, 0);
+}
+
+TEST_F(ViewerWindow, LivePsnrEqualsThePsnrCommand) {
+    const fs::path stats = dir / "stats.json", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(5) + "' --spp 4 --frames 4 --probe 200,300 --stats-json '" +
+                                   stats.string() + "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    ASSERT_EQ(keithray("render '" + scene(5) + "' --spp 4 -q -o '" + headless.string() + "'", false).status, 0);
+    const ViewRun p = keithray("psnr '" + headless.string() + "' '" + reference(5).string() + "'", false);
+    ASSERT_EQ(p.status, 0) << p.err;
+    const auto j = nlohmann::json::parse(kr::test::read_file(stats));
+    EXPECT_EQ(j["spp"], 4);
+    EXPECT_EQ(j["reference"], "assignment_05.ppm");
+    EXPECT_NEAR(j["psnr"].get<double>(), std::stod(p.out), 0.01);  // psnr prints two decimals
+    EXPECT_GT(j["rmse"].get<double>(), 0);
+    EXPECT_GT(j["mrays_per_second"].get<double>(), 0);
+    EXPECT_GT(j["noise"].get<double>(), 0);
+    // The locked probe reads the headless image's pixel.
+    const kr::Rgb8Image h = kr::read_ppm(headless);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(j["probe"]["displayed"][size_t(k)].get<int>(), h.bytes[(300 * 512 + 200) * 3 + size_t(k)]);
+    EXPECT_EQ(j["probe"]["samples"], 4);
+}
+
+// At 4x each image pixel is a 4x4 block of the pixel's tone-mapped value.
+TEST_F(ViewerWindow, ZoomShowsBlocksOfTheImagesPixels) {
+    const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(3) + "' --spp 1 --frames 1 --zoom 4 --screenshot '" + shot.string() +
+                                   "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(v.out, m, std::regex("image pixel ([0-9.]+),([0-9.]+) at ([0-9.]+) screen pixels")))
+        << v.out;
+    const double x0 = std::stod(m[1]), y0 = std::stod(m[2]);
+    ASSERT_EQ(std::stod(m[3]), 4);
+    ASSERT_EQ(keithray("render '" + scene(3) + "' --spp 1 -q -o '" + headless.string() + "'", false).status, 0);
+    const kr::Rgb8Image s = kr::read_ppm(shot), h = kr::read_ppm(headless);
+    ASSERT_GT(s.width, 200);
+    ASSERT_GT(s.height, 200);
+    int worst = 0, uneven = 0;
+    for (int r = 0; r < s.height; ++r)
+        for (int c = 0; c < s.width; ++c) {
+            // Whole blocks: the screenshot starts on a block's edge (x0, y0 are multiples of 1/4).
+            const int ix = int(std::floor(x0 + c / 4.0 + 1e-9)), iy = int(std::floor(y0 + r / 4.0 + 1e-9));
+            ASSERT_LT(ix, 512);
+            ASSERT_LT(iy, 512);
+            // The block's first screen pixel.
+            const int c0 = int(std::ceil((ix - x0) * 4 - 1e-9)), r0 = int(std::ceil((iy - y0) * 4 - 1e-9));
+            for (int k = 0; k < 3; ++k) {
+                const uint8_t got = s.bytes[(size_t(r) * s.width + c) * 3 + k];
+                worst = std::max(worst, std::abs(int(got) - int(h.bytes[(size_t(iy) * 512 + ix) * 3 + k])));
+                uneven += got != s.bytes[(size_t(std::max(r0, 0)) * s.width + std::max(c0, 0)) * 3 + k];
+            }
+        }
+    EXPECT_EQ(uneven, 0);
+    EXPECT_LE(worst, 1);
+}
+
 // Real X input events (xdotool) on the real window, through tests/viewer_input.sh, which
 // waits on the viewer's --status-file for each condition (bounded, never a fixed time).
 namespace {
@@ -176,4 +301,29 @@ TEST_F(ViewerWindow, EscWithUnsavedEditsAsksFirst) {
     ASSERT_EQ(r.count("error"), 0u) << r["error"];
     EXPECT_EQ(r["running_after_esc"], "1");
     EXPECT_NE(r["generation_after"], r["generation_before"]);  // the held arrow key orbited
+}
+
+// Zoom, view and probe keys and clicks as a user gives them; none of them edits the scene.
+TEST_F(ViewerWindow, ZoomKeysProbeClickAndMiddleDragPan) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "zoom_probe", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["generation_after"], r["generation_before"]);  // no click or drag moved the camera
+    // Zoomed 2x about the pointer (250, 330): the image point under it stayed there, so the
+    // probe (the pixel under the pointer) is that point's pixel in both layouts.
+    double x = 0, y = 0, scale = 0;
+    ASSERT_EQ(std::sscanf(r["zoomed"].c_str(), "%lf,%lf,%lf", &x, &y, &scale), 3) << r["zoomed"];
+    EXPECT_EQ(scale, 2);
+    int px = 0, py = 0;
+    ASSERT_EQ(std::sscanf(r["probe"].c_str(), "%d,%d", &px, &py), 2) << r["probe"];
+    EXPECT_EQ(px, int(std::floor((250 - x) / 2)));
+    EXPECT_EQ(py, int(std::floor((330 - y) / 2)));
+    // The middle drag of (40, -20) moved the zoomed image with the pointer.
+    double x2 = 0, y2 = 0, scale2 = 0;
+    ASSERT_EQ(std::sscanf(r["panned"].c_str(), "%lf,%lf,%lf", &x2, &y2, &scale2), 3) << r["panned"];
+    EXPECT_EQ(x2 - x, 40);
+    EXPECT_EQ(y2 - y, -20);
+    EXPECT_EQ(scale2, 2);
+    ASSERT_EQ(std::sscanf(r["wheel_zoomed"].c_str(), "%lf,%lf,%lf", &x, &y, &scale), 3) << r["wheel_zoomed"];
+    EXPECT_EQ(scale, 2);
 }

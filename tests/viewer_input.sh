@@ -69,6 +69,52 @@ raise_target)
     wait_for 'state=done spp=4 target=4' || exit 1
     echo "title_after=$(xdotool getwindowname "$wid")"
     ;;
+zoom_probe)
+    # Zoom in a step about the pointer (1:1 -> 2x), V to the next view, Shift+click locks
+    # the probe (no orbit), a middle drag pans the zoomed image, 0 fits it again.
+    xdotool key equal
+    wait_for 'image=[-0-9.]+,[-0-9.]+,2 ' || exit 1
+    echo "zoomed=$(field image)"
+    xdotool key v
+    wait_for 'view=reference' || exit 1
+    xdotool keydown shift
+    xdotool click 1
+    xdotool keyup shift
+    wait_for 'probe=[0-9]+,[0-9]+' || exit 1
+    echo "probe=$(field probe)"
+    xdotool mousedown 2
+    wait_for 'press=4 pointer=250,330' || exit 1
+    xdotool mousemove_relative 40 -20
+    wait_for 'pointer=290,310' || exit 1
+    xdotool mouseup 2
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    echo "panned=$(field image)"
+    xdotool key F1
+    wait_for 'help=0' || exit 1
+    xdotool key 0
+    wait_for 'image=[-0-9.]+,[-0-9.]+,fit' || exit 1
+    # Ctrl+wheel zooms about the pointer too.
+    xdotool keydown ctrl
+    xdotool click 4
+    xdotool keyup ctrl
+    wait_for 'image=[-0-9.]+,[-0-9.]+,2 ' || exit 1
+    echo "wheel_zoomed=$(field image)"
+    xdotool key 0
+    wait_for 'image=[-0-9.]+,[-0-9.]+,fit' || exit 1
+    # The split view's divider (V: reference -> split) follows a left drag, without orbiting.
+    xdotool key v
+    wait_for 'view=split split=0.500' || exit 1
+    left=$(field image | cut -d, -f1)
+    xdotool mousemove --window "$wid" $((${left%.*} + 256)) 330
+    wait_for "pointer=$((${left%.*} + 256)),330" || exit 1
+    xdotool mousedown 1
+    wait_for 'press=8 pointer' || exit 1  # the divider's, not an orbit
+    xdotool mousemove_relative -- -128 0
+    wait_for "pointer=$((${left%.*} + 128)),330" || exit 1
+    xdotool mouseup 1
+    wait_for 'split=0.250' || exit 1
+    ;;
 esc)
     xdotool key Escape
     ;;

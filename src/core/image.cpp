@@ -17,22 +17,33 @@ uint8_t quantize_unit(double v) {
     return static_cast<uint8_t>(std::lround(v * 255.0));
 }
 
+std::array<uint8_t, 3> tonemap_color(const Color& radiance, ToneMap op, double scale) {
+    const Color c = radiance * scale;
+    std::array<uint8_t, 3> out{};
+    for (int k = 0; k < 3; ++k) {
+        const double v = c[k];
+        double unit = v;
+        switch (op) {
+            case ToneMap::sigmoid: unit = sigmoid_tonemap(v); break;
+            case ToneMap::linear: break;
+            case ToneMap::srgb: unit = v > 0 ? srgb_encode(std::min(v, 1.0)) : v; break;  // NaN stays NaN: 0
+        }
+        out[size_t(k)] = quantize_unit(unit);
+    }
+    return out;
+}
+
+double tonemap_scale(const Image& radiance, ToneMap op, double exposure) {
+    return op == ToneMap::linear ? linear_tonemap_scale(radiance, exposure) : exposure;
+}
+
 Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure) {
     Rgb8Image out{radiance.width, radiance.height, {}};
     out.bytes.resize(radiance.pixels.size() * 3);
-    const double scale = op == ToneMap::linear ? linear_tonemap_scale(radiance, exposure) : exposure;
+    const double scale = tonemap_scale(radiance, op, exposure);
     for (size_t i = 0; i < radiance.pixels.size(); ++i) {
-        const Color c = radiance.pixels[i] * scale;
-        for (int k = 0; k < 3; ++k) {
-            const double v = c[k];
-            double unit = v;
-            switch (op) {
-                case ToneMap::sigmoid: unit = sigmoid_tonemap(v); break;
-                case ToneMap::linear: break;
-                case ToneMap::srgb: unit = v > 0 ? srgb_encode(std::min(v, 1.0)) : v; break;  // NaN stays NaN: 0
-            }
-            out.bytes[3 * i + k] = quantize_unit(unit);
-        }
+        const std::array<uint8_t, 3> c = tonemap_color(radiance.pixels[i], op, scale);
+        std::copy(c.begin(), c.end(), out.bytes.begin() + std::ptrdiff_t(3 * i));
     }
     return out;
 }

@@ -45,6 +45,11 @@ Rgb8Image tonemap(const Image& radiance, ToneMap op, double exposure = 1.0);
 // (0 for a black image). The viewer's shader takes it as a uniform.
 double linear_tonemap_scale(const Image& radiance, double exposure = 1.0);
 
+// One pixel of tonemap(): `scale` is tonemap_scale() of the whole image (the linear
+// operator's depends on the image's maximum).
+double tonemap_scale(const Image& radiance, ToneMap op, double exposure = 1.0);
+std::array<uint8_t, 3> tonemap_color(const Color& radiance, ToneMap op, double scale);
+
 // The sRGB transfer curve (IEC 61966-2-1) of a linear value in [0, 1].
 inline double srgb_encode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
 

@@ -236,6 +236,9 @@ constexpr std::array<std::array<uint8_t, 3>, 9> kViridis{{{68, 1, 84},
                                                           {170, 220, 50},
                                                           {253, 231, 37}}};
 
+
+}  // namespace
+
 std::array<uint8_t, 3> viridis(double v) {
     v = std::clamp(std::isnan(v) ? 1.0 : v, 0.0, 1.0) * (kViridis.size() - 1);
     const size_t i = std::min(size_t(v), kViridis.size() - 2);
@@ -246,11 +249,20 @@ std::array<uint8_t, 3> viridis(double v) {
     return out;
 }
 
-}  // namespace
+Rgb8Image false_colour_picture(const std::vector<float>& values, int width, int height, double scale) {
+    if (width <= 0 || height <= 0 || values.size() != size_t(width) * size_t(height))
+        throw std::invalid_argument("false_colour: values do not match the image size");
+    Rgb8Image img{width, height, std::vector<uint8_t>(values.size() * 3)};
+    const double inv = scale > 0 ? 1 / scale : 0;
+    for (size_t i = 0; i < values.size(); ++i) {
+        const std::array<uint8_t, 3> c = viridis(values[i] * inv);
+        std::copy(c.begin(), c.end(), img.bytes.begin() + std::ptrdiff_t(3 * i));
+    }
+    return img;
+}
 
 Rgb8Image false_colour(const std::vector<float>& error, int width, int height, double scale) {
-    if (width <= 0 || height <= 0 || error.size() != size_t(width) * size_t(height))
-        throw std::invalid_argument("false_colour: error values do not match the image size");
+    const Rgb8Image picture = false_colour_picture(error, width, height, scale);
     // The picture, then under it a gap, the bar and a row of labels, on black.
     // Labels in stb_easy_font at 1.4 pixels a unit: its digits' 7 units fit the 10-pixel row.
     constexpr int kGap = 4, kBar = 12, kLabel = 10, kMargin = 8;
@@ -263,9 +275,9 @@ Rgb8Image false_colour(const std::vector<float>& error, int width, int height, d
         uint8_t* p = &img.bytes[3 * (size_t(y) * size_t(img.width) + size_t(x))];
         p[0] = c[0], p[1] = c[1], p[2] = c[2];
     };
-    const double inv = scale > 0 ? 1 / scale : 0;
     for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) put(x, y, viridis(error[size_t(y) * size_t(width) + size_t(x)] * inv));
+        std::copy_n(picture.bytes.begin() + std::ptrdiff_t(3 * size_t(y) * size_t(width)), 3 * width,
+                    img.bytes.begin() + std::ptrdiff_t(3 * size_t(y) * size_t(img.width)));
     const int bar_top = height + kGap, bar_left = kMargin, bar_right = img.width - kMargin;
     for (int x = bar_left; x < bar_right; ++x) {
         const auto c = viridis(double(x - bar_left) / double(std::max(1, bar_right - 1 - bar_left)));

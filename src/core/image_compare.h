@@ -52,6 +52,11 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
 // The upper quantile of the standard normal distribution: z with P(Z > z) = p.
 double normal_upper_quantile(double p);
 
+// Viridis at v in [0, 1] (clamped; NaN is the top colour), dark to bright.
+std::array<uint8_t, 3> viridis(double v);
+// Per pixel, viridis of value / scale: the picture alone, width x height.
+Rgb8Image false_colour_picture(const std::vector<float>& values, int width, int height, double scale);
+
 // A false-colour picture of a per-pixel error (viridis from 0 to `scale`, brighter is larger,
 // values above saturate), with a colour bar under it labelled 0 and `scale`.
 Rgb8Image false_colour(const std::vector<float>& error, int width, int height, double scale);

@@ -54,17 +54,21 @@ Display::Display(const GlFunctions& gl) : gl_(gl) {
     sampler_loc_ = gl_.GetUniformLocation(program_, "radiance");
     // A core profile draws nothing without a bound vertex array, even with no attributes.
     gl_.GenVertexArrays(1, &vertex_array_);
-    gl_.GenTextures(1, &texture_);
-    gl_.BindTexture(GL_TEXTURE_2D, texture_);
-    // Nearest: at 1:1 every fragment reads exactly its pixel; previews show as blocks.
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    for (GLuint* t : {&texture_, &bytes_texture_}) {
+        gl_.GenTextures(1, t);
+        gl_.BindTexture(GL_TEXTURE_2D, *t);
+        // Nearest: at 1:1 every fragment reads exactly its pixel; previews and zoomed
+        // pixels show as blocks.
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
 }
 
 Display::~Display() {
     gl_.DeleteTextures(1, &texture_);
+    gl_.DeleteTextures(1, &bytes_texture_);
     gl_.DeleteVertexArrays(1, &vertex_array_);
     gl_.DeleteProgram(program_);
 }
@@ -87,26 +91,53 @@ void Display::upload(const Image& radiance) {
     inv_max_ = linear_tonemap_scale(radiance);
 }
 
-void Display::draw(const PixelRect& where, int framebuffer_width, int framebuffer_height,
+void Display::upload_bytes(const Rgb8Image& picture) {
+    gl_.ActiveTexture(GL_TEXTURE0);
+    gl_.BindTexture(GL_TEXTURE_2D, bytes_texture_);
+    gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB8, picture.width, picture.height, 0, GL_RGB, GL_UNSIGNED_BYTE,
+                   picture.bytes.data());
+    bytes_width_ = picture.width;
+}
+
+void Display::draw(const PixelRect& where, const PixelRect& clip, int framebuffer_width, int framebuffer_height,
                    const ToneSettings& tone) const {
-    if (!has_image() || framebuffer_width <= 0 || framebuffer_height <= 0) return;
+    if (!has_image()) return;
+    draw_quad(where, clip, framebuffer_width, framebuffer_height, int(tone.tonemap),  // ToneMap's order
+              float(tone.exposure_scale()), float(inv_max_ * tone.exposure_scale()), texture_);
+}
+
+void Display::draw_bytes(const PixelRect& where, const PixelRect& clip, int framebuffer_width,
+                         int framebuffer_height) const {
+    if (!has_bytes()) return;
+    draw_quad(where, clip, framebuffer_width, framebuffer_height, 3, 1, 1, bytes_texture_);
+}
+
+void Display::draw_quad(const PixelRect& where, const PixelRect& clip, int framebuffer_width, int framebuffer_height,
+                        int op, float exposure, float inv_max, GLuint texture) const {
+    if (framebuffer_width <= 0 || framebuffer_height <= 0 || clip.width <= 0 || clip.height <= 0) return;
     gl_.Viewport(0, 0, framebuffer_width, framebuffer_height);
+    gl_.Enable(GL_SCISSOR_TEST);
+    // GL's scissor box counts rows from the bottom.
+    gl_.Scissor(GLint(clip.x), GLint(framebuffer_height - clip.y - clip.height), GLsizei(clip.width),
+                GLsizei(clip.height));
     const double x0 = 2.0 * where.x / framebuffer_width - 1.0;
     const double x1 = 2.0 * (where.x + where.width) / framebuffer_width - 1.0;
     const double y0 = 1.0 - 2.0 * where.y / framebuffer_height;  // top edge
     const double y1 = 1.0 - 2.0 * (where.y + where.height) / framebuffer_height;
     gl_.UseProgram(program_);
     gl_.Uniform4f(rect_loc_, float(x0), float(y0), float(x1), float(y1));
-    gl_.Uniform1i(op_loc_, int(tone.tonemap));  // the shader's op numbers are ToneMap's order
-    gl_.Uniform1f(exposure_loc_, float(tone.exposure_scale()));
-    gl_.Uniform1f(inv_max_loc_, float(inv_max_ * tone.exposure_scale()));
+    gl_.Uniform1i(op_loc_, op);
+    gl_.Uniform1f(exposure_loc_, exposure);
+    gl_.Uniform1f(inv_max_loc_, inv_max);
     gl_.Uniform1i(sampler_loc_, 0);
     gl_.ActiveTexture(GL_TEXTURE0);
-    gl_.BindTexture(GL_TEXTURE_2D, texture_);
+    gl_.BindTexture(GL_TEXTURE_2D, texture);
     gl_.BindVertexArray(vertex_array_);
     gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     gl_.BindVertexArray(0);
     gl_.UseProgram(0);
+    gl_.Disable(GL_SCISSOR_TEST);
 }
 
 }  // namespace kr::viewer

@@ -5,13 +5,9 @@
 #include "core/image.h"
 #include "viewer/edit.h"
 #include "viewer/gl_functions.h"
+#include "viewer/image_view.h"  // PixelRect
 
 namespace kr::viewer {
-
-// Pixel rectangle in a framebuffer, origin at the top-left.
-struct PixelRect {
-    double x = 0, y = 0, width = 0, height = 0;
-};
 
 class Display {
 public:
@@ -28,13 +24,24 @@ public:
     int image_width() const { return tex_width_; }
     int image_height() const { return tex_height_; }
 
-    // Draws the image into `where` of a framebuffer of the given size (viewport set here).
-    void draw(const PixelRect& where, int framebuffer_width, int framebuffer_height,
+    // An 8-bit picture shown as it is (image B, an error or noise map) by draw_bytes.
+    void upload_bytes(const Rgb8Image& picture);
+    bool has_bytes() const { return bytes_width_ > 0; }
+
+    // Draws the tone-mapped radiance into `where` of a framebuffer of the given size,
+    // clipped to `clip` (viewport and scissor set here).
+    void draw(const PixelRect& where, const PixelRect& clip, int framebuffer_width, int framebuffer_height,
               const ToneSettings& tone) const;
+    // Draws the 8-bit picture the same way, unchanged.
+    void draw_bytes(const PixelRect& where, const PixelRect& clip, int framebuffer_width,
+                    int framebuffer_height) const;
 
 private:
+    void draw_quad(const PixelRect& where, const PixelRect& clip, int framebuffer_width, int framebuffer_height,
+                   int op, float exposure, float inv_max, GLuint texture) const;
     const GlFunctions& gl_;
-    GLuint program_ = 0, texture_ = 0, vertex_array_ = 0;
+    GLuint program_ = 0, texture_ = 0, bytes_texture_ = 0, vertex_array_ = 0;
+    int bytes_width_ = 0;
     GLint rect_loc_ = -1, op_loc_ = -1, exposure_loc_ = -1, inv_max_loc_ = -1, sampler_loc_ = -1;
     int tex_width_ = 0, tex_height_ = 0;
     double inv_max_ = 0;

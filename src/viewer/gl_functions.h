@@ -18,6 +18,9 @@ namespace kr::viewer {
     X(Viewport, PFNGLVIEWPORTPROC)                           \
     X(ClearColor, PFNGLCLEARCOLORPROC)                       \
     X(Clear, PFNGLCLEARPROC)                                 \
+    X(Enable, PFNGLENABLEPROC)                               \
+    X(Disable, PFNGLDISABLEPROC)                             \
+    X(Scissor, PFNGLSCISSORPROC)                             \
     X(Finish, PFNGLFINISHPROC)                               \
     X(PixelStorei, PFNGLPIXELSTOREIPROC)                     \
     X(ReadBuffer, PFNGLREADBUFFERPROC)                       \

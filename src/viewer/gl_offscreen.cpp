@@ -38,7 +38,7 @@ Rgb8Image display_offscreen(const Image& radiance, const ToneSettings& tone, std
         display.upload(radiance);
         gl.ClearColor(0, 0, 0, 1);
         gl.Clear(GL_COLOR_BUFFER_BIT);
-        display.draw({0, 0, double(w), double(h)}, w, h, tone);
+        display.draw({0, 0, double(w), double(h)}, {0, 0, double(w), double(h)}, w, h, tone);
         gl.Finish();
         // Read through GL, as the window's screenshot does; rows come bottom row first.
         std::vector<unsigned char> rgba(static_cast<size_t>(w) * h * 4);

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "viewer/accumulator.h"
+#include "viewer/inspect.h"
 
 namespace kr::viewer {
 
@@ -203,6 +204,7 @@ void RenderWorker::run() {
         frame->rays = totals.rays;
         frame->relative_error = frame->spp >= 2 ? totals.relative_error() : INFINITY;
         frame->nonfinite_samples = totals.nonfinite_samples;
+        if (frame->scale == 1) record_pixel_statistics(totals, *frame);
         {
             std::lock_guard lock(mutex_);
             frame->target_spp = target_spp_;

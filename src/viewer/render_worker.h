@@ -38,6 +38,10 @@ struct Snapshot {
     double full_seconds = 0; // of which full-resolution passes
     uint64_t rays = 0;       // rays of the full-resolution passes
     double relative_error = 0;  // RenderState::relative_error() of the accumulation
+    // Full-resolution frames only (viewer/inspect.h): per pixel, the samples accumulated
+    // and the standard error of the mean luminance (infinite below two samples).
+    std::vector<uint32_t> sample_count;
+    std::vector<float> standard_error;
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     const char* stopped_by = "";  // "spp", "time" or "noise" once finished

@@ -19,13 +19,17 @@ SavePaths SavePaths::for_scene(const Scene& scene) {
     paths.image = image.replace_extension(".ppm").string();
     paths.png = fs::path(image).replace_extension(".png").string();
     paths.hdr = fs::path(image).replace_extension(".exr").string();
+    paths.convergence = (image.parent_path() / (image.stem().string() + "-convergence.csv")).string();
     const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
     paths.scene = (source.parent_path() / (source.stem().string() + "-edited.json")).string();
     return paths;
 }
 
-std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model, const Snapshot* shown) {
-    if (kind == SaveKind::scene) {
+std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model, const Snapshot* shown,
+                        const std::string& convergence_csv) {
+    if (kind == SaveKind::convergence) {
+        write_file_atomic(path, convergence_csv);
+    } else if (kind == SaveKind::scene) {
         save_scene_json(model.scene_for_saving(), path);
         model.mark_saved();  // the edits are in a file now
     } else {

@@ -10,6 +10,7 @@
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 
+#include "core/file_write.h"
 #include "core/image_io.h"
 #include "render/trace.h"
 #include "scene/load.h"
@@ -63,6 +64,10 @@ ViewerApp::ViewerApp(ViewOptions options)
     }
     watch_.watch(options_.scene);
     reset_save_paths();
+    compare_.settings = options_.compare;
+    locked_probe_ = options_.probe;
+    if (options_.reference) load_reference(*options_.reference, false);
+    else if (const auto brief = brief_reference_for(options_.scene)) load_reference(*brief, true);
 
     if (!glfwInit()) throw std::runtime_error("cannot initialise GLFW (is there a display? try render --gl)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
@@ -142,6 +147,13 @@ void ViewerApp::open_scene(const std::filesystem::path& file) {
         if (file != watch_.file()) {
             watch_.watch(file);
             reset_save_paths();
+            // The brief's reference follows the scene; one the user chose stays.
+            if (reference_automatic_ || !compare_.reference()) {
+                compare_.clear_reference();
+                reference_automatic_ = false;
+                picture_key_.clear();
+                if (const auto brief = brief_reference_for(file)) load_reference(*brief, true);
+            }
         }
     } catch (const SceneError& e) {
         show_error(e.what());  // the last good scene stays on screen
@@ -194,18 +206,17 @@ double ViewerApp::status_bar_height() const {
     return (2 * ImGui::GetFrameHeightWithSpacing() + 2 * style.WindowPadding.y) * ImGui::GetIO().DisplayFramebufferScale.y;
 }
 
-PixelRect ViewerApp::image_rect() const {
+PixelRect ViewerApp::view_area() const {
     int fb_w = 0, fb_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
-    if (!model_.has_scene()) return {};
-    const double w = model_.scene().renderer.width, h = model_.scene().renderer.height;
     const double panel = panel_visible_ ? panel_width_ * ImGui::GetIO().DisplayFramebufferScale.x : 0.0;
-    // The free area left of the panel and above the status bar; the image fits it whole.
-    const double area_w = std::max(1.0, fb_w - panel), area_h = std::max(1.0, fb_h - status_bar_height());
-    double scale = std::min(area_w / w, area_h / h);
-    // Whole pixels when it fits, so each image pixel is exactly one (or k x k) screen pixels.
-    if (scale >= 1) scale = std::floor(scale);
-    return {std::floor((area_w - w * scale) / 2), std::floor((area_h - h * scale) / 2), w * scale, h * scale};
+    return {0, 0, std::max(1.0, fb_w - panel), std::max(1.0, fb_h - status_bar_height())};
+}
+
+PixelRect ViewerApp::image_rect() const {
+    if (!model_.has_scene()) return {};
+    // Fitted whole (whole screen pixels per image pixel when it fits), or zoomed and panned.
+    return view_.placement(view_area(), model_.scene().renderer.width, model_.scene().renderer.height);
 }
 
 Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
@@ -248,35 +259,59 @@ void ViewerApp::handle_input() {
 void ViewerApp::handle_mouse(const PixelRect& rect) {
     ImGuiIO& io = ImGui::GetIO();
     const double to_fb = io.DisplayFramebufferScale.x;  // window points to framebuffer pixels
-    const double image_scale = rect.width / model_.scene().renderer.width;
+    const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
+    const double image_scale = rect.width / w;
     const double mx = io.MousePos.x * to_fb, my = io.MousePos.y * to_fb;
-    const bool over_image = mx >= rect.x && my >= rect.y && mx < rect.x + rect.width && my < rect.y + rect.height;
+    const PixelRect area = view_area();
+    auto inside = [&](const PixelRect& r) { return mx >= r.x && my >= r.y && mx < r.x + r.width && my < r.y + r.height; };
+    const bool over_image = inside(area) && inside(rect);
     for (int b = 0; b < 3; ++b)
         if (!io.MouseDown[b]) drags_[b].release();
+    if (!io.MouseDown[0]) divider_drag_ = false;
     // Mouse: only when ImGui does not want it, so a click on a panel never moves the camera.
     if (io.WantCaptureMouse || !over_image) {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b)) drags_[b].release();  // a press on a panel drags nothing
+        if (!io.WantCaptureMouse && inside(area) && io.KeyCtrl && io.MouseWheel != 0)
+            view_.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
     } else {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b))
                 drags_[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
-        if (ImGui::IsMouseClicked(ImGuiMouseButton_Left) && (io.KeyCtrl || pick_focus_)) {
+        const bool left_click = ImGui::IsMouseClicked(ImGuiMouseButton_Left);
+        const double divider_x = rect.x + compare_.settings.split * rect.width;
+        if (left_click && io.KeyShift) {
+            drags_[0].release();  // Shift+click locks the inspector on a pixel, or frees it
+            const std::pair<int, int> pixel{int(std::floor((mx - rect.x) / image_scale)),
+                                            int(std::floor((my - rect.y) / image_scale))};
+            if (locked_probe_ == pixel) locked_probe_.reset();
+            else locked_probe_ = pixel;
+        } else if (left_click && compare_.settings.mode == ViewMode::split && std::abs(mx - divider_x) <= 6 * to_fb) {
+            drags_[0].release();  // the split view's divider, never an orbit
+            divider_drag_ = true;
+        } else if (left_click && (io.KeyCtrl || pick_focus_)) {
             drags_[0].release();  // a focus click, never an orbit
-            const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
             const Vec2 film = raster_to_camera((mx - rect.x) / rect.width * w, (my - rect.y) / rect.height * h, w, h);
             if (!model_.focus_at(film.x, film.y)) show_error("click-to-focus: nothing there to focus on");
             else generation_edited_ = Clock::now();
             pick_focus_ = false;
         }
-        if (io.MouseWheel != 0)
-            edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-                dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
-            }, "dolly", "wheel");
+        if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
+            // The middle button pans a zoomed image; on a fitted one it dollies the camera.
+            middle_pans_ = !view_.fitted();
+            pan_last_x_ = pan_last_y_ = 0;
+        }
+        if (io.MouseWheel != 0) {
+            if (io.KeyCtrl) view_.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            else
+                edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+                    dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
+                }, "dolly", "wheel");
+        }
     }
+    if (divider_drag_) compare_.settings.split = std::clamp((mx - rect.x) / rect.width, 0.0, 1.0);
     // Drags started on the image go on wherever the pointer goes. Each applies its whole
     // offset from where it started (screen pixels, in image pixels here) to the camera as it was then.
-    const int h = model_.scene().renderer.height;
     double dx = 0, dy = 0;
     const int active = model_.scene().camera;
     auto drag = [&](DragGesture& g) {
@@ -297,12 +332,52 @@ void ViewerApp::handle_mouse(const PixelRect& rect) {
             pan_drag(cam, dx, dy, h);
             s.cameras[size_t(active)] = cam;
         }, "pan", "pan");
-    if (drag(drags_[2]))
+    if (middle_pans_) {
+        // The image follows the pointer from where the button went down: this frame's part of
+        // the drag, in screen pixels, once past the click threshold.
+        if (drag(drags_[2])) {
+            const double tx = mx - drags_[2].press_x, ty = my - drags_[2].press_y;
+            view_.pan(area, w, h, tx - pan_last_x_, ty - pan_last_y_);
+            pan_last_x_ = tx;
+            pan_last_y_ = ty;
+        }
+    } else if (drag(drags_[2])) {
         edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             Camera cam = drags_[2].start_camera;
             dolly(cam, std::exp(dy * 0.005));
             s.cameras[size_t(active)] = cam;
         }, "dolly", "dolly");
+    }
+}
+
+bool ViewerApp::zoom_keys() {
+    const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
+    const PixelRect area = view_area();
+    const ImGuiIO& io = ImGui::GetIO();
+    // About the pointer when it is over the view, else about the view's centre.
+    const double to_fb = io.DisplayFramebufferScale.x;
+    double px = io.MousePos.x * to_fb, py = io.MousePos.y * to_fb;
+    if (!(px >= area.x && py >= area.y && px < area.x + area.width && py < area.y + area.height)) {
+        px = area.x + area.width / 2;
+        py = area.y + area.height / 2;
+    }
+    bool acted = false;
+    for (const int key : key_presses_) {
+        acted = true;
+        if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) view_.zoom_steps(area, w, h, 1, px, py);
+        else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) view_.zoom_steps(area, w, h, -1, px, py);
+        else if (key == GLFW_KEY_0 || key == GLFW_KEY_KP_0) view_.fit();
+        else if (key == GLFW_KEY_1 || key == GLFW_KEY_KP_1) view_.one_to_one(area, w, h);
+        else if (key == GLFW_KEY_V) {
+            auto& mode = compare_.settings.mode;
+            mode = ViewMode((int(mode) + 1) % int(view_mode_names.names.size()));
+        } else if (key == GLFW_KEY_K && shown_ && shown_->scale == 1) {
+            compare_.settings.b = compare_.keep(shown_->radiance, shown_->spp);
+            picture_key_.clear();
+            status_ = "kept the image as " + compare_.slots()[size_t(compare_.settings.b)]->name + " (image B)";
+        } else acted = false;
+    }
+    return acted;
 }
 
 void ViewerApp::handle_keys() {
@@ -354,6 +429,7 @@ void ViewerApp::handle_keys() {
         model_.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
     }
     if (pressed(GLFW_KEY_F)) pick_focus_ = !pick_focus_;
+    if (!io.KeyCtrl) zoom_keys();
     if (pressed(GLFW_KEY_SPACE))
         edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
     if (io.KeyCtrl) {
@@ -429,16 +505,25 @@ void ViewerApp::update_title() {
 }
 
 void ViewerApp::write_status_file(const RunStatus& status) {
-    // press: the left button is down on the image as the last frame saw it; pointer: where
+    // press: the buttons down on the image as the last frame saw them (1 left, 2 right,
+    // 4 middle, 8 the left one on the split view's divider); pointer: where
     // that frame saw the pointer (window points). Scripts wait on these before the next event.
     const ImGuiIO& io = ImGui::GetIO();
-    char line[320];
+    // view, image (the image's corner in the framebuffer and its scale; "fit" when fitted)
+    // and probe (the locked pixel) follow the inspect and compare tools.
+    const PixelRect rect = image_rect();
+    char probe[48] = "none";
+    if (locked_probe_) std::snprintf(probe, sizeof probe, "%d,%d", locked_probe_->first, locked_probe_->second);
+    char line[420];
     std::snprintf(line, sizeof line,
-                  "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d\n",
+                  "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(help_visible_),
-                  int(panel_visible_), int(drags_[0].pressed), int(std::lround(io.MousePos.x)),
-                  int(std::lround(io.MousePos.y)));
+                  int(panel_visible_), int(drags_[0].pressed) | 2 * int(drags_[1].pressed) | 4 * int(drags_[2].pressed) | 8 * int(divider_drag_), int(std::lround(io.MousePos.x)),
+                  int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(compare_.settings.mode)).c_str(),
+                  compare_.settings.split, rect.x, rect.y, view_.fitted() ? "fit" : "", model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0,
+                  probe);
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);
@@ -469,15 +554,28 @@ bool ViewerApp::script_step(const PixelRect& rect) {
         std::fflush(stdout);
     }
     // Without an image to write, the latency run is over; an idle run ends in idle_measure_step.
-    if (!options_.screenshot && !options_.save_scene && options_.frames == 0) return options_.measure_idle <= 0;
+    if (!options_.screenshot && !options_.save_scene && !options_.stats_json && options_.frames == 0)
+        return options_.measure_idle <= 0;
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int needed = script_passes_needed(options_, model_.settings());
     if (!(current && shown_->scale == 1 && shown_->spp >= needed)) return false;
     try {
         if (options_.screenshot) {
-            write_image(*options_.screenshot, read_image_region(rect));
-            std::printf("screenshot: %s (%d spp, generation %llu)\n", options_.screenshot->string().c_str(),
-                        shown_->spp, static_cast<unsigned long long>(shown_->generation));
+            // What is on screen of the image: all of it unless zoomed in.
+            const PixelRect area = view_area();
+            const double x0 = std::max(rect.x, area.x), y0 = std::max(rect.y, area.y);
+            const double x1 = std::min(rect.x + rect.width, area.x + area.width);
+            const double y1 = std::min(rect.y + rect.height, area.y + area.height);
+            write_image(*options_.screenshot, read_image_region({x0, y0, x1 - x0, y1 - y0}));
+            const double scale = rect.width / model_.scene().renderer.width;
+            std::printf("screenshot: %s (%d spp, generation %llu; image pixel %.6g,%.6g at %g screen pixels each)\n",
+                        options_.screenshot->string().c_str(), shown_->spp,
+                        static_cast<unsigned long long>(shown_->generation), (x0 - rect.x) / scale,
+                        (y0 - rect.y) / scale, scale);
+        }
+        if (options_.stats_json) {
+            write_file_atomic(*options_.stats_json, stats_json(stats_figures()));
+            std::printf("stats: %s\n", options_.stats_json->string().c_str());
         }
         if (options_.save_scene) {
             save_scene_json(model_.scene_for_saving(), *options_.save_scene);
@@ -500,6 +598,11 @@ bool ViewerApp::draw_frame() {
         inside_checked_generation_ = model_.generation();
         inside_sphere_ = sphere_containing(model_.scene(), model_.camera().position);
     }
+    if (!zoom_applied_ && model_.has_scene()) {
+        zoom_applied_ = true;  // --zoom, about the image's centre, once the layout is known
+        const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
+        if (options_.zoom > 0) view_.set_zoom(view_area(), w, h, options_.zoom, w / 2.0, h / 2.0);
+    }
     draw_panels();
     draw_status_bar();
     draw_help();
@@ -507,6 +610,7 @@ bool ViewerApp::draw_frame() {
     handle_input();
     sync_worker();
     update_title();
+    update_pictures();
 
     int fb_w = 0, fb_h = 0;
     glfwGetFramebufferSize(window_, &fb_w, &fb_h);
@@ -514,7 +618,8 @@ bool ViewerApp::draw_frame() {
     gl_.ClearColor(0.1f, 0.1f, 0.1f, 1.0f);
     gl_.Clear(GL_COLOR_BUFFER_BIT);
     const PixelRect rect = image_rect();
-    if (shown_) display_->draw(rect, fb_w, fb_h, model_.settings().tone);
+    if (shown_) draw_image(rect, fb_w, fb_h);
+    if (model_.has_scene()) draw_inspector(rect);
     // Scripted runs read the image region back here: what the shader drew, before
     // the panels are drawn over anything.
     const bool done = options_.scripted() && script_step(rect);
@@ -560,6 +665,10 @@ int ViewerApp::run() {
         // The scripted edits go through the same functions as the mouse and the panels.
         const bool ok = apply_script_edits(options_, model_, [&](Edit kind, const auto& change) { return edit(kind, change); });
         if (!ok) return 1;
+        if (options_.reference && !compare_.reference()) {
+            std::fprintf(stderr, "error: %s\n", error_.c_str());
+            return 1;
+        }
     }
     last_frame_ = Clock::now();
     settle_frames_ = kSettleFrames;

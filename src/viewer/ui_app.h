@@ -12,8 +12,12 @@
 #include <utility>
 #include <vector>
 
+#include "viewer/compare_view.h"
+#include "viewer/convergence_log.h"
 #include "viewer/files.h"
 #include "viewer/gl_display.h"
+#include "viewer/image_view.h"
+#include "viewer/inspect.h"
 #include "viewer/gl_functions.h"
 #include "viewer/latency.h"
 #include "viewer/model.h"
@@ -53,7 +57,18 @@ private:
     void draw_help();
     void draw_error_flash();
     void update_title();
-    PixelRect image_rect() const;
+    PixelRect view_area() const;   // the free area left of the panel, above the status bar
+    PixelRect image_rect() const;  // where the image is drawn in it (zoom and pan)
+    bool zoom_keys();              // the zoom keys; true when one acted
+    // Inspect and compare (ui_compare.cpp).
+    void update_pictures();        // image B, the error or noise map, the figures, the log
+    void draw_image(const PixelRect& rect, int fb_w, int fb_h);
+    void draw_inspector(const PixelRect& rect);
+    void panel_compare();
+    void plot_convergence();
+    void load_reference(const std::filesystem::path& file, bool automatic);
+    std::optional<PixelProbe> probe(int x, int y) const;
+    StatsFigures stats_figures() const;
     double status_bar_height() const;  // framebuffer pixels
     bool animating() const;            // something moves without input: redraw at the frame rate
     void request_quit();
@@ -126,8 +141,26 @@ private:
     std::optional<std::string> inside_sphere_;  // the camera is inside this sphere
     uint64_t inside_checked_generation_ = 0;
 
+    // Inspect and compare.
+    ImageView view_;
+    bool zoom_applied_ = false;  // --zoom waits for the first frame's layout
+    Comparison compare_;
+    bool reference_automatic_ = false;   // the brief's reference for this scene, not --reference
+    std::string reference_path_;         // the compare panel's field
+    ConvergenceLog convergence_;
+    std::optional<CompareFigures> figures_;  // the shown frame (A) against image B
+    std::string figures_note_;           // why there are no figures
+    Rgb8Image picture_;                  // what draw_bytes shows, as uploaded
+    bool picture_current_ = false;       // picture_ is the current mode's, for the shown frame
+    double picture_scale_ = 0;           // the false-colour map's top value
+    std::string picture_key_;            // what picture_ was made from
+    double linear_scale_ = 0;            // tonemap_scale of the shown frame (the inspector)
+    std::optional<std::pair<int, int>> locked_probe_;
+    bool divider_drag_ = false, middle_pans_ = false;
+    double pan_last_x_ = 0, pan_last_y_ = 0;
+
     // Input.
-    DragGesture drags_[3];  // left: orbit, right: pan, middle: dolly
+    DragGesture drags_[3];  // left: orbit, right: pan, middle: dolly (or pan a zoomed image)
     TypedFields typed_;
     Clock::time_point last_motion_{};  // previous frame with motion keys held
     bool motion_keys_held_ = false;

@@ -37,7 +37,12 @@ std::string field_name(const char* label) {
 constexpr const char* kHelpRows[][2] = {
     {"left drag", "orbit about the target"},
     {"right drag", "pan"},
-    {"wheel, middle drag", "dolly"},
+    {"wheel, middle drag", "dolly (middle drag pans a zoomed image)"},
+    {"Ctrl+wheel, + / -", "zoom the image about the pointer (up to 16x)"},
+    {"0 / 1", "fit the image to the window / show it 1:1"},
+    {"hover / Shift+click", "read a pixel / lock the probe on it"},
+    {"V", "next view: render, reference, split, error, noise, samples"},
+    {"K", "keep the image as a snapshot (image B)"},
     {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
     {"arrows", "orbit"},
     {"W / S", "dolly in / out"},
@@ -155,6 +160,7 @@ void ViewerApp::draw_panels() {
         panel_materials();
         panel_tone_map();
         panel_renderer();
+        panel_compare();
         panel_stats();
         panel_save();
     }
@@ -511,6 +517,7 @@ void ViewerApp::panel_stats() {
     const double passes_per_second = current && shown_->full_seconds > 0 ? shown_->spp / shown_->full_seconds : 0.0;
     ImGui::Text("%.2f passes/s, non-finite samples dropped: %llu", passes_per_second,
                 static_cast<unsigned long long>(current ? shown_->nonfinite_samples : 0));
+    plot_convergence();
 }
 
 }  // namespace kr::viewer

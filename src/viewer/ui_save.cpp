@@ -69,7 +69,7 @@ void ViewerApp::overwrite_popup() {
 
 void ViewerApp::save_now(SaveKind kind, const fs::path& path) {
     try {
-        status_ = save_output(kind, path, model_, shown_.get());
+        status_ = save_output(kind, path, model_, shown_.get(), convergence_.csv());
         // Saving over the watched file should not read like an outside change.
         std::error_code ec;
         if (kind == SaveKind::scene && fs::equivalent(path, watch_.file(), ec)) watch_.acknowledge();

@@ -1,6 +1,9 @@
 #include "viewer/view_options.h"
 
+#include <cmath>
+
 #include "core/limits.h"
+#include "viewer/image_view.h"
 
 namespace kr::viewer {
 
@@ -22,6 +25,13 @@ Options (as for render; they stay in force when another scene is opened):
 )";
 
 constexpr const char* kViewOnlyOptions = R"(  --unlimited           keep refining past the target spp
+  --reference FILE      image B for the compare views and PSNR/RMSE (PPM, PNG, EXR, PFM);
+                        default: the brief's reference render for the brief's scenes
+  --view MODE           render, reference, split, error, noise or samples (default render)
+  --split F             the split view's divider at fraction F of the image width (0.5)
+  --error METRIC        the error view's per-pixel error: absolute or relative
+  --zoom Z              show the image at Z screen pixels per pixel (up to 16) about its centre
+  --probe X,Y           lock the pixel inspector on image pixel (X, Y)
   -h, --help            this text
 Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run):
   --aperture A          make the camera a thin lens of aperture radius A
@@ -36,6 +46,8 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
                         paused (unlimited), the same again; printed as % of a core
   --status-file FILE    rewrite FILE with the status line (state, spp, target, generation,
                         unsaved edits) whenever it changes: for scripts driving the window
+  --stats-json FILE     then write spp, elapsed, Mrays/s, noise, the probe, and PSNR/RMSE
+                        against image B when there is one, as JSON
   --timeout S           fail a scripted run after S seconds (default 600)
 )";
 
@@ -66,6 +78,15 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--measure-latency") o.measure_latency = int(parse_integer(arg, value(), 1, 10000));
         else if (arg == "--measure-idle") o.measure_idle = parse_number(arg, value(), 0.1, 3600);
         else if (arg == "--status-file") o.status_file = value();
+        else if (arg == "--reference") o.reference = value();
+        else if (arg == "--view") o.compare.mode = parse_name(arg, value(), view_mode_names);
+        else if (arg == "--split") o.compare.split = parse_number(arg, value(), 0, 1);
+        else if (arg == "--error") o.compare.metric = parse_name(arg, value(), error_metric_names);
+        else if (arg == "--zoom") o.zoom = parse_number(arg, value(), 0.125, kMaxZoom);
+        else if (arg == "--probe") {
+            const auto [x, y] = parse_pair(arg, value());
+            o.probe = {int(std::floor(x)), int(std::floor(y))};
+        } else if (arg == "--stats-json") o.stats_json = value();
         else if (arg == "--timeout") o.timeout = parse_number(arg, value(), 1, 1e7);
         else if (!arg.empty() && arg[0] == '-') throw unknown_option(arg);
         else if (have_scene) throw UsageError{"view opens one scene; got a second: " + quote_user_text(arg)};

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "render/options.h"
+#include "viewer/compare_view.h"
 
 namespace kr::viewer {
 
@@ -26,10 +27,16 @@ struct ViewOptions {
     int measure_latency = 0;  // edits to time, edit to first displayed frame
     double measure_idle = 0;  // seconds of idle CPU to measure, done and then paused
     std::optional<std::filesystem::path> status_file;  // the status line, rewritten on change
+    // Inspect and compare (interactive too).
+    std::optional<std::filesystem::path> reference;  // image B; default: the brief's for its scenes
+    CompareSettings compare;                          // --view, --split, --error
+    double zoom = 0;                                  // 0: fit; else about the image's centre
+    std::optional<std::pair<int, int>> probe;         // a locked probe at image pixel (x, y)
+    std::optional<std::filesystem::path> stats_json;  // figures written when a scripted run ends
     double timeout = 600;     // seconds: a scripted run that gets stuck fails
     bool help = false;        // -h, --help
     bool scripted() const {
-        return frames > 0 || screenshot || save_scene || measure_latency > 0 || measure_idle > 0;
+        return frames > 0 || screenshot || save_scene || stats_json || measure_latency > 0 || measure_idle > 0;
     }
 };
 

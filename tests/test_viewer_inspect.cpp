@@ -1,0 +1,329 @@
+// The viewer's inspect and compare tools without a window: the pixel inspector against the
+// render state, zoom and pan, image B and its figures, the convergence log, --stats-json.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "core/args.h"
+#include "core/image_compare.h"
+#include "core/image_io.h"
+#include "render/render_scene.h"
+#include "scene/load.h"
+#include "test_util.h"
+#include "viewer/accumulator.h"
+#include "viewer/compare_view.h"
+#include "viewer/convergence_log.h"
+#include "viewer/image_view.h"
+#include "viewer/inspect.h"
+#include "viewer/view_options.h"
+
+namespace fs = std::filesystem;
+using namespace kr;
+using namespace kr::viewer;
+
+namespace {
+
+// A full-resolution snapshot of `passes` passes of brief scene `n` at size x size, as the
+// render thread publishes it, with the accumulator it came from.
+struct Rendered {
+    Accumulator acc;
+    Snapshot frame;
+};
+Rendered render_frame(int n, int size, int passes, Allocation allocation = Allocation::adaptive) {
+    const RenderScene scene = prepare_scene(test::brief_scene(n, size));
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.allocation = allocation;
+    Rendered r;
+    r.acc.reset(size, size);
+    for (int i = 0; i < passes; ++i) EXPECT_TRUE(r.acc.render_pass(scene, settings));
+    r.frame.radiance = r.acc.mean();
+    r.frame.spp = r.acc.passes();
+    r.frame.relative_error = r.acc.totals().relative_error();
+    record_pixel_statistics(r.acc.totals(), r.frame);
+    return r;
+}
+
+}  // namespace
+
+// Mean radiance, 8-bit value, samples and standard error are the render state's, for every
+// tone map (the linear one scaled by the whole image's maximum).
+TEST(PixelInspector, NumbersAreTheRenderStates) {
+    // Past the adaptive warm-up, so pixels hold different sample counts.
+    const Rendered r = render_frame(3, 24, 12);
+    const RenderState& totals = r.acc.totals();
+    const Image mean = totals.radiance();
+    for (ToneMap op : {ToneMap::sigmoid, ToneMap::linear, ToneMap::srgb}) {
+        ToneSettings tone;
+        tone.tonemap = op;
+        tone.exposure = 0.5;
+        const Rgb8Image shown = tonemap(mean, op, tone.exposure_scale());
+        const double linear_scale = tonemap_scale(r.frame.radiance, op, tone.exposure_scale());
+        for (const auto& [x, y] : {std::pair{0, 0}, {7, 13}, {23, 23}, {12, 5}}) {
+            const auto p = probe_pixel(r.frame, 24, 24, x, y, tone, linear_scale);
+            ASSERT_TRUE(p);
+            const size_t i = size_t(y) * 24 + size_t(x);
+            EXPECT_EQ(p->x, x);
+            EXPECT_EQ(p->y, y);
+            EXPECT_EQ(p->mean, mean.pixels[i]);
+            EXPECT_EQ(p->samples, totals.sample_count[i]);
+            EXPECT_EQ(p->standard_error, float(totals.pixel_standard_error(i)));
+            EXPECT_FALSE(p->preview);
+            for (int k = 0; k < 3; ++k) EXPECT_EQ(p->displayed[size_t(k)], shown.bytes[3 * i + size_t(k)]) << int(op);
+        }
+    }
+    // The counts differ between pixels (adaptive allocation), so the readout is per pixel.
+    const auto [lo, hi] = std::minmax_element(totals.sample_count.begin(), totals.sample_count.end());
+    EXPECT_LT(*lo, *hi);
+    EXPECT_FALSE(probe_pixel(r.frame, 24, 24, 24, 0, ToneSettings{}, 1));
+    EXPECT_FALSE(probe_pixel(r.frame, 24, 24, 0, -1, ToneSettings{}, 1));
+}
+
+TEST(PixelInspector, PreviewHasNoStatisticsAndCoversBlocks) {
+    Snapshot preview;
+    preview.scale = 4;
+    preview.radiance = Image(4, 4);
+    preview.radiance.at(2, 1) = Color(0.5, 1, 2);
+    const auto p = probe_pixel(preview, 16, 16, 9, 7, ToneSettings{}, 1);
+    ASSERT_TRUE(p);
+    EXPECT_TRUE(p->preview);
+    EXPECT_EQ(p->mean, Color(0.5, 1, 2));
+    EXPECT_EQ(p->samples, 0u);
+}
+
+TEST(NoiseView, MapsAreFalseColourOfTheStatistics) {
+    const Rendered r = render_frame(3, 16, 12);
+    const double se_top = robust_scale(r.frame.standard_error);
+    EXPECT_GT(se_top, 0);
+    const Rgb8Image noise = standard_error_map(r.frame, se_top);
+    const Rgb8Image samples = sample_count_map(r.frame, 64);
+    ASSERT_EQ(noise.width, 16);
+    ASSERT_EQ(samples.height, 16);
+    for (size_t i = 0; i < 256; ++i) {
+        const auto n = viridis(r.frame.standard_error[i] / se_top), s = viridis(r.frame.sample_count[i] / 64.0);
+        for (size_t k = 0; k < 3; ++k) {
+            ASSERT_EQ(noise.bytes[3 * i + k], n[k]);
+            ASSERT_EQ(samples.bytes[3 * i + k], s[k]);
+        }
+    }
+    EXPECT_TRUE(standard_error_map(Snapshot{}, 1).bytes.empty());  // a preview: nothing
+    // The scale ignores the top 1% and non-finite values.
+    std::vector<float> values(1000, 1.0f);
+    values[3] = 1e9f;
+    values[4] = INFINITY;
+    EXPECT_EQ(robust_scale(values), 1.0);
+    EXPECT_EQ(robust_scale({}), 0.0);
+}
+
+TEST(ImageView, FitPlacesTheImageAsBeforeAndZoomKeepsThePointUnderThePointer) {
+    const PixelRect area{0, 0, 880, 650};
+    ImageView view;
+    // Fit: whole screen pixels when it fits, centred on whole pixels.
+    PixelRect r = view.placement(area, 512, 512);
+    EXPECT_EQ(r.width, 512);
+    EXPECT_EQ(r.x, 184);
+    EXPECT_EQ(r.y, 69);
+    r = view.placement(area, 200, 100);
+    EXPECT_EQ(r.width, 800);  // 4x
+    r = view.placement(area, 2000, 1000);
+    EXPECT_DOUBLE_EQ(r.width, 880);  // shrunk to fit
+
+    // A step in about a pointer keeps the image point under it (to a pixel: corners are whole).
+    double ix = 0, iy = 0, jx = 0, jy = 0;
+    view.to_image(area, 512, 512, 300, 200, ix, iy);
+    view.zoom_steps(area, 512, 512, 1, 300, 200);
+    EXPECT_EQ(view.scale(area, 512, 512), 2);
+    view.to_image(area, 512, 512, 300, 200, jx, jy);
+    EXPECT_NEAR(jx, ix, 0.5);
+    EXPECT_NEAR(jy, iy, 0.5);
+    view.zoom_steps(area, 512, 512, 2, 300, 200);
+    EXPECT_EQ(view.scale(area, 512, 512), 4);
+    r = view.placement(area, 512, 512);
+    EXPECT_EQ(r.x, std::floor(r.x));
+    EXPECT_EQ(r.width, 2048);
+    view.zoom_steps(area, 512, 512, 20, 300, 200);
+    EXPECT_EQ(view.scale(area, 512, 512), kMaxZoom);
+    // Out past the fit scale: fitted again.
+    view.zoom_steps(area, 512, 512, -20, 300, 200);
+    EXPECT_TRUE(view.fitted());
+
+    // Pan moves a zoomed image with the pointer and keeps some of it in view.
+    view.set_zoom(area, 512, 512, 4, 256, 256);
+    const PixelRect before = view.placement(area, 512, 512);
+    view.pan(area, 512, 512, 40, -8);
+    const PixelRect after = view.placement(area, 512, 512);
+    EXPECT_EQ(after.x - before.x, 40);
+    EXPECT_EQ(after.y - before.y, -8);
+    view.pan(area, 512, 512, 1e6, 1e6);
+    r = view.placement(area, 512, 512);
+    EXPECT_LT(r.x, area.x + area.width);
+    EXPECT_LT(r.y, area.y + area.height);
+    view.one_to_one(area, 512, 512);
+    EXPECT_EQ(view.scale(area, 512, 512), 1);
+    view.fit();
+    EXPECT_TRUE(view.fitted());
+    // A fitted image that shows whole does not pan.
+    view.pan(area, 512, 512, 30, 30);
+    EXPECT_TRUE(view.fitted());
+}
+
+TEST(Compare, FiguresAreThoseOfThePsnrCommand) {
+    Rgb8Image a{4, 2, std::vector<uint8_t>(24, 100)}, b = a;
+    b.bytes[5] = 130;
+    b.bytes[17] = 90;
+    const auto f = compare_figures(a, b);
+    ASSERT_TRUE(f);
+    EXPECT_EQ(f->psnr, psnr(a, b));
+    EXPECT_EQ(f->rmse, rgb8_errors(a, b).rmse);
+    EXPECT_NEAR(f->rmse, std::sqrt((30.0 * 30 + 10.0 * 10) / 24) / 255, 1e-12);
+    EXPECT_FALSE(compare_figures(a, Rgb8Image{2, 4, std::vector<uint8_t>(24, 100)}));
+
+    // Per pixel: RMS over the channels; relative divides by the reference plus 0.01.
+    const std::vector<float> abs = pixel_errors(a, b, ErrorMetric::absolute);
+    const std::vector<float> rel = pixel_errors(a, b, ErrorMetric::relative);
+    ASSERT_EQ(abs.size(), 8u);
+    EXPECT_FLOAT_EQ(abs[1], float(std::sqrt(30.0 * 30 / 3) / 255));
+    EXPECT_FLOAT_EQ(rel[1], float(std::sqrt(std::pow(-30 / 255.0 / (130 / 255.0 + 0.01), 2) / 3)));
+    EXPECT_EQ(abs[0], 0);
+}
+
+TEST(Compare, SlotsKeepSnapshotsAndBPicksThem) {
+    Comparison c;
+    EXPECT_EQ(c.b(), nullptr);
+    Image img(2, 2);
+    img.at(1, 1) = Color(1, 2, 3);
+    const int s0 = c.keep(img, 16);
+    const int s1 = c.keep(img, 32);
+    EXPECT_EQ(s0, 0);
+    EXPECT_EQ(s1, 1);
+    c.settings.b = s1;
+    ASSERT_NE(c.b(), nullptr);
+    EXPECT_EQ(c.b()->name, "slot 2 (32 spp)");
+    EXPECT_TRUE(c.b()->hdr());
+    // B tone maps a snapshot as the render is shown.
+    ToneSettings tone;
+    tone.tonemap = ToneMap::linear;
+    EXPECT_EQ(c.b()->display(tone).bytes, tonemap(img, ToneMap::linear).bytes);
+    c.drop(s1);
+    EXPECT_EQ(c.settings.b, -1);
+    // Full: the oldest goes.
+    for (int i = 0; i < kSnapshotSlots + 2; ++i) c.keep(img, i);
+    int kept = 0;
+    for (const auto& slot : c.slots()) kept += slot.has_value();
+    EXPECT_EQ(kept, kSnapshotSlots);
+}
+
+TEST(Compare, ReferencesLoadByFormatAndTheBriefsIsOffered) {
+    const fs::path scenes = fs::path(KEITHRAY_RES_DIR) / "scenes";
+    const auto brief = brief_reference_for(scenes / "assignment_05.json");
+    ASSERT_TRUE(brief);
+    EXPECT_EQ(brief->filename(), "assignment_05.ppm");
+    EXPECT_FALSE(brief_reference_for(scenes / "nothing_here.json"));
+    EXPECT_FALSE(brief_reference_for("elsewhere/assignment_05.json"));
+
+    const CompareImage ref = load_reference(*brief);
+    EXPECT_FALSE(ref.hdr());
+    EXPECT_EQ(ref.width(), 512);
+    EXPECT_EQ(ref.bytes.bytes, read_image(*brief).bytes);
+
+    const fs::path dir = fs::temp_directory_path() / ("keithray_compare_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path bad = dir / "bad.ppm";
+    {
+        std::ofstream f(bad, std::ios::binary);
+        f << "P6\n2 2\n255\nxx";
+    }
+    try {
+        load_reference(bad);
+        ADD_FAILURE() << "a truncated PPM loaded";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.ppm"), std::string::npos) << e.what();
+    }
+    fs::remove_all(dir);
+}
+
+TEST(ConvergenceLog, OnePointPerFullFrameOfTheGeneration) {
+    ConvergenceLog log;
+    Snapshot f;
+    f.generation = 3;
+    f.scale = 4;  // a preview: not a point
+    log.record(f, std::nullopt);
+    EXPECT_TRUE(log.points().empty());
+    f.scale = 1;
+    f.spp = 1;
+    f.full_seconds = 0.5;
+    f.relative_error = INFINITY;
+    log.record(f, std::nullopt);
+    f.spp = 2;
+    f.full_seconds = 1.0;
+    f.relative_error = 0.25;
+    log.record(f, CompareFigures{30, 0.03});
+    log.record(f, CompareFigures{31, 0.028});  // the same frame again: figures updated
+    ASSERT_EQ(log.points().size(), 2u);
+    EXPECT_EQ(log.points()[1].psnr, 31);
+    EXPECT_EQ(log.csv(),
+              "seconds,spp,estimated_relative_error,rmse,psnr\n"
+              "0.500000,1,,,\n"
+              "1.000000,2,0.25,0.028,31\n");
+    f.generation = 4;  // an edit: a new log
+    log.record(f, std::nullopt);
+    EXPECT_EQ(log.points().size(), 1u);
+    EXPECT_EQ(log.generation(), 4u);
+}
+
+TEST(StatsJson, HoldsWhatTheWindowShows) {
+    StatsFigures s;
+    s.state = "done";
+    s.spp = 8;
+    s.target = 8;
+    s.elapsed = 1.5;
+    s.mrays_per_second = 40;
+    s.noise = 0.05;
+    s.reference = "assignment_03.ppm";
+    s.figures = CompareFigures{25.5, 0.05};
+    PixelProbe p;
+    p.x = 3;
+    p.samples = 8;
+    p.standard_error = INFINITY;
+    s.probe = p;
+    const auto j = nlohmann::json::parse(stats_json(s));
+    EXPECT_EQ(j["spp"], 8);
+    EXPECT_EQ(j["state"], "done");
+    EXPECT_EQ(j["noise"], 0.05);
+    EXPECT_EQ(j["psnr"], 25.5);
+    EXPECT_EQ(j["rmse"], 0.05);
+    EXPECT_EQ(j["probe"]["x"], 3);
+    EXPECT_TRUE(j["probe"]["standard_error"].is_null());
+    s.noise = -1;
+    s.figures.reset();
+    const auto k = nlohmann::json::parse(stats_json(s));
+    EXPECT_TRUE(k["noise"].is_null());
+    EXPECT_FALSE(k.contains("psnr"));
+}
+
+TEST(ViewOptions, CompareFlags) {
+    auto parse = [](std::vector<std::string> args) {
+        args.insert(args.begin(), {"keithray", "view"});
+        std::vector<char*> argv;
+        for (auto& a : args) argv.push_back(a.data());
+        return parse_view_options(int(argv.size()), argv.data());
+    };
+    const ViewOptions o = parse({"s.json", "--view", "error", "--error", "relative", "--split", "0.25", "--zoom", "4",
+                                 "--probe", "10,20", "--reference", "r.exr", "--stats-json", "out.json"});
+    EXPECT_EQ(o.compare.mode, ViewMode::error);
+    EXPECT_EQ(o.compare.metric, ErrorMetric::relative);
+    EXPECT_EQ(o.compare.split, 0.25);
+    EXPECT_EQ(o.zoom, 4);
+    EXPECT_EQ(o.probe, std::make_pair(10, 20));
+    EXPECT_EQ(o.reference, fs::path("r.exr"));
+    EXPECT_TRUE(o.scripted());
+    EXPECT_THROW(parse({"--view", "sideways"}), UsageError);
+    EXPECT_THROW(parse({"--split", "1.5"}), UsageError);
+    EXPECT_THROW(parse({"--zoom", "64"}), UsageError);
+    EXPECT_THROW(parse({"--probe", "3"}), UsageError);
+}
