@@ -157,6 +157,7 @@ private:
     double linear_scale_ = 0;            // tonemap_scale of the shown frame (the inspector)
     std::optional<std::pair<int, int>> locked_probe_;
     bool divider_drag_ = false, middle_pans_ = false;
+    bool compare_panel_shown_ = false;   // the panel has been drawn once (the command line opens it)
     double pan_last_x_ = 0, pan_last_y_ = 0;
 
     // Input.

@@ -203,7 +203,13 @@ void colour_bar(double scale, const char* unit) {
 }  // namespace
 
 void ViewerApp::panel_compare() {
+    // Open and scrolled to from the start when the command line asked for a compare view or
+    // a probe.
+    const bool asked = !compare_panel_shown_ && (options_.compare.mode != ViewMode::render || options_.probe);
+    compare_panel_shown_ = true;
+    if (asked) ImGui::SetNextItemOpen(true);
     if (!ImGui::CollapsingHeader("Inspect and compare")) return;
+    if (asked) ImGui::SetScrollHereY(0.0f);
     const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
     const PixelRect area = view_area();
     // Zoom.

@@ -204,6 +204,11 @@ void ViewerApp::draw_status_bar() {
     ImGui::SameLine(680);
     if (st.noise >= 0) ImGui::Text("noise %.3g%%", 100 * st.noise);
     else ImGui::TextDisabled("noise: needs 2 spp");
+    if (figures_ && current) {
+        // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
+        ImGui::SameLine(790);
+        ImGui::Text("vs B %.2f dB", figures_->psnr);
+    }
     // Line 2: one message, the most important first; full text on hover.
     const std::string* message = nullptr;
     ImVec4 colour(0.85f, 0.85f, 0.85f, 1);
