@@ -179,7 +179,8 @@ TEST(Compare, FiguresAreThoseOfThePsnrCommand) {
     const auto f = compare_figures(a, b);
     ASSERT_TRUE(f);
     EXPECT_EQ(f->psnr, psnr(a, b));
-    EXPECT_EQ(f->rmse, rgb8_errors(a, b).rmse);
+    EXPECT_NEAR(f->rmse, rgb8_errors(a, b).rmse, 1e-15);
+    EXPECT_EQ(compare_figures(a, a)->rmse, 0);
     EXPECT_NEAR(f->rmse, std::sqrt((30.0 * 30 + 10.0 * 10) / 24) / 255, 1e-12);
     EXPECT_FALSE(compare_figures(a, Rgb8Image{2, 4, std::vector<uint8_t>(24, 100)}));
 
