@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -21,6 +22,7 @@
 #include "viewer/convergence_log.h"
 #include "viewer/image_view.h"
 #include "viewer/inspect.h"
+#include "viewer/save_dialog.h"
 #include "viewer/view_options.h"
 
 namespace fs = std::filesystem;
@@ -327,4 +329,29 @@ TEST(ViewOptions, CompareFlags) {
     EXPECT_THROW(parse({"--split", "1.5"}), UsageError);
     EXPECT_THROW(parse({"--zoom", "64"}), UsageError);
     EXPECT_THROW(parse({"--probe", "3"}), UsageError);
+}
+
+// The Stats panel's "Save convergence CSV" writes the log whole, where the Save panel's
+// default path puts it.
+TEST(ConvergenceLog, SavedAsCsvBesideTheOutput) {
+    const fs::path dir = fs::temp_directory_path() / ("keithray_csv_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    ViewerModel model;
+    model.load(fs::path(KEITHRAY_RES_DIR) / "scenes" / "assignment_02.json");
+    EXPECT_EQ(fs::path(SavePaths::for_scene(model.scene()).convergence).filename(), "assignment_02-convergence.csv");
+    ConvergenceLog log;
+    Snapshot f;
+    f.spp = 1;
+    f.full_seconds = 0.25;
+    log.record(f, std::nullopt);
+    const fs::path csv = dir / "c.csv";
+    EXPECT_NE(save_output(SaveKind::convergence, csv, model, nullptr, log.csv()).find("saved"), std::string::npos);
+    std::ifstream in(csv);
+    std::stringstream text;
+    text << in.rdbuf();
+    EXPECT_EQ(text.str(), log.csv());
+    // Under a regular file: refused, and nothing written.
+    EXPECT_THROW(save_output(SaveKind::convergence, csv / "c.csv", model, nullptr, log.csv()), std::exception);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);  // no temp file left
+    fs::remove_all(dir);
 }

@@ -114,6 +114,10 @@ zoom_probe)
     wait_for "pointer=$((${left%.*} + 128)),330" || exit 1
     xdotool mouseup 1
     wait_for 'split=0.250' || exit 1
+    # K keeps the image in the first free slot and makes it image B.
+    wait_for 'b=reference' || exit 1
+    xdotool key k
+    wait_for 'b=slot1' || exit 1
     ;;
 esc)
     xdotool key Escape

@@ -509,21 +509,22 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // 4 middle, 8 the left one on the split view's divider); pointer: where
     // that frame saw the pointer (window points). Scripts wait on these before the next event.
     const ImGuiIO& io = ImGui::GetIO();
-    // view, image (the image's corner in the framebuffer and its scale; "fit" when fitted)
-    // and probe (the locked pixel) follow the inspect and compare tools.
+    // view, image (the image's corner in the framebuffer and its scale; "fit" when fitted),
+    // probe (the locked pixel) and b (image B) follow the inspect and compare tools.
     const PixelRect rect = image_rect();
-    char probe[48] = "none";
+    char probe[48] = "none", b[32] = "none";
     if (locked_probe_) std::snprintf(probe, sizeof probe, "%d,%d", locked_probe_->first, locked_probe_->second);
+    if (compare_.b()) std::snprintf(b, sizeof b, compare_.settings.b < 0 ? "reference" : "slot%d", compare_.settings.b + 1);
     char line[420];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(help_visible_),
                   int(panel_visible_), int(drags_[0].pressed) | 2 * int(drags_[1].pressed) | 4 * int(drags_[2].pressed) | 8 * int(divider_drag_), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(compare_.settings.mode)).c_str(),
                   compare_.settings.split, rect.x, rect.y, view_.fitted() ? "fit" : "", model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0,
-                  probe);
+                  probe, b);
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);
