@@ -28,9 +28,9 @@ RenderState two_halves(int w, int h, int passes) {
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
             const double n = passes, mean = 0.5, variance = x >= w / 2 ? 1.0 : 0.0;
-            s.sample_count[i] = s.sample_index[i] = uint32_t(passes);
-            s.radiance_sum[i] = Color(n * mean);
-            s.luminance_sq_sum[i] = (n - 1) * variance + n * mean * mean;
+            s.buffers().sample_count[i] = s.buffers().sample_index[i] = uint32_t(passes);
+            s.buffers().radiance_sum[i] = Color(n * mean);
+            s.buffers().luminance_sq_sum[i] = (n - 1) * variance + n * mean * mean;
         }
     return s;
 }
@@ -62,8 +62,8 @@ TEST(Allocation, PlanSpendsOnePassInProportionToTheDeviation) {
     std::vector<long> total(size_t(w) * h, 0);
     for (int r = 0; r < rounds; ++r) {
         state.plan_pass(settings);
-        ASSERT_EQ(state.pass_samples.size(), total.size());
-        for (size_t i = 0; i < total.size(); ++i) total[i] += state.pass_samples[i];
+        ASSERT_EQ(state.pass_samples().size(), total.size());
+        for (size_t i = 0; i < total.size(); ++i) total[i] += state.pass_samples()[i];
     }
     // Fractions carry over: after `rounds` passes every pixel is within one sample of its
     // quota, so the sum is within one sample per pixel of rounds x pixels.
@@ -87,41 +87,41 @@ TEST(Allocation, UniformBeforeTheWarmupForStratifiedAndWhenAskedFor) {
     RenderState state = two_halves(8, 8, kAllocationWarmup - 1);
     RenderSettings settings = adaptive_settings();
     state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples.empty());  // one sample each: the variance is not known yet
+    EXPECT_TRUE(state.pass_samples().empty());  // one sample each: the variance is not known yet
     state.passes = kAllocationWarmup;
     state.plan_pass(settings);
-    EXPECT_FALSE(state.pass_samples.empty());
+    EXPECT_FALSE(state.pass_samples().empty());
     settings.estimator = Estimator::stratified;  // its strata need exactly s samples per pixel
     state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples.empty());
+    EXPECT_TRUE(state.pass_samples().empty());
     settings = adaptive_settings();
     settings.allocation = Allocation::uniform;
     state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples.empty());
+    EXPECT_TRUE(state.pass_samples().empty());
     // No variance anywhere: nothing to adapt to.
     RenderState flat(8, 8);
     flat.passes = kAllocationWarmup;
-    for (size_t i = 0; i < flat.sample_count.size(); ++i) {
-        flat.sample_count[i] = kAllocationWarmup;
-        flat.radiance_sum[i] = Color(kAllocationWarmup * 0.5);
-        flat.luminance_sq_sum[i] = kAllocationWarmup * 0.25;
+    for (size_t i = 0; i < flat.sample_count().size(); ++i) {
+        flat.buffers().sample_count[i] = kAllocationWarmup;
+        flat.buffers().radiance_sum[i] = Color(kAllocationWarmup * 0.5);
+        flat.buffers().luminance_sq_sum[i] = kAllocationWarmup * 0.25;
     }
     flat.plan_pass(adaptive_settings());
-    EXPECT_TRUE(flat.pass_samples.empty());
+    EXPECT_TRUE(flat.pass_samples().empty());
 }
 
 // The noise rule's mask and the allocation together: pixels that met their share get
 // nothing, the others share a pass as large as their count.
 TEST(Allocation, InactivePixelsGetNoSamples) {
     RenderState state = two_halves(8, 8, kAllocationWarmup);
-    state.active.assign(64, 1);
-    for (int i = 0; i < 16; ++i) state.active[i] = 0;
+    state.buffers().active.assign(64, 1);
+    for (int i = 0; i < 16; ++i) state.buffers().active[i] = 0;
     long sum = 0;
     for (int r = 0; r < 100; ++r) {
         state.plan_pass(adaptive_settings());
         for (int i = 0; i < 64; ++i) {
-            if (i < 16) EXPECT_EQ(state.pass_samples[i], 0);
-            sum += state.pass_samples[i];
+            if (i < 16) EXPECT_EQ(state.pass_samples()[i], 0);
+            sum += state.pass_samples()[i];
         }
     }
     EXPECT_LE(sum, 100L * 48);
@@ -163,17 +163,17 @@ TEST(Allocation, AdaptiveFurnaceKeepsTheAnalyticValue) {
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
             const size_t i = size_t(y) * 16 + x;
-            const double mean = state.radiance_sum[i].x / state.sample_count[i];
+            const double mean = state.radiance_sum()[i].x / state.sample_count()[i];
             const int on = corners_on_sphere(x, y);
             if (on == 0) {
                 EXPECT_EQ(mean, 2.0) << x << "," << y;  // the emitter: exactly Le
                 background_pixels += 1;
-                background_samples += state.sample_count[i];
+                background_samples += state.sample_count()[i];
             } else if (on == 4) {
                 EXPECT_NEAR(mean, 1.2, 5 * state.pixel_standard_error(i) + 1e-9) << x << "," << y;
                 sphere_pixels += 1;
-                sphere_samples += state.sample_count[i];
-                sphere_sum += state.radiance_sum[i].x;
+                sphere_samples += state.sample_count()[i];
+                sphere_sum += state.radiance_sum()[i].x;
             }
         }
     ASSERT_GT(sphere_pixels, 20);
@@ -185,7 +185,7 @@ TEST(Allocation, AdaptiveFurnaceKeepsTheAnalyticValue) {
     // as one a pass (within one per pixel: the carried fractions).
     EXPECT_GT(sphere_samples / sphere_pixels, 1.3 * 256);
     EXPECT_LT(background_samples / background_pixels, 0.6 * 256);
-    const uint64_t all = std::accumulate(state.sample_count.begin(), state.sample_count.end(), 0ull);
+    const uint64_t all = std::accumulate(state.sample_count().begin(), state.sample_count().end(), 0ull);
     EXPECT_NEAR(double(all), 256.0 * 256, 256);
 }
 
@@ -208,8 +208,8 @@ TEST(Allocation, AdaptiveBeatsUniformAtTheSameBudget) {
     render_until(scene, settings, uniform, rule);
     settings.allocation = Allocation::adaptive;
     render_until(scene, settings, adaptive, rule);
-    const uint64_t uniform_samples = std::accumulate(uniform.sample_count.begin(), uniform.sample_count.end(), 0ull);
-    const uint64_t adaptive_samples = std::accumulate(adaptive.sample_count.begin(), adaptive.sample_count.end(), 0ull);
+    const uint64_t uniform_samples = std::accumulate(uniform.sample_count().begin(), uniform.sample_count().end(), 0ull);
+    const uint64_t adaptive_samples = std::accumulate(adaptive.sample_count().begin(), adaptive.sample_count().end(), 0ull);
     EXPECT_NEAR(double(adaptive_samples), double(uniform_samples), 24 * 24);
     const double mse_uniform = mean_squared_error(uniform.radiance(), reference.radiance());
     const double mse_adaptive = mean_squared_error(adaptive.radiance(), reference.radiance());
@@ -237,18 +237,18 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
         return state;
     };
     const RenderState one = render_with(1), two = render_with(2);
-    EXPECT_EQ(one.sample_count, two.sample_count);
-    for (size_t i = 0; i < one.radiance_sum.size(); ++i) EXPECT_EQ(one.radiance_sum[i].x, two.radiance_sum[i].x);
-    EXPECT_NE(*std::min_element(one.sample_count.begin(), one.sample_count.end()),
-              *std::max_element(one.sample_count.begin(), one.sample_count.end()));
+    EXPECT_EQ(one.sample_count(), two.sample_count());
+    for (size_t i = 0; i < one.radiance_sum().size(); ++i) EXPECT_EQ(one.radiance_sum()[i].x, two.radiance_sum()[i].x);
+    EXPECT_NE(*std::min_element(one.sample_count().begin(), one.sample_count().end()),
+              *std::max_element(one.sample_count().begin(), one.sample_count().end()));
 
     // With the noise rule too, whose mask (update_adaptive) also sums rows in parallel.
     rule.noise = 0.04;  // not met by pass 24 (about 0.05): the mask is updated at passes 16, 20, 24
     const RenderState noise_one = render_with(1), noise_two = render_with(2);
-    EXPECT_EQ(noise_one.sample_count, noise_two.sample_count);
-    EXPECT_EQ(noise_one.active, noise_two.active);
+    EXPECT_EQ(noise_one.sample_count(), noise_two.sample_count());
+    EXPECT_EQ(noise_one.active(), noise_two.active());
     EXPECT_EQ(noise_one.relative_error(), noise_two.relative_error());
-    const auto still_active = std::count(noise_one.active.begin(), noise_one.active.end(), 1);
+    const auto still_active = std::count(noise_one.active().begin(), noise_one.active().end(), 1);
     EXPECT_GT(still_active, 0);
     EXPECT_LT(still_active, 256);  // the mask has left some pixels out
     rule.noise = 0;
@@ -256,5 +256,5 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     viewer::Accumulator accumulator;
     accumulator.reset(16, 16);
     for (int pass = 0; pass < rule.max_passes; ++pass) accumulator.render_pass(scene, settings);
-    EXPECT_EQ(accumulator.totals().sample_count, one.sample_count);
+    EXPECT_EQ(accumulator.totals().sample_count(), one.sample_count());
 }

@@ -26,15 +26,15 @@ namespace {
 void expect_same_state(const RenderState& a, const RenderState& b) {
     EXPECT_EQ(a.passes, b.passes);
     EXPECT_EQ(a.rays, b.rays);
-    EXPECT_EQ(a.sample_count, b.sample_count);
-    EXPECT_EQ(a.sample_index, b.sample_index);
-    EXPECT_EQ(a.active, b.active);
-    EXPECT_EQ(a.depth_sum, b.depth_sum);
-    EXPECT_EQ(a.luminance_sq_sum, b.luminance_sq_sum);
+    EXPECT_EQ(a.sample_count(), b.sample_count());
+    EXPECT_EQ(a.sample_index(), b.sample_index());
+    EXPECT_EQ(a.active(), b.active());
+    EXPECT_EQ(a.depth_sum(), b.depth_sum());
+    EXPECT_EQ(a.luminance_sq_sum(), b.luminance_sq_sum());
     size_t differ = 0;
-    for (size_t i = 0; i < a.radiance_sum.size(); ++i)
-        differ += a.radiance_sum[i].x != b.radiance_sum[i].x || a.radiance_sum[i].y != b.radiance_sum[i].y ||
-                  a.radiance_sum[i].z != b.radiance_sum[i].z || a.radiance_sq_sum[i].x != b.radiance_sq_sum[i].x;
+    for (size_t i = 0; i < a.radiance_sum().size(); ++i)
+        differ += a.radiance_sum()[i].x != b.radiance_sum()[i].x || a.radiance_sum()[i].y != b.radiance_sum()[i].y ||
+                  a.radiance_sum()[i].z != b.radiance_sum()[i].z || a.radiance_sq_sum()[i].x != b.radiance_sq_sum()[i].x;
     EXPECT_EQ(differ, 0u);
 }
 
@@ -70,8 +70,8 @@ TEST(Checkpoint, ResumedRenderIsTheUninterruptedOne) {
         render_until(scene, settings, whole, rule);
         ASSERT_EQ(whole.passes, 36);
         // The noise rule's mask and the allocation's carried fractions are in play.
-        EXPECT_EQ(whole.active.empty(), c.noise == 0);
-        EXPECT_EQ(whole.sample_credit.empty(), c.allocation == Allocation::uniform);
+        EXPECT_EQ(whole.active().empty(), c.noise == 0);
+        EXPECT_EQ(whole.sample_credit().empty(), c.allocation == Allocation::uniform);
         const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
         for (int k : {3, 10, 25}) {
             StopRule first = rule;

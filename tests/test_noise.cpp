@@ -122,7 +122,7 @@ TEST(StopRule, AdaptiveSamplingSpendsPassesOnNoisyPixels) {
     render_until(scene, settings_with_seed(5), state, rule);
     // Background pixels (no variance) stop at the minimum; lit ones go on.
     uint32_t fewest = ~0u, most = 0;
-    for (uint32_t n : state.sample_count) {
+    for (uint32_t n : state.sample_count()) {
         fewest = std::min(fewest, n);
         most = std::max(most, n);
     }

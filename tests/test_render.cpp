@@ -201,9 +201,9 @@ TEST(Progressive, ImageIndependentOfThreadCount) {
     };
     const RenderState one = render(1), two = render(2), three = render(3);
     omp_set_num_threads(omp_get_num_procs());
-    for (size_t i = 0; i < one.radiance_sum.size(); ++i) {
-        EXPECT_EQ(one.radiance_sum[i], two.radiance_sum[i]);
-        EXPECT_EQ(one.radiance_sum[i], three.radiance_sum[i]);
+    for (size_t i = 0; i < one.radiance_sum().size(); ++i) {
+        EXPECT_EQ(one.radiance_sum()[i], two.radiance_sum()[i]);
+        EXPECT_EQ(one.radiance_sum()[i], three.radiance_sum()[i]);
     }
     EXPECT_EQ(one.rays, two.rays);
     EXPECT_EQ(one.passes, 4);
@@ -216,11 +216,11 @@ TEST(Progressive, StopFlagEndsPass) {
     std::atomic<bool> stop{true};
     EXPECT_FALSE(render_pass(scene, settings_for(Integrator::pt), state, &stop));
     EXPECT_EQ(state.passes, 0);
-    for (uint32_t c : state.sample_count) EXPECT_EQ(c, 0u);
+    for (uint32_t c : state.sample_count()) EXPECT_EQ(c, 0u);
     stop = false;
     EXPECT_TRUE(render_pass(scene, settings_for(Integrator::pt), state, &stop));
     EXPECT_EQ(state.passes, 1);
-    for (uint32_t c : state.sample_count) EXPECT_EQ(c, 1u);
+    for (uint32_t c : state.sample_count()) EXPECT_EQ(c, 1u);
 }
 
 // The depth map records the primary hit distance, and a finite maximum for misses.

@@ -51,9 +51,9 @@ RenderSettings settings_for(Integrator integrator, int depth = 6, int spp = 1,
 }
 
 bool all_finite(const RenderState& state) {
-    for (const Color& c : state.radiance_sum)
+    for (const Color& c : state.radiance_sum())
         if (!is_finite(c)) return false;
-    for (double d : state.depth_sum)
+    for (double d : state.depth_sum())
         if (!std::isfinite(d)) return false;
     return true;
 }
@@ -129,9 +129,9 @@ double mean_z2(const RenderState& a, const RenderState& b) {
 }
 
 size_t state_bytes(const RenderState& s) {
-    return s.radiance_sum.capacity() * sizeof(Color) + s.depth_sum.capacity() * sizeof(double) +
-           s.luminance_sq_sum.capacity() * sizeof(double) + s.sample_count.capacity() * sizeof(uint32_t) +
-           s.sample_index.capacity() * sizeof(uint32_t) + s.active.capacity();
+    return s.radiance_sum().capacity() * sizeof(Color) + s.depth_sum().capacity() * sizeof(double) +
+           s.luminance_sq_sum().capacity() * sizeof(double) + s.sample_count().capacity() * sizeof(uint32_t) +
+           s.sample_index().capacity() * sizeof(uint32_t) + s.active().capacity();
 }
 
 // A small still life: floor, diffuse, mirror and glass balls, a point light and (for the
@@ -400,7 +400,7 @@ TEST(RobustMaterials, EtaOneDielectricIsInvisible) {
         EXPECT_LT(relative_l1(with.radiance(), without.radiance()), 1e-9);
         // The ball is in view (its depth shows), and at eta = 1.5 it shows in the image too.
         int in_view = 0;
-        for (size_t i = 0; i < with.depth_sum.size(); ++i) in_view += with.depth_sum[i] != without.depth_sum[i];
+        for (size_t i = 0; i < with.depth_sum().size(); ++i) in_view += with.depth_sum()[i] != without.depth_sum()[i];
         EXPECT_GT(in_view, 20);
         const RenderState glass = render(scene(true, false, 1.5), s, 24, 24, 4);
         EXPECT_GT(relative_l1(glass.radiance(), without.radiance()), 1e-2);
@@ -415,13 +415,13 @@ TEST(RobustMaterials, EtaOneDielectricIsInvisible) {
         // heavy-tailed and per-pixel z-scores mislead. Instead: the mean luminance over the
         // pixels where the ball is (its depth shows), whose standard error pools them all.
         std::vector<size_t> ball;
-        for (size_t i = 0; i < with.depth_sum.size(); ++i)
-            if (with.depth_sum[i] != without.depth_sum[i]) ball.push_back(i);
+        for (size_t i = 0; i < with.depth_sum().size(); ++i)
+            if (with.depth_sum()[i] != without.depth_sum()[i]) ball.push_back(i);
         ASSERT_GT(ball.size(), 10u);
         auto ball_mean = [&](const RenderState& state, double& standard_error) {
             double sum = 0, variance = 0;
             for (size_t i : ball) {
-                sum += luminance(state.radiance_sum[i]) / state.sample_count[i];
+                sum += luminance(state.radiance_sum()[i]) / state.sample_count()[i];
                 variance += std::pow(state.pixel_standard_error(i), 2);
             }
             standard_error = std::sqrt(variance) / double(ball.size());
@@ -431,9 +431,9 @@ TEST(RobustMaterials, EtaOneDielectricIsInvisible) {
         const double difference = ball_mean(with, se_with) - ball_mean(without, se_without);
         EXPECT_LT(std::abs(difference), 4 * std::hypot(se_with, se_without));
         double sum_with = 0, sum_without = 0;
-        for (size_t i = 0; i < with.radiance_sum.size(); ++i) {
-            sum_with += luminance(with.radiance_sum[i]);
-            sum_without += luminance(without.radiance_sum[i]);
+        for (size_t i = 0; i < with.radiance_sum().size(); ++i) {
+            sum_with += luminance(with.radiance_sum()[i]);
+            sum_without += luminance(without.radiance_sum()[i]);
         }
         EXPECT_NEAR(sum_with / sum_without, 1.0, 0.03);
     }
@@ -659,7 +659,7 @@ TEST(RobustRenderer, SamplesOneAndNonSquareStratified) {
         s.estimator = Estimator::stratified;
         const RenderState state = render(scene, s, 10, 10, spp);
         ASSERT_TRUE(all_finite(state));
-        for (uint32_t c : state.sample_count) EXPECT_EQ(c, uint32_t(spp));
+        for (uint32_t c : state.sample_count()) EXPECT_EQ(c, uint32_t(spp));
         EXPECT_EQ(state.passes, spp);
     }
     // 50 (7x7 strata plus one uniform) against 200 uniform samples.
@@ -681,15 +681,15 @@ TEST(RobustRenderer, ExtremeDimensions) {
     const RenderSettings s = settings_for(Integrator::wrt, 2, 1);
     {
         const RenderState one = render(scene, s, 1, 1, 4);
-        ASSERT_EQ(one.radiance_sum.size(), 1u);
-        EXPECT_EQ(one.sample_count[0], 4u);
+        ASSERT_EQ(one.radiance_sum().size(), 1u);
+        EXPECT_EQ(one.sample_count()[0], 4u);
         EXPECT_NEAR(one.radiance().pixels[0].x, 2.0, 1e-12);
     }
     {
         const RenderState tall = render(scene, s, 1, 4096, 1);
         ASSERT_TRUE(all_finite(tall));
-        EXPECT_EQ(tall.radiance_sum.size(), 4096u);
-        for (uint32_t c : tall.sample_count) EXPECT_EQ(c, 1u);
+        EXPECT_EQ(tall.radiance_sum().size(), 4096u);
+        for (uint32_t c : tall.sample_count()) EXPECT_EQ(c, 1u);
         for (const Color& c : tall.radiance().pixels) EXPECT_NEAR(c.x, 2.0, 1e-12);
         const Rgb8Image img = tonemap(tall.radiance(), ToneMap::sigmoid);
         EXPECT_EQ(img.width, 1);
@@ -700,10 +700,10 @@ TEST(RobustRenderer, ExtremeDimensions) {
         const auto start = std::chrono::steady_clock::now();
         const RenderState big = render(scene, s, 4096, 2160, 1);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        ASSERT_EQ(big.radiance_sum.size(), size_t(4096) * 2160);
+        ASSERT_EQ(big.radiance_sum().size(), size_t(4096) * 2160);
         EXPECT_EQ(big.nonfinite_samples, 0u);
         size_t unsampled = 0;
-        for (uint32_t c : big.sample_count) unsampled += c != 1;
+        for (uint32_t c : big.sample_count()) unsampled += c != 1;
         EXPECT_EQ(unsampled, 0u);
         const Image radiance = big.radiance();
         const Rgb8Image img = tonemap(radiance, ToneMap::sigmoid);
@@ -841,7 +841,7 @@ TEST(RobustLights, PointLightOnOrInsideASurface) {
     for (Integrator integrator : {Integrator::wrt, Integrator::pt}) {
         const RenderState state = render(b.build(), settings_for(integrator, 6, 4), 12, 12, 4);
         ASSERT_TRUE(all_finite(state));
-        for (const Color& c : state.radiance_sum) EXPECT_EQ(c.x, 0.0) << integrator_names.name(integrator);
+        for (const Color& c : state.radiance_sum()) EXPECT_EQ(c.x, 0.0) << integrator_names.name(integrator);
     }
 }
 
@@ -1058,7 +1058,7 @@ TEST(RobustJson, EmptyScene) {
     const RenderScene scene = prepare_scene(loaded.scene);
     for (Integrator integrator : {Integrator::wrt, Integrator::pt, Integrator::pt_naive}) {
         const RenderState state = render(scene, settings_for(integrator), 8, 8, 2);
-        for (const Color& c : state.radiance_sum) EXPECT_EQ(c, Color());
+        for (const Color& c : state.radiance_sum()) EXPECT_EQ(c, Color());
         for (double d : state.mean_depth()) EXPECT_EQ(d, kMissDepth);
     }
     EXPECT_NE(load_error("").find("malformed JSON"), std::string::npos);
@@ -1111,7 +1111,7 @@ TEST(RobustJson, HundredThousandPrimitives) {
     ASSERT_TRUE(all_finite(state));
     EXPECT_EQ(state.nonfinite_samples, 0u);
     double lit = 0;
-    for (const Color& c : state.radiance_sum) lit += c.x;
+    for (const Color& c : state.radiance_sum()) lit += c.x;
     EXPECT_GT(lit, 0);
     std::printf("[ timing   ] 100k primitives (50k area lights), %.1f MB of JSON: parse+load %.2f s, "
                 "prepare %.2f s, 32x32 PT 1 spp render %.2f s\n",
@@ -1138,15 +1138,15 @@ TEST(RobustNonFinite, SamplesAreCountedAndNeverAccumulated) {
         const RenderState state = render(scene, settings_for(integrator, 6, 4), 16, 16, 4);
         EXPECT_GT(state.nonfinite_samples, 0u) << integrator_names.name(integrator);
         ASSERT_TRUE(all_finite(state));
-        for (double v : state.luminance_sq_sum) EXPECT_FALSE(std::isnan(v));
+        for (double v : state.luminance_sq_sum()) EXPECT_FALSE(std::isnan(v));
         uint64_t dropped = 0;
-        for (size_t i = 0; i < state.sample_count.size(); ++i) {
-            EXPECT_LE(state.sample_count[i], state.sample_index[i]);
-            dropped += state.sample_index[i] - state.sample_count[i];
+        for (size_t i = 0; i < state.sample_count().size(); ++i) {
+            EXPECT_LE(state.sample_count()[i], state.sample_index()[i]);
+            dropped += state.sample_index()[i] - state.sample_count()[i];
         }
         EXPECT_EQ(dropped, state.nonfinite_samples);
         // The corner pixels see the lit wall far from the light: finite, kept.
-        EXPECT_EQ(state.sample_count[0], 4u);
+        EXPECT_EQ(state.sample_count()[0], 4u);
     }
 }
 

@@ -129,7 +129,7 @@ TEST_P(SaveScene, SavedSceneRendersTheSameImage) {
         RenderSettings settings = RenderSettings::from_scene(rs.renderer);
         RenderState state(rs.renderer.width, rs.renderer.height);
         render_pass(rs, settings, state);
-        return state.radiance_sum;
+        return state.radiance_sum();
     };
     const auto a = render(original), b = render(again);
     ASSERT_EQ(a.size(), b.size());

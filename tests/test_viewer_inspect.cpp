@@ -73,14 +73,14 @@ TEST(PixelInspector, NumbersAreTheRenderStates) {
             EXPECT_EQ(p->x, x);
             EXPECT_EQ(p->y, y);
             EXPECT_EQ(p->mean, mean.pixels[i]);
-            EXPECT_EQ(p->samples, totals.sample_count[i]);
+            EXPECT_EQ(p->samples, totals.sample_count()[i]);
             EXPECT_EQ(p->standard_error, float(totals.pixel_standard_error(i)));
             EXPECT_FALSE(p->preview);
             for (int k = 0; k < 3; ++k) EXPECT_EQ(p->displayed[size_t(k)], shown.bytes[3 * i + size_t(k)]) << int(op);
         }
     }
     // The counts differ between pixels (adaptive allocation), so the readout is per pixel.
-    const auto [lo, hi] = std::minmax_element(totals.sample_count.begin(), totals.sample_count.end());
+    const auto [lo, hi] = std::minmax_element(totals.sample_count().begin(), totals.sample_count().end());
     EXPECT_LT(*lo, *hi);
     EXPECT_FALSE(probe_pixel(r.frame, 24, 24, 24, 0, ToneSettings{}, 1));
     EXPECT_FALSE(probe_pixel(r.frame, 24, 24, 0, -1, ToneSettings{}, 1));

@@ -215,19 +215,19 @@ TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
 TEST(Accumulation, NoDriftAfterAMillionSamples) {
     RenderState totals(1, 1);
     RenderState pass(1, 1);
-    pass.radiance_sum[0] = Color(0.1, 0.7, 1.0 / 3.0);
-    pass.sample_count[0] = 1;
+    pass.buffers().radiance_sum[0] = Color(0.1, 0.7, 1.0 / 3.0);
+    pass.buffers().sample_count[0] = 1;
     for (int i = 0; i < 1000000; ++i) totals.merge(pass);
     const Color mean = totals.radiance().pixels[0];
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], pass.radiance_sum[0][k], 1e-12 * pass.radiance_sum[0][k]);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(mean[k], pass.radiance_sum()[0][k], 1e-12 * pass.radiance_sum()[0][k]);
     EXPECT_EQ(totals.passes, 1000000);
-    EXPECT_EQ(totals.sample_count[0], 1000000u);
+    EXPECT_EQ(totals.sample_count()[0], 1000000u);
     // A scratch state cleared for its next pass keeps its sample indices.
-    pass.sample_index[0] = 7;
+    pass.buffers().sample_index[0] = 7;
     pass.clear_sums();
-    EXPECT_EQ(pass.radiance_sum[0].x, 0.0);
-    EXPECT_EQ(pass.sample_count[0], 0u);
-    EXPECT_EQ(pass.sample_index[0], 7u);
+    EXPECT_EQ(pass.radiance_sum()[0].x, 0.0);
+    EXPECT_EQ(pass.sample_count()[0], 0u);
+    EXPECT_EQ(pass.sample_index()[0], 7u);
 }
 
 // The same through render_pass: the camera inside an emitter of radiance 0.1 with depth 0

@@ -124,13 +124,13 @@ public:
             owned_.assign(pixels, 0);
             for (int y = rank_; y < state.height; y += size_) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
         }
-        noise_mask_.swap(state.active);
+        noise_mask_.swap(state.buffers().active);
         if (noise_mask_.empty()) {
-            state.active = owned_;
+            state.buffers().active = owned_;
         } else {
-            state.active.resize(pixels);
+            state.buffers().active.resize(pixels);
 #pragma omp parallel for schedule(static)
-            for (size_t i = 0; i < pixels; ++i) state.active[i] = owned_[i] & noise_mask_[i];
+            for (size_t i = 0; i < pixels; ++i) state.buffers().active[i] = owned_[i] & noise_mask_[i];
         }
         if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
         cpu_start_ = cpu_seconds();
@@ -138,16 +138,16 @@ public:
 
     void after_pass(RenderState& state, bool statistics) override {
         cost_.busy_seconds += cpu_seconds() - cpu_start_;
-        state.active.swap(noise_mask_);
+        state.buffers().active.swap(noise_mask_);
         noise_mask_.clear();
         ++passes_;
         pass_end_ = wall_seconds();
         if (!statistics && !always_combine_) return;
         const double start = pass_end_;
         const RowDeal deal{rank_, size_, state.width, state.height};
-        deal.exchange(state.radiance_sum, true, mine_, gathered_);
-        deal.exchange(state.luminance_sq_sum, true, mine_, gathered_);
-        deal.exchange(state.sample_count, true, mine_, gathered_);
+        deal.exchange(state.buffers().radiance_sum, true, mine_, gathered_);
+        deal.exchange(state.buffers().luminance_sq_sum, true, mine_, gathered_);
+        deal.exchange(state.buffers().sample_count, true, mine_, gathered_);
         pass_end_ = wall_seconds();
         cost_.combine_seconds += pass_end_ - start;
         ++cost_.exchanges;
@@ -239,12 +239,12 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     if (!mpi_) return;
     const RowDeal deal{rank_, size_, state.width, state.height};
     std::vector<char> mine, gathered;
-    deal.exchange(state.radiance_sum, false, mine, gathered);
-    deal.exchange(state.depth_sum, false, mine, gathered);
-    deal.exchange(state.luminance_sq_sum, false, mine, gathered);
-    deal.exchange(state.radiance_sq_sum, false, mine, gathered);
-    deal.exchange(state.sample_count, false, mine, gathered);
-    deal.exchange(state.sample_index, false, mine, gathered);
+    deal.exchange(state.buffers().radiance_sum, false, mine, gathered);
+    deal.exchange(state.buffers().depth_sum, false, mine, gathered);
+    deal.exchange(state.buffers().luminance_sq_sum, false, mine, gathered);
+    deal.exchange(state.buffers().radiance_sq_sum, false, mine, gathered);
+    deal.exchange(state.buffers().sample_count, false, mine, gathered);
+    deal.exchange(state.buffers().sample_index, false, mine, gathered);
     const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
     unsigned long long sum[2] = {0, 0};
     MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);

@@ -64,7 +64,7 @@ HdrImage hdr_from_render(const RenderScene& scene, const RenderState& state, con
     const size_t n = out.pixel_count();
     const std::vector<double> depth = state.mean_depth();
     out.depth.assign(depth.begin(), depth.end());
-    out.samples.assign(state.sample_count.begin(), state.sample_count.end());
+    out.samples.assign(state.sample_count().begin(), state.sample_count().end());
     const SurfaceLayers surface = first_surface_layers(scene, state.width, state.height);
     out.albedo.resize(3 * n);
     out.normal.resize(3 * n);

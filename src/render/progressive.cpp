@@ -23,20 +23,20 @@ void RenderState::reset(int w, int h) {
     width = w;
     height = h;
     const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
-    radiance_sum.assign(n, Color());
-    depth_sum.assign(n, 0.0);
-    luminance_sq_sum.assign(n, 0.0);
-    radiance_sq_sum.assign(n, Color());
-    sample_count.assign(n, 0);
-    sample_index.assign(n, 0);
+    px_.radiance_sum.assign(n, Color());
+    px_.depth_sum.assign(n, 0.0);
+    px_.luminance_sq_sum.assign(n, 0.0);
+    px_.radiance_sq_sum.assign(n, Color());
+    px_.sample_count.assign(n, 0);
+    px_.sample_index.assign(n, 0);
     passes = 0;
     rays = 0;
     nonfinite_samples = 0;
-    active.clear();
-    pass_samples.clear();
-    sample_credit.clear();
-    for (auto& scratch : allocation_scratch) scratch.clear();
-    sobol_keys.clear();
+    px_.active.clear();
+    px_.pass_samples.clear();
+    px_.sample_credit.clear();
+    for (auto& scratch : px_.allocation_scratch) scratch.clear();
+    px_.sobol_keys.clear();
     merged_raw_.clear();
     merged_compensation_.clear();
 }
@@ -54,26 +54,26 @@ inline void add_compensated(double& sum, double& compensation, double x) {
 }  // namespace
 
 void RenderState::merge(const RenderState& pass) {
-    const size_t n = radiance_sum.size();
+    const size_t n = px_.radiance_sum.size();
     if (merged_raw_.size() != n) {
-        merged_raw_ = radiance_sum;
+        merged_raw_ = px_.radiance_sum;
         merged_compensation_.assign(n, Color());
     }
     // Every pixel on its own: the same sums for any thread count.
 #pragma omp parallel for schedule(static)
     for (long k = 0; k < long(n); ++k) {
         const size_t i = size_t(k);
-        if (pass.sample_count[i] == 0) continue;
+        if (pass.px_.sample_count[i] == 0) continue;
         Color& sum = merged_raw_[i];
         Color& c = merged_compensation_[i];
-        add_compensated(sum.x, c.x, pass.radiance_sum[i].x);
-        add_compensated(sum.y, c.y, pass.radiance_sum[i].y);
-        add_compensated(sum.z, c.z, pass.radiance_sum[i].z);
-        radiance_sum[i] = sum + c;
-        depth_sum[i] += pass.depth_sum[i];
-        luminance_sq_sum[i] += pass.luminance_sq_sum[i];
-        radiance_sq_sum[i] += pass.radiance_sq_sum[i];
-        sample_count[i] += pass.sample_count[i];
+        add_compensated(sum.x, c.x, pass.px_.radiance_sum[i].x);
+        add_compensated(sum.y, c.y, pass.px_.radiance_sum[i].y);
+        add_compensated(sum.z, c.z, pass.px_.radiance_sum[i].z);
+        px_.radiance_sum[i] = sum + c;
+        px_.depth_sum[i] += pass.px_.depth_sum[i];
+        px_.luminance_sq_sum[i] += pass.px_.luminance_sq_sum[i];
+        px_.radiance_sq_sum[i] += pass.px_.radiance_sq_sum[i];
+        px_.sample_count[i] += pass.px_.sample_count[i];
     }
     rays += pass.rays;
     nonfinite_samples += pass.nonfinite_samples;
@@ -83,16 +83,21 @@ void RenderState::merge(const RenderState& pass) {
 void RenderState::clear_sums() {
     // In parallel: at 512x512 these loops took a tenth of a cheap scene's pass.
 #pragma omp parallel for schedule(static)
-    for (long k = 0; k < long(radiance_sum.size()); ++k) {
+    for (long k = 0; k < long(px_.radiance_sum.size()); ++k) {
         const size_t i = size_t(k);
-        radiance_sum[i] = Color();
-        depth_sum[i] = 0.0;
-        luminance_sq_sum[i] = 0.0;
-        radiance_sq_sum[i] = Color();
-        sample_count[i] = 0u;
+        px_.radiance_sum[i] = Color();
+        px_.depth_sum[i] = 0.0;
+        px_.luminance_sq_sum[i] = 0.0;
+        px_.radiance_sq_sum[i] = Color();
+        px_.sample_count[i] = 0u;
     }
     rays = 0;
     nonfinite_samples = 0;
+}
+
+void RenderState::follow_plan(const RenderState& totals) {
+    px_.pass_samples = totals.px_.pass_samples;
+    px_.active = totals.px_.active;
 }
 
 uint64_t render_memory_bytes(int width, int height, bool blurred) {
@@ -104,44 +109,44 @@ uint64_t render_memory_bytes(int width, int height, bool blurred) {
 Image RenderState::radiance() const {
     Image img(width, height);
     for (size_t i = 0; i < img.pixels.size(); ++i)
-        img.pixels[i] = sample_count[i] ? radiance_sum[i] / double(sample_count[i]) : Color();
+        img.pixels[i] = px_.sample_count[i] ? px_.radiance_sum[i] / double(px_.sample_count[i]) : Color();
     return img;
 }
 
 std::vector<double> RenderState::mean_depth() const {
-    std::vector<double> d(depth_sum.size(), kMissDepth);
+    std::vector<double> d(px_.depth_sum.size(), kMissDepth);
     for (size_t i = 0; i < d.size(); ++i)
-        if (sample_count[i]) d[i] = depth_sum[i] / double(sample_count[i]);
+        if (px_.sample_count[i]) d[i] = px_.depth_sum[i] / double(px_.sample_count[i]);
     return d;
 }
 
 std::vector<Color> RenderState::variance_of_mean() const {
-    std::vector<Color> v(radiance_sum.size(), Color(kInfinity));
+    std::vector<Color> v(px_.radiance_sum.size(), Color(kInfinity));
     for (size_t i = 0; i < v.size(); ++i) {
-        const double n = sample_count[i];
-        if (n < 2 || !is_finite(radiance_sq_sum[i])) continue;  // unknown, as sample_variance
+        const double n = px_.sample_count[i];
+        if (n < 2 || !is_finite(px_.radiance_sq_sum[i])) continue;  // unknown, as sample_variance
         // The unbiased sample variance of each channel, then over n for the mean's.
         auto channel = [&](double sum, double sq_sum) {
             const double mean = sum / n;
             return std::max(0.0, (sq_sum - n * mean * mean) / (n - 1)) / n;
         };
-        v[i] = {channel(radiance_sum[i].x, radiance_sq_sum[i].x), channel(radiance_sum[i].y, radiance_sq_sum[i].y),
-                channel(radiance_sum[i].z, radiance_sq_sum[i].z)};
+        v[i] = {channel(px_.radiance_sum[i].x, px_.radiance_sq_sum[i].x), channel(px_.radiance_sum[i].y, px_.radiance_sq_sum[i].y),
+                channel(px_.radiance_sum[i].z, px_.radiance_sq_sum[i].z)};
     }
     return v;
 }
 
 double RenderState::sample_variance(size_t i) const {
-    const double n = sample_count[i];
+    const double n = px_.sample_count[i];
     // Below two samples there is no variance; a sum of squares that overflowed (radiance
     // above ~1e154) would give inf - inf: the variance is unknown, not zero.
-    if (n < 2 || !std::isfinite(luminance_sq_sum[i])) return kInfinity;
-    const double mean = luminance(radiance_sum[i]) / n;
-    return std::max(0.0, (luminance_sq_sum[i] - n * mean * mean) / (n - 1));  // unbiased
+    if (n < 2 || !std::isfinite(px_.luminance_sq_sum[i])) return kInfinity;
+    const double mean = luminance(px_.radiance_sum[i]) / n;
+    return std::max(0.0, (px_.luminance_sq_sum[i] - n * mean * mean) / (n - 1));  // unbiased
 }
 
 double RenderState::pixel_standard_error(size_t i) const {
-    return std::sqrt(sample_variance(i) / sample_count[i]);  // of the mean of n samples
+    return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
 }
 
 double RenderState::relative_error() const {
@@ -159,7 +164,7 @@ double RenderState::relative_error() const {
                 break;
             }
             row_error[size_t(y)] += se * se;
-            const double mean = luminance(radiance_sum[i]) / sample_count[i];
+            const double mean = luminance(px_.radiance_sum[i]) / px_.sample_count[i];
             row_signal[size_t(y)] += mean * mean;
         }
     double error_sq = 0, signal_sq = 0;
@@ -197,17 +202,17 @@ double guarded_3x3(const std::vector<double>& values, const std::vector<double>&
 }  // namespace
 
 size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
-    const size_t n = sample_count.size(), w = size_t(width);
+    const size_t n = px_.sample_count.size(), w = size_t(width);
     // Rows in parallel, their sums added in order (as plan_pass).
-    std::vector<double>& error_sq = allocation_scratch[0];
-    std::vector<double>& row_sums = allocation_scratch[1];
+    std::vector<double>& error_sq = px_.allocation_scratch[0];
+    std::vector<double>& row_sums = px_.allocation_scratch[1];
     error_sq.resize(n);
     row_sums.resize(n);
     std::vector<double> row_signal(size_t(height), 0.0);
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < height; ++y) {
         for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
-            const double mean = sample_count[i] ? luminance(radiance_sum[i]) / sample_count[i] : 0.0;
+            const double mean = px_.sample_count[i] ? luminance(px_.radiance_sum[i]) / px_.sample_count[i] : 0.0;
             row_signal[size_t(y)] += mean * mean;
             const double se = pixel_standard_error(i);
             error_sq[i] = se * se;
@@ -217,15 +222,15 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
     double signal_sq = 0;
     for (double s : row_signal) signal_sq += s;
     const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
-    active.resize(n);
+    px_.active.resize(n);
     std::vector<size_t> row_count(size_t(height), 0);
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < height; ++y)
         for (size_t x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
             const bool needs_more =
-                sample_count[i] < min_samples || !(guarded_3x3(error_sq, row_sums, width, height, y, x) <= share);
-            active[i] = needs_more;
+                px_.sample_count[i] < min_samples || !(guarded_3x3(error_sq, row_sums, width, height, y, x) <= share);
+            px_.active[i] = needs_more;
             row_count[size_t(y)] += needs_more;
         }
     size_t count = 0;
@@ -236,19 +241,19 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
 void RenderState::plan_pass(const RenderSettings& settings) {
     if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
         passes < kAllocationWarmup) {
-        pass_samples.clear();
+        px_.pass_samples.clear();
         return;
     }
-    const size_t n = sample_count.size(), w = size_t(width);
+    const size_t n = px_.sample_count.size(), w = size_t(width);
     // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
     // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
     // estimate may be too low, and bounds the bias of deciding from the samples themselves.
     // Every loop runs over rows in parallel; sums are taken per row and then over the rows in
     // order, so the plan is the same for any number of threads. The loops are fused:
     // at 512x512 the plan is bound by memory traffic.
-    std::vector<double>& variance = allocation_scratch[0];
-    std::vector<double>& row_sums = allocation_scratch[1];  // 3-wide sums along each row
-    std::vector<double>& weight = allocation_scratch[2];
+    std::vector<double>& variance = px_.allocation_scratch[0];
+    std::vector<double>& row_sums = px_.allocation_scratch[1];  // 3-wide sums along each row
+    std::vector<double>& weight = px_.allocation_scratch[2];
     variance.resize(n);
     row_sums.resize(n);
     weight.resize(n);
@@ -265,7 +270,7 @@ void RenderState::plan_pass(const RenderSettings& settings) {
     for (int y = 0; y < height; ++y)
         for (size_t x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
-            const bool on = active.empty() || active[i];
+            const bool on = px_.active.empty() || px_.active[i];
             const double guarded = guarded_3x3(variance, row_sums, width, height, y, x);
             weight[i] = on && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
             row_weight[size_t(y)] += weight[i];
@@ -278,43 +283,44 @@ void RenderState::plan_pass(const RenderSettings& settings) {
         active_count += row_active[size_t(y)];
     }
     const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
-    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
+    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over px_.active pixels
     if (!(total > 0) || !std::isfinite(total)) {
-        pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
+        px_.pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
         return;
     }
-    sample_credit.resize(n, 0.0f);
-    pass_samples.resize(n);
+    px_.sample_credit.resize(n, 0.0f);
+    px_.pass_samples.resize(n);
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < height; ++y)
         for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
-            if (!(active.empty() || active[i])) {
-                pass_samples[i] = 0;
+            if (!(px_.active.empty() || px_.active[i])) {
+                px_.pass_samples[i] = 0;
                 continue;
             }
-            // Quotas sum to the active pixel count: the pass costs what a uniform one does.
+            // Quotas sum to the px_.active pixel count: the pass costs what a uniform one does.
             const double quota = (weight[i] + floor) * quota_scale;
-            const double credit = std::min<double>(sample_credit[i] + quota, 4 * kMaxPassSamples);
+            const double credit = std::min<double>(px_.sample_credit[i] + quota, 4 * kMaxPassSamples);
             const int take = std::min(int(credit), kMaxPassSamples);
-            pass_samples[i] = static_cast<uint8_t>(take);
-            sample_credit[i] = static_cast<float>(credit - take);
+            px_.pass_samples[i] = static_cast<uint8_t>(take);
+            px_.sample_credit[i] = static_cast<float>(credit - take);
         }
 }
 
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop) {
     const int width = state.width, height = state.height;
+    PixelBuffers& px = state.buffers();
     uint64_t rays = 0, nonfinite = 0;
     bool stopped = false;
     const bool sobol = settings.estimator == Estimator::sobol;
     const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
-    if (sobol && (state.sobol_keys.size() != pixels || state.sobol_keys_seed != settings.seed)) {
-        state.sobol_keys.resize(pixels);
-        state.sobol_keys_seed = settings.seed;
+    if (sobol && (px.sobol_keys.size() != pixels || px.sobol_keys_seed != settings.seed)) {
+        px.sobol_keys.resize(pixels);
+        px.sobol_keys_seed = settings.seed;
         const long n = long(pixels);
 #pragma omp parallel for schedule(static)
-        for (long i = 0; i < n; ++i) state.sobol_keys[size_t(i)] = Sampler::pixel_key(settings.seed, uint64_t(i));
+        for (long i = 0; i < n; ++i) px.sobol_keys[size_t(i)] = Sampler::pixel_key(settings.seed, uint64_t(i));
     }
     // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp parallel for schedule(dynamic, 1) reduction(+ : rays, nonfinite) reduction(|| : stopped)
@@ -341,27 +347,27 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 // A NaN or Inf sample is dropped and counted, never accumulated; so is one that
                 // would overflow the pixel's sum. The sums stay finite, so a sum plus a sample
                 // is finite only where the sample is too: one test covers both.
-                if (!is_finite(state.radiance_sum[pixel] + r.radiance)) {
+                if (!is_finite(px.radiance_sum[pixel] + r.radiance)) {
                     ++nonfinite;
                     continue;
                 }
-                state.radiance_sum[pixel] += r.radiance;
-                state.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
+                px.radiance_sum[pixel] += r.radiance;
+                px.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
                 const double lum = luminance(r.radiance);
-                state.luminance_sq_sum[pixel] += lum * lum;
-                state.radiance_sq_sum[pixel] += r.radiance * r.radiance;
-                state.sample_count[pixel] += 1;
+                px.luminance_sq_sum[pixel] += lum * lum;
+                px.radiance_sq_sum[pixel] += r.radiance * r.radiance;
+                px.sample_count[pixel] += 1;
             }
             pending = 0;
         };
         for (int x = 0; x < width; ++x) {
             const size_t pixel = static_cast<size_t>(y) * width + x;
-            if (!state.active.empty() && !state.active[pixel]) continue;
-            const int samples = state.pass_samples.empty() ? 1 : state.pass_samples[pixel];
+            if (!px.active.empty() && !px.active[pixel]) continue;
+            const int samples = px.pass_samples.empty() ? 1 : px.pass_samples[pixel];
             for (int k = 0; k < samples; ++k) {
-                const uint32_t index = state.sample_index[pixel]++;
+                const uint32_t index = px.sample_index[pixel]++;
                 batch_samplers[pending] =
-                    sobol ? &samplers[pending].emplace(state.sobol_keys[pixel], index)
+                    sobol ? &samplers[pending].emplace(px.sobol_keys[pixel], index)
                           : &samplers[pending].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
                 batch_x[pending] = x;
                 batch_y[pending] = y;

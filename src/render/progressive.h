@@ -15,17 +15,16 @@
 
 namespace kr {
 
-struct RenderState {
-    int width = 0, height = 0;
+// A RenderState's per-pixel buffers. The pass engine (render_pass, merge, plan_pass,
+// update_adaptive), checkpoints and the process exchange of PassHooks write them through
+// RenderState::buffers(); everything else reads them through RenderState's readers.
+struct PixelBuffers {
     std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
     std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
     std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
     std::vector<Color> radiance_sq_sum;   // per pixel and channel, sum of squared sample radiance
     std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
     std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
-    int passes = 0;                       // completed passes
-    uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
-    uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
     // The noise rule (update_adaptive): render_pass samples only pixels whose entry is 1
     // (empty: all of them).
     std::vector<uint8_t> active;
@@ -37,6 +36,28 @@ struct RenderState {
     // every pass, so render_pass works them out once (empty until a Sobol pass).
     std::vector<uint32_t> sobol_keys;
     uint64_t sobol_keys_seed = 0;
+};
+
+class RenderState {
+public:
+    int width = 0, height = 0;
+    int passes = 0;                       // completed passes
+    uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
+    uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
+
+    // The per-pixel buffers (PixelBuffers says what each holds).
+    const std::vector<Color>& radiance_sum() const { return px_.radiance_sum; }
+    const std::vector<double>& depth_sum() const { return px_.depth_sum; }
+    const std::vector<double>& luminance_sq_sum() const { return px_.luminance_sq_sum; }
+    const std::vector<Color>& radiance_sq_sum() const { return px_.radiance_sq_sum; }
+    const std::vector<uint32_t>& sample_count() const { return px_.sample_count; }
+    const std::vector<uint32_t>& sample_index() const { return px_.sample_index; }
+    const std::vector<uint8_t>& active() const { return px_.active; }
+    const std::vector<uint8_t>& pass_samples() const { return px_.pass_samples; }
+    const std::vector<float>& sample_credit() const { return px_.sample_credit; }
+    const PixelBuffers& buffers() const { return px_; }
+    // For the pass engine, checkpoints and PassHooks (see PixelBuffers).
+    PixelBuffers& buffers() { return px_; }
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
@@ -81,7 +102,14 @@ struct RenderState {
     // ready for its next pass.
     void clear_sums();
 
+    // A scratch state that renders passes of `totals` (the viewer's accumulation): takes its
+    // pass plan and adaptive mask.
+    void follow_plan(const RenderState& totals);
+    // Samples every pixel again (no adaptive mask).
+    void clear_adaptive() { px_.active.clear(); }
+
 private:
+    PixelBuffers px_;
     // merge()'s running radiance sums before correction and their corrections, per pixel
     // (empty until the first merge); radiance_sum holds their corrected total.
     std::vector<Color> merged_raw_, merged_compensation_;

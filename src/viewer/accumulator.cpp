@@ -11,7 +11,7 @@ bool Accumulator::render_pass(const RenderScene& scene, const RenderSettings& se
                               const std::atomic<bool>* stop) {
     // The plan comes from the totals' statistics (the scratch state holds one pass).
     totals_.plan_pass(settings);
-    scratch_.pass_samples = totals_.pass_samples;
+    scratch_.follow_plan(totals_);
     const bool complete = kr::render_pass(scene, settings, scratch_, stop);
     if (complete) totals_.merge(scratch_);
     scratch_.clear_sums();
@@ -22,7 +22,7 @@ Image Accumulator::mean() const { return totals_.radiance(); }
 
 bool Accumulator::noise_target_met(const StopRule& rule) {
     const bool met = kr::noise_target_met(totals_, rule);
-    scratch_.active = totals_.active;
+    scratch_.follow_plan(totals_);
     return met;
 }
 

@@ -27,8 +27,8 @@ public:
     // clear_adaptive() samples every pixel again.
     bool noise_target_met(const StopRule& rule);
     void clear_adaptive() {
-        scratch_.active.clear();
-        totals_.active.clear();
+        scratch_.clear_adaptive();
+        totals_.clear_adaptive();
     }
 
     // The running totals as a RenderState (radiance_sum holds the compensated sums), for

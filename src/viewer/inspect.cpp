@@ -8,8 +8,8 @@
 namespace kr::viewer {
 
 void record_pixel_statistics(const RenderState& totals, Snapshot& frame) {
-    const size_t n = totals.sample_count.size();
-    frame.sample_count = totals.sample_count;
+    const size_t n = totals.sample_count().size();
+    frame.sample_count = totals.sample_count();
     frame.standard_error.resize(n);
     for (size_t i = 0; i < n; ++i) frame.standard_error[i] = float(totals.pixel_standard_error(i));
 }
