@@ -2,7 +2,8 @@
 # A benchmark of the viewer (prints figures, asserts nothing): for scenes 3 and 6, the
 # viewer's idle CPU once the render is done and once paused (% of one core over 10 s with no
 # input), and the latency from an orbit edit to the first frame of the new image on screen
-# (median and 90th percentile over 30 edits). Runs a real window under Xvfb.
+# (median and 90th percentile over 30 edits). Runs a real window under Xvfb. Then the
+# per-frame cost of the inspect and compare tools (scripts/bench_compare.cpp).
 # Usage: scripts/bench_viewer.sh [build/keithray]   (docs/viewer.md records its figures)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,3 +16,6 @@ for n in 3 6; do
   xvfb-run -a -s "-screen 0 1280x1024x24" "$exe" view "$scene" --measure-latency 30 2>/dev/null |
     grep "^latency" || true
 done
+echo "== inspect and compare, per full-resolution frame"
+cmake --build "$(dirname "$exe")" --target keithray_bench_compare >/dev/null
+"$(dirname "$exe")/keithray_bench_compare"
