@@ -1,13 +1,16 @@
 // The two integrators: Whitted-style recursive ray tracing and iterative path tracing, one
-// sample at a time. Path tracing of four samples at once is packet.cpp; the steps both
-// path tracers share are here (path.h).
+// sample at a time. Path tracing of eight (float) or four (double) samples at once is
+// packet.cpp; the steps both path tracers share are here (path.h) and in vertex.h.
 #include <algorithm>
 
 #include "render/material.h"
 #include "render/path.h"
 #include "render/trace.h"
+#include "render/vertex.h"
 
 namespace kr {
+
+using vertex::OnePath;
 
 // A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
 // whole Ray just after its fields were stored stalls on store forwarding (measured: a
@@ -47,18 +50,15 @@ bool area_light_direct(const RenderScene& scene, LightSampling sampling, const A
                        const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
                        Color& direct) {
     if (light.sphere == hit.sphere) return false;  // a convex emitter cannot light itself
+    if (!has_smooth_lobe(m)) return false;          // eval_smooth is 0
     LightSample ls;
     const SphereGeom& geom = scene.spheres[light.sphere];
     if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
-    const Color f_cos = eval_smooth(m, sp, ls.wi);
-    if (is_black(f_cos)) return false;
+    const vertex::DirectLight<OnePath> d = vertex::direct_light<OnePath>(
+        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, m.rho, sp.ns(), light.radiance, select_prob, mis);
+    if (!d.lit) return false;
     respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
-    double weight = 1;
-    if (mis && ls.mis_pdf > 0) {
-        const double p_light = select_prob * ls.mis_pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
-        weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
-    }
-    direct = f_cos * light.radiance * (weight / (select_prob * ls.pdf));
+    direct = d.light;
     return true;
 }
 
@@ -272,11 +272,11 @@ struct Tracer {
             history.last_sphere = hit.sphere;
             respawn(ray, hit, s.direction);
 
-            // Russian roulette with q = max(throughput) (brief), past the threshold depth.
+            // Russian roulette past the threshold depth.
             if (bounce + 1 >= settings.rr_depth) {
-                const double q = std::min(1.0, max_component(throughput));
-                if (!(u.roulette < q)) break;
-                throughput /= q;
+                bool alive = true;
+                vertex::russian_roulette<OnePath>(throughput, alive, true, u.roulette);
+                if (!alive) break;
             }
         }
         return L;

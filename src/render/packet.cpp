@@ -26,6 +26,7 @@
 #include "render/lanes.h"
 #include "render/path.h"
 #include "render/trace.h"
+#include "render/vertex.h"
 
 #ifdef KR_X86_64_V3
 #include <immintrin.h>
