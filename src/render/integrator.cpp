@@ -77,41 +77,10 @@ double emission_weight(const RenderScene& scene, LightSampling sampling, const A
            (p_bsdf * p_bsdf + p_light * p_light);
 }
 
-namespace {
-
-// The light next-event estimation takes for the number `u`, chosen in proportion to power:
-// a point light's index or an area light's (the last one where rounding leaves `u` above the
-// total), or neither. Naive path tracing takes point lights only. (packet.cpp makes the same
-// choice lane-wise.)
-struct LightChoice {
-    int point = -1, area = -1;
-};
-LightChoice choose_light(const RenderScene& scene, bool naive, double u) {
-    LightChoice choice;
-    for (size_t i = 0; i < scene.point_lights.size(); ++i) {
-        if (u < scene.point_lights[i].select_prob) {
-            choice.point = int(i);
-            return choice;
-        }
-        u -= scene.point_lights[i].select_prob;
-    }
-    if (naive) return choice;
-    // Falls through to the last area light if rounding left u above the total.
-    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-        if (u < scene.area_lights[i].select_prob || i + 1 == scene.area_lights.size()) {
-            choice.area = int(i);
-            return choice;
-        }
-        u -= scene.area_lights[i].select_prob;
-    }
-    return choice;
-}
-
-}  // namespace
-
 bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
                       const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
-    const LightChoice choice = choose_light(scene, settings.integrator == Integrator::pt_naive, u);
+    const vertex::LightChoice<OnePath> choice =
+        vertex::choose_light<OnePath>(scene, settings.integrator == Integrator::pt_naive, u);
     if (choice.point >= 0) {
         const PointLight& light = scene.point_lights[size_t(choice.point)];
         if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;

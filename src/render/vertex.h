@@ -1,14 +1,15 @@
 // The physics of a path vertex, written once over the lane type: the materials' scattering
-// and smooth (diffuse) lobe, the Fresnel split, the spherical lights' `brief` and `cone`
-// samples, the light a sample brings with its MIS weight, crossing a dielectric and Russian
+// and smooth (diffuse) lobe, the Fresnel split, the choice of a light, the spherical
+// lights' `brief` and `cone` samples, the light a sample brings with its MIS weight, crossing a dielectric and Russian
 // roulette. One path (material.cpp, light.cpp, integrator.cpp) instantiates it with OnePath,
 // one double wide; the SIMD kernels (packet_lanes.inc) with their lanes, four doubles or eight
 // floats. So a new material or light is written here, once, for both.
 //
 // A lane type L gives: Real (the numbers), Scalar (one lane's number), Mask (comparisons of
-// Reals) and Vec (three Reals, with +, -, unary -, * by a Real or a Vec, and dot found by
-// argument-dependent lookup); kWidth lanes; and the few operations the code below needs:
-// splat, select (of Reals, Vecs and Masks), any, mask_not, sqrt, lane/set_lane/on (one lane,
+// Reals), Index (indices) and Vec (three Reals, with +, -, unary -, * by a Real or a Vec, and
+// dot found by argument-dependent lookup); kWidth lanes; and the few operations the code
+// below needs: splat, index (an int in every lane), select (of Reals, Vecs, Masks and
+// Indices), any, mask_not, sqrt, lane/set_lane/on (one lane,
 // for the rare steps done one lane at a time), and the maths of sampling: sin_cos_turns,
 // cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize
 // and log_positive. OnePath's are core's scalar functions; the lanes' are their lane-wise
@@ -39,10 +40,13 @@ struct OnePath {
     using Scalar = double;
     using Mask = bool;
     using Vec = Vec3;
+    using Index = int;
     static constexpr int kWidth = 1;
+    static KR_LANES int index(int i) { return i; }
     static KR_LANES double splat(double x) { return x; }
     static KR_LANES double select(bool m, double a, double b) { return m ? a : b; }
     static KR_LANES bool select(bool m, bool a, bool b) { return m ? a : b; }
+    static KR_LANES int select(bool m, int a, int b) { return m ? a : b; }
     static KR_LANES Vec3 select(bool m, const Vec3& a, const Vec3& b) { return m ? a : b; }
     static KR_LANES bool any(bool m) { return m; }
     static KR_LANES bool mask_not(bool m) { return !m; }
