@@ -1,13 +1,16 @@
 // The two integrators: Whitted-style recursive ray tracing and iterative path tracing, one
-// sample at a time. Path tracing of four samples at once is packet.cpp; the steps both
-// path tracers share are here (path.h).
+// sample at a time. Path tracing of eight (float) or four (double) samples at once is
+// packet.cpp; the steps both path tracers share are here (path.h) and in vertex.h.
 #include <algorithm>
 
 #include "render/material.h"
 #include "render/path.h"
 #include "render/trace.h"
+#include "render/vertex.h"
 
 namespace kr {
+
+using vertex::OnePath;
 
 // A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
 // whole Ray just after its fields were stored stalls on store forwarding (measured: a
@@ -47,18 +50,15 @@ bool area_light_direct(const RenderScene& scene, LightSampling sampling, const A
                        const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
                        Color& direct) {
     if (light.sphere == hit.sphere) return false;  // a convex emitter cannot light itself
+    if (!has_smooth_lobe(m)) return false;          // eval_smooth is 0
     LightSample ls;
     const SphereGeom& geom = scene.spheres[light.sphere];
     if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
-    const Color f_cos = eval_smooth(m, sp, ls.wi);
-    if (is_black(f_cos)) return false;
+    const vertex::DirectLight<OnePath> d = vertex::direct_light<OnePath>(
+        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, m.rho, sp.ns(), light.radiance, select_prob, mis);
+    if (!d.lit) return false;
     respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
-    double weight = 1;
-    if (mis && ls.mis_pdf > 0) {
-        const double p_light = select_prob * ls.mis_pdf, p_bsdf = pdf_smooth(m, sp, ls.wi);
-        weight = p_light * p_light / (p_light * p_light + p_bsdf * p_bsdf);  // power heuristic
-    }
-    direct = f_cos * light.radiance * (weight / (select_prob * ls.pdf));
+    direct = d.light;
     return true;
 }
 
@@ -77,41 +77,10 @@ double emission_weight(const RenderScene& scene, LightSampling sampling, const A
            (p_bsdf * p_bsdf + p_light * p_light);
 }
 
-namespace {
-
-// The light next-event estimation takes for the number `u`, chosen in proportion to power:
-// a point light's index or an area light's (the last one where rounding leaves `u` above the
-// total), or neither. Naive path tracing takes point lights only. (packet.cpp makes the same
-// choice lane-wise.)
-struct LightChoice {
-    int point = -1, area = -1;
-};
-LightChoice choose_light(const RenderScene& scene, bool naive, double u) {
-    LightChoice choice;
-    for (size_t i = 0; i < scene.point_lights.size(); ++i) {
-        if (u < scene.point_lights[i].select_prob) {
-            choice.point = int(i);
-            return choice;
-        }
-        u -= scene.point_lights[i].select_prob;
-    }
-    if (naive) return choice;
-    // Falls through to the last area light if rounding left u above the total.
-    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-        if (u < scene.area_lights[i].select_prob || i + 1 == scene.area_lights.size()) {
-            choice.area = int(i);
-            return choice;
-        }
-        u -= scene.area_lights[i].select_prob;
-    }
-    return choice;
-}
-
-}  // namespace
-
 bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
                       const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
-    const LightChoice choice = choose_light(scene, settings.integrator == Integrator::pt_naive, u);
+    const vertex::LightChoice<OnePath> choice =
+        vertex::choose_light<OnePath>(scene, settings.integrator == Integrator::pt_naive, u);
     if (choice.point >= 0) {
         const PointLight& light = scene.point_lights[size_t(choice.point)];
         if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;
@@ -272,11 +241,11 @@ struct Tracer {
             history.last_sphere = hit.sphere;
             respawn(ray, hit, s.direction);
 
-            // Russian roulette with q = max(throughput) (brief), past the threshold depth.
+            // Russian roulette past the threshold depth.
             if (bounce + 1 >= settings.rr_depth) {
-                const double q = std::min(1.0, max_component(throughput));
-                if (!(u.roulette < q)) break;
-                throughput /= q;
+                bool alive = true;
+                vertex::russian_roulette<OnePath>(throughput, alive, true, u.roulette);
+                if (!alive) break;
             }
         }
         return L;

@@ -1,5 +1,5 @@
 // Four lanes of doubles (GCC vector extensions) and the few operations on them that the BVH's
-// block test (accel.cpp) and the four-path tracer (packet.cpp) share; and KR_CLONES, which
+// block test (accel.cpp) and the double-lane path tracer (packet.cpp) share; and KR_CLONES, which
 // compiles a function twice, for x86-64-v3 and for any x86-64 (packet.cpp does the same for
 // its kernels by including them twice, where KR_X86_64_V3 is defined).
 #pragma once

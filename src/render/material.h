@@ -1,8 +1,10 @@
-// Material scattering: the BSDF of each material type, as sampling and evaluation.
+// Material scattering: the BSDF of each material type, as sampling and evaluation, for one
+// path (the physics itself is vertex.h's, which the SIMD lanes share).
 #pragma once
 
 #include "core/math.h"
 #include "core/sampling.h"
+#include "render/vertex.h"
 #include "scene/scene.h"
 
 namespace kr {
@@ -35,8 +37,7 @@ struct MediumScale {
     double radiance = 1;  // 1 / eta^2: what gathered light is multiplied by
     // After a transmission through material `m` (`entering`: from outside its sphere).
     void cross(const Material& m, bool entering) {
-        eta = entering ? eta * m.eta : eta / m.eta;
-        radiance = 1.0 / (eta * eta);
+        vertex::cross_medium<vertex::OnePath>(eta, radiance, true, entering, m.eta);
     }
     // Light gathered in this medium as the camera sees it. Most paths never enter a
     // dielectric: the test costs less than the multiply it skips (measured, WRT).

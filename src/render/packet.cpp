@@ -1,10 +1,11 @@
 // Path tracing of several samples at once, their paths in the lanes of SIMD registers (AVX2
 // where the CPU has it). Casting rays, hit records, Sobol numbers, the light choice, the
 // `brief` and `cone` light samples, every material's scattering, throughput and Russian
-// roulette run lane-wise, as copies of the one-path routines, operation for operation; the
-// other light samples, emission weights and other estimators' numbers run per lane through
-// the same functions as one path (path.h). So every path is the one trace_sample gives, up
-// to rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
+// roulette run lane-wise: the physics through the same templates as one path (vertex.h),
+// the lanes' own maths as copies of core's, operation for operation; the other light
+// samples, emission weights and other estimators' numbers run per lane through the same
+// functions as one path (path.h). So every path is the one trace_sample gives, up to
+// rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
 //
 // The kernels are in packet_lanes.inc, compiled three times: four double lanes for any
 // x86-64 CPU and for x86-64-v3 (AVX2, FMA), and eight single-precision lanes for x86-64-v3.
@@ -26,6 +27,7 @@
 #include "render/lanes.h"
 #include "render/path.h"
 #include "render/trace.h"
+#include "render/vertex.h"
 
 #ifdef KR_X86_64_V3
 #include <immintrin.h>
