@@ -26,20 +26,18 @@ fi
 # Skipped under the sanitizers (they run in the normal build): the heaviest
 # image-fidelity tests, which render the brief's scenes at enough samples to compare with
 # the references and, under a sanitizer, cost minutes while running the same render loop
-# that the lighter tests already run sanitized; plus two that are not about correctness
+# that the lighter tests already run sanitized; plus one that is not about correctness
 # under a sanitizer:
 #   Scenes/PathTracedReference.*, Scenes/WhittedReference.*, ReferenceSensitivity.*:
 #       reference-image comparisons (about 6 min of the 9 min ASan run of every test).
 #   Scenes/GlDisplay.MatchesCpuToneMap for scenes 4, 5, 7, 8: the same GL-vs-CPU image
 #       check as for scene 2, which still runs (both tone maps).
-#   Accumulation.RenderPassPathStaysExact: a numerical-drift check of 10^6 one-pixel
-#       passes, 10^6 OpenMP regions (100 s under either sanitizer).
 #   RobustJson.HundredThousandPrimitives: loads, prepares and renders 100,000 spheres,
 #       minutes under a sanitizer. RobustJson.HugeArrays keeps a large file in the
 #       sanitized runs.
 skip='^(Scenes/PathTracedReference\.|Scenes/WhittedReference\.|ReferenceSensitivity\.'
 skip+='|Scenes/GlDisplay\.MatchesCpuToneMap/assignment_0[4578]_'
-skip+='|Accumulation\.RenderPassPathStaysExact$|RobustJson\.HundredThousandPrimitives$)'
+skip+='|RobustJson\.HundredThousandPrimitives$)'
 # Under ASan only: ViewerWindow.ScriptedEditsScreenshotMatchesHeadlessRender, the window
 # screenshot-vs-headless image check after scripted edits (80 to 170 s under ASan, the
 # longest test of the run). The other two window tests still run under ASan, and all three

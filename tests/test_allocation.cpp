@@ -3,7 +3,9 @@
 // independence from threads.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <memory>
 #include <numeric>
 #include <omp.h>
 
@@ -11,7 +13,7 @@
 #include "render/trace.h"
 #include "scene/load.h"
 #include "test_util.h"
-#include "viewer/accumulator.h"
+#include "viewer/render_worker.h"
 
 using namespace kr;
 
@@ -219,8 +221,7 @@ TEST(Allocation, AdaptiveBeatsUniformAtTheSameBudget) {
 }
 
 // The plan sums per row in parallel and adds the rows in order: the same image with 1 or 2
-// threads, and the viewer's accumulator (plan from its totals) draws the same samples as
-// render_until.
+// threads, and the viewer's render thread draws the same samples as render_until.
 TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     const RenderScene scene = prepare_scene(brief_scene(6, 16));
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
@@ -253,8 +254,17 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     EXPECT_LT(still_active, 256);  // the mask has left some pixels out
     rule.noise = 0;
 
-    viewer::Accumulator accumulator;
-    accumulator.reset(16, 16);
-    for (int pass = 0; pass < rule.max_passes; ++pass) accumulator.render_pass(scene, settings);
-    EXPECT_EQ(accumulator.totals().sample_count(), one.sample_count());
+    // The viewer's render thread, through the same driver.
+    settings.target_spp = rule.max_passes;
+    viewer::RenderWorker worker;
+    worker.submit({1, std::make_shared<const RenderScene>(scene), settings});
+    std::shared_ptr<const viewer::Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->finished);
+    EXPECT_EQ(f->spp, rule.max_passes);
+    EXPECT_EQ(f->sample_count, one.sample_count());
+    const Image image = one.radiance();
+    for (size_t i = 0; i < image.pixels.size(); ++i) EXPECT_EQ(f->radiance.pixels[i].x, image.pixels[i].x) << i;
 }

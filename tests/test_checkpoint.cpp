@@ -30,6 +30,9 @@ void expect_same_state(const RenderState& a, const RenderState& b) {
     EXPECT_EQ(a.sample_index(), b.sample_index());
     EXPECT_EQ(a.active(), b.active());
     EXPECT_EQ(a.depth_sum(), b.depth_sum());
+    EXPECT_EQ(a.radiance_compensation().size(), b.radiance_compensation().size());
+    for (size_t i = 0; i < a.radiance_compensation().size(); ++i)
+        EXPECT_EQ(a.radiance_compensation()[i].x, b.radiance_compensation()[i].x) << i;
     EXPECT_EQ(a.luminance_sq_sum(), b.luminance_sq_sum());
     size_t differ = 0;
     for (size_t i = 0; i < a.radiance_sum().size(); ++i)
@@ -83,6 +86,40 @@ TEST(Checkpoint, ResumedRenderIsTheUninterruptedOne) {
             render_until(scene, settings, resumed, rule);
             expect_same_state(whole, resumed);
         }
+    }
+}
+
+// As the command line takes them: written after a pass (render_until's on_pass), at the
+// noise rule's checks too, the last one (which meets the target) included. The resumed render
+// stops where the uninterrupted one stops, for the same reason, with the same state.
+TEST(Checkpoint, TakenAfterANoiseCheckResumesExactly) {
+    const Scene authored = test::brief_scene(6, 16);
+    const RenderScene scene = prepare_scene(authored);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.target_spp = 200;
+    StopRule rule;
+    rule.max_passes = 200;
+    rule.noise = 0.1;
+    rule.min_samples = 8;
+    RenderState whole(16, 16);
+    ASSERT_EQ(render_until(scene, settings, whole, rule), StopReason::noise);
+    const int last = whole.passes;
+    ASSERT_GE(last, 16);  // so at least one check before the last one did not meet the target
+    const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
+    for (int k : {last - 4, last - 1, last}) {
+        SCOPED_TRACE(k);
+        RenderState part(16, 16);
+        std::string bytes;
+        const StopReason first = render_until(scene, settings, part, rule, [&](const RenderState& s) {
+            if (s.passes < k) return true;
+            bytes = encode_checkpoint(key, s);
+            return false;
+        });
+        ASSERT_EQ(first, StopReason::cancelled);
+        RenderState resumed;
+        decode_checkpoint(bytes, "part.ckpt", key, resumed);
+        EXPECT_EQ(render_until(scene, settings, resumed, rule), StopReason::noise);
+        expect_same_state(whole, resumed);
     }
 }
 

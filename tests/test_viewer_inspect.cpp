@@ -17,7 +17,6 @@
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "test_util.h"
-#include "viewer/accumulator.h"
 #include "viewer/compare_view.h"
 #include "viewer/convergence_log.h"
 #include "viewer/image_view.h"
@@ -32,9 +31,9 @@ using namespace kr::viewer;
 namespace {
 
 // A full-resolution snapshot of `passes` passes of brief scene `n` at size x size, as the
-// render thread publishes it, with the accumulator it came from.
+// render thread publishes it, with the state it came from.
 struct Rendered {
-    Accumulator acc;
+    RenderState state;
     Snapshot frame;
 };
 Rendered render_frame(int n, int size, int passes, Allocation allocation = Allocation::adaptive) {
@@ -42,12 +41,14 @@ Rendered render_frame(int n, int size, int passes, Allocation allocation = Alloc
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.allocation = allocation;
     Rendered r;
-    r.acc.reset(size, size);
-    for (int i = 0; i < passes; ++i) EXPECT_TRUE(r.acc.render_pass(scene, settings));
-    r.frame.radiance = r.acc.mean();
-    r.frame.spp = r.acc.passes();
-    r.frame.relative_error = r.acc.totals().relative_error();
-    record_pixel_statistics(r.acc.totals(), r.frame);
+    r.state.reset(size, size);
+    StopRule rule;
+    rule.max_passes = passes;
+    EXPECT_EQ(render_until(scene, settings, r.state, rule), StopReason::passes);
+    r.frame.radiance = r.state.radiance();
+    r.frame.spp = r.state.passes;
+    r.frame.relative_error = r.state.relative_error();
+    record_pixel_statistics(r.state, r.frame);
     return r;
 }
 
@@ -58,7 +59,7 @@ Rendered render_frame(int n, int size, int passes, Allocation allocation = Alloc
 TEST(PixelInspector, NumbersAreTheRenderStates) {
     // Past the adaptive warm-up, so pixels hold different sample counts.
     const Rendered r = render_frame(3, 24, 12);
-    const RenderState& totals = r.acc.totals();
+    const RenderState& totals = r.state;
     const Image mean = totals.radiance();
     for (ToneMap op : {ToneMap::sigmoid, ToneMap::linear, ToneMap::srgb}) {
         ToneSettings tone;

@@ -240,6 +240,7 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     const RowDeal deal{rank_, size_, state.width, state.height};
     std::vector<char> mine, gathered;
     deal.exchange(state.buffers().radiance_sum, false, mine, gathered);
+    deal.exchange(state.buffers().radiance_compensation, false, mine, gathered);
     deal.exchange(state.buffers().depth_sum, false, mine, gathered);
     deal.exchange(state.buffers().luminance_sq_sum, false, mine, gathered);
     deal.exchange(state.buffers().radiance_sq_sum, false, mine, gathered);

@@ -123,7 +123,7 @@ std::string read_checkpoint_file(const std::filesystem::path& file, const Checkp
     const uint64_t pixels = uint64_t(expected.width) * uint64_t(expected.height);
     // Header, key (bounded generously), sums and counts, the mask and the fractions, checksum.
     const uint64_t largest = kMagic.size() + 1024 + expected.settings.size() +
-                             pixels * (2 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 1 + sizeof(float));
+                             pixels * (3 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 1 + sizeof(float));
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
         throw std::runtime_error(where + ": cannot read the checkpoint: " +
@@ -152,6 +152,7 @@ std::string encode_checkpoint(const CheckpointKey& key, const RenderState& state
     w.put(state.rays);
     w.put(state.nonfinite_samples);
     w.put_all(state.radiance_sum());
+    w.put_all(state.radiance_compensation());
     w.put_all(state.depth_sum());
     w.put_all(state.luminance_sq_sum());
     w.put_all(state.radiance_sq_sum());
@@ -198,6 +199,7 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     restored.rays = r.get<uint64_t>();
     restored.nonfinite_samples = r.get<uint64_t>();
     r.get_all(px.radiance_sum, n);
+    r.get_all(px.radiance_compensation, n);
     r.get_all(px.depth_sum, n);
     r.get_all(px.luminance_sq_sum, n);
     r.get_all(px.radiance_sq_sum, n);

@@ -1,13 +1,14 @@
 // Checkpoints: a render's state in a file, to resume it later (`keithray render --checkpoint
 // FILE`, `--resume FILE`). A resumed render is byte for byte the uninterrupted one: the state
 // holds every sum, count, sample index, the adaptive mask and the allocation's carried
-// fractions, and render_until counts passes from state.passes.
+// fractions, and ProgressiveDriver counts passes from state.passes and repeats a noise check
+// the state ends on.
 //
-// Format (version 1, little-endian, as x86-64 and AArch64 lay it out in memory):
+// Format (version 2, little-endian, as x86-64 and AArch64 lay it out in memory):
 //   "keithray checkpoint\n"  magic
 //   u32 version, u64 scene fingerprint, u32 key length, key text ("integrator=pt seed=0 ..."),
 //   i32 width, i32 height, i32 passes, u64 rays, u64 non-finite samples,
-//   per pixel: radiance_sum (3 f64), depth_sum (f64), luminance_sq_sum (f64),
+//   per pixel: radiance_sum (3 f64), radiance_compensation (3 f64), depth_sum (f64), luminance_sq_sum (f64),
 //   radiance_sq_sum (3 f64), sample_count (u32), sample_index (u32),
 //   u8 + per pixel u8: the adaptive mask (when the u8 is 1), u8 + per pixel f32: the carried
 //   fractions (when the u8 is 1), and last a u64 FNV-1a of every byte before it.
@@ -22,7 +23,7 @@
 
 namespace kr {
 
-inline constexpr uint32_t kCheckpointVersion = 1;
+inline constexpr uint32_t kCheckpointVersion = 2;
 
 // What a checkpoint must match to be resumed: the scene (a fingerprint of its canonical JSON
 // without the output path and display block, which do not change the samples), the settings

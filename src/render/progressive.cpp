@@ -24,6 +24,7 @@ void RenderState::reset(int w, int h) {
     height = h;
     const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
     px_.radiance_sum.assign(n, Color());
+    px_.radiance_compensation.assign(n, Color());
     px_.depth_sum.assign(n, 0.0);
     px_.luminance_sq_sum.assign(n, 0.0);
     px_.radiance_sq_sum.assign(n, Color());
@@ -37,13 +38,12 @@ void RenderState::reset(int w, int h) {
     px_.sample_credit.clear();
     for (auto& scratch : px_.allocation_scratch) scratch.clear();
     px_.sobol_keys.clear();
-    merged_raw_.clear();
-    merged_compensation_.clear();
 }
 
 namespace {
 
 // Neumaier's variant of Kahan summation: also exact when the addend is the larger term.
+// `sum` stays the plain running sum; `compensation` gathers what its roundings lost.
 inline void add_compensated(double& sum, double& compensation, double x) {
     const double t = sum + x;
     if (std::abs(sum) >= std::abs(x)) compensation += (sum - t) + x;
@@ -52,53 +52,6 @@ inline void add_compensated(double& sum, double& compensation, double x) {
 }
 
 }  // namespace
-
-void RenderState::merge(const RenderState& pass) {
-    const size_t n = px_.radiance_sum.size();
-    if (merged_raw_.size() != n) {
-        merged_raw_ = px_.radiance_sum;
-        merged_compensation_.assign(n, Color());
-    }
-    // Every pixel on its own: the same sums for any thread count.
-#pragma omp parallel for schedule(static)
-    for (long k = 0; k < long(n); ++k) {
-        const size_t i = size_t(k);
-        if (pass.px_.sample_count[i] == 0) continue;
-        Color& sum = merged_raw_[i];
-        Color& c = merged_compensation_[i];
-        add_compensated(sum.x, c.x, pass.px_.radiance_sum[i].x);
-        add_compensated(sum.y, c.y, pass.px_.radiance_sum[i].y);
-        add_compensated(sum.z, c.z, pass.px_.radiance_sum[i].z);
-        px_.radiance_sum[i] = sum + c;
-        px_.depth_sum[i] += pass.px_.depth_sum[i];
-        px_.luminance_sq_sum[i] += pass.px_.luminance_sq_sum[i];
-        px_.radiance_sq_sum[i] += pass.px_.radiance_sq_sum[i];
-        px_.sample_count[i] += pass.px_.sample_count[i];
-    }
-    rays += pass.rays;
-    nonfinite_samples += pass.nonfinite_samples;
-    ++passes;
-}
-
-void RenderState::clear_sums() {
-    // In parallel: at 512x512 these loops took a tenth of a cheap scene's pass.
-#pragma omp parallel for schedule(static)
-    for (long k = 0; k < long(px_.radiance_sum.size()); ++k) {
-        const size_t i = size_t(k);
-        px_.radiance_sum[i] = Color();
-        px_.depth_sum[i] = 0.0;
-        px_.luminance_sq_sum[i] = 0.0;
-        px_.radiance_sq_sum[i] = Color();
-        px_.sample_count[i] = 0u;
-    }
-    rays = 0;
-    nonfinite_samples = 0;
-}
-
-void RenderState::follow_plan(const RenderState& totals) {
-    px_.pass_samples = totals.px_.pass_samples;
-    px_.active = totals.px_.active;
-}
 
 uint64_t render_memory_bytes(int width, int height, bool blurred) {
     const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
@@ -109,7 +62,9 @@ uint64_t render_memory_bytes(int width, int height, bool blurred) {
 Image RenderState::radiance() const {
     Image img(width, height);
     for (size_t i = 0; i < img.pixels.size(); ++i)
-        img.pixels[i] = px_.sample_count[i] ? px_.radiance_sum[i] / double(px_.sample_count[i]) : Color();
+        img.pixels[i] = px_.sample_count[i]
+                            ? (px_.radiance_sum[i] + px_.radiance_compensation[i]) / double(px_.sample_count[i])
+                            : Color();
     return img;
 }
 
@@ -351,7 +306,11 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                     ++nonfinite;
                     continue;
                 }
-                px.radiance_sum[pixel] += r.radiance;
+                Color& sum = px.radiance_sum[pixel];
+                Color& lost = px.radiance_compensation[pixel];
+                add_compensated(sum.x, lost.x, r.radiance.x);
+                add_compensated(sum.y, lost.y, r.radiance.y);
+                add_compensated(sum.z, lost.z, r.radiance.z);
                 px.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
                 const double lum = luminance(r.radiance);
                 px.luminance_sq_sum[pixel] += lum * lum;
@@ -398,23 +357,49 @@ bool noise_target_met(RenderState& state, const StopRule& rule) {
     return state.relative_error() <= rule.noise || state.update_adaptive(rule.noise, rule.min_samples) == 0;
 }
 
+ProgressiveDriver::ProgressiveDriver(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                                     const StopRule& rule, PassHooks* hooks)
+    : scene_(scene), settings_(settings), state_(state), hooks_(hooks) {
+    if (state.passes > 0 && noise_check_due(rule, state.passes)) {
+        noise_checked_ = rule.noise;
+        noise_met_ = noise_target_met(state, rule);
+    }
+}
+
+bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* cancel) {
+    if (noise_checked_ && *noise_checked_ != rule.noise) {
+        state_.clear_adaptive();  // the mask followed another target
+        noise_met_ = false;
+    }
+    noise_checked_ = rule.noise;
+    const auto start = std::chrono::steady_clock::now();
+    state_.plan_pass(settings_);
+    if (hooks_) hooks_->before_pass(state_);
+    if (!render_pass(scene_, settings_, state_, cancel)) return false;
+    const bool noise_check = noise_check_due(rule, state_.passes);
+    if (hooks_) hooks_->after_pass(state_, noise_check || plan_reads_statistics(settings_, state_));
+    if (noise_check) noise_met_ = noise_target_met(state_, rule);
+    seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (hooks_) time_agreed_ = hooks_->any(rule.seconds > 0 && seconds_ >= rule.seconds);
+    return true;
+}
+
+std::optional<StopReason> ProgressiveDriver::stop_reason(const StopRule& rule) const {
+    if (noise_met_ && rule.noise > 0 && noise_checked_ == rule.noise) return StopReason::noise;
+    if (hooks_ ? time_agreed_ : rule.seconds > 0 && seconds_ >= rule.seconds) return StopReason::time;
+    if (state_.passes >= rule.max_passes) return StopReason::passes;
+    return std::nullopt;
+}
+
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                         const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass,
                         PassHooks* hooks) {
-    const auto start = std::chrono::steady_clock::now();
-    while (state.passes < rule.max_passes) {
-        state.plan_pass(settings);
-        if (hooks) hooks->before_pass(state);
-        render_pass(scene, settings, state);
-        const bool noise_check = noise_check_due(rule, state.passes);
-        if (hooks) hooks->after_pass(state, noise_check || plan_reads_statistics(settings, state));
+    ProgressiveDriver driver(scene, settings, state, rule, hooks);
+    for (;;) {
+        if (const auto reason = driver.stop_reason(rule)) return *reason;
+        driver.pass(rule);
         if (on_pass && !on_pass(state)) return StopReason::cancelled;
-        if (noise_check && noise_target_met(state, rule)) return StopReason::noise;
-        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        const bool time_up = rule.seconds > 0 && elapsed >= rule.seconds;
-        if (hooks ? hooks->any(time_up) : time_up) return StopReason::time;
     }
-    return StopReason::passes;
 }
 
 }  // namespace kr

@@ -1,12 +1,14 @@
 // The progressive rendering API: settings + state + render_pass(), which adds one sample to
-// every pixel, and render_until, the one driver of passes (plan, pass, merge, stop rules)
-// under the CLI, the viewer's render thread and MPI ranks.
+// every pixel, and ProgressiveDriver, the one driver of passes (plan, pass, process
+// exchange, stop rules) under the CLI (render_until), the viewer's render thread and MPI
+// ranks.
 #pragma once
 
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "core/image.h"
@@ -15,11 +17,16 @@
 
 namespace kr {
 
-// A RenderState's per-pixel buffers. The pass engine (render_pass, merge, plan_pass,
+// A RenderState's per-pixel buffers. The pass engine (render_pass, plan_pass,
 // update_adaptive), checkpoints and the process exchange of PassHooks write them through
 // RenderState::buffers(); everything else reads them through RenderState's readers.
 struct PixelBuffers {
-    std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance
+    std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance (plainly rounded)
+    // Per pixel, Neumaier's running correction of radiance_sum: radiance_sum plus it is the
+    // sum to within an ulp or two after any number of samples, where the plain sum of 10^6
+    // samples of 0.1 is off by 1.3e-11 relative. The mean radiance uses both; the statistics
+    // (variances, plans, the noise rule) use radiance_sum alone, which processes share.
+    std::vector<Color> radiance_compensation;
     std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
     std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
     std::vector<Color> radiance_sq_sum;   // per pixel and channel, sum of squared sample radiance
@@ -47,6 +54,7 @@ public:
 
     // The per-pixel buffers (PixelBuffers says what each holds).
     const std::vector<Color>& radiance_sum() const { return px_.radiance_sum; }
+    const std::vector<Color>& radiance_compensation() const { return px_.radiance_compensation; }
     const std::vector<double>& depth_sum() const { return px_.depth_sum; }
     const std::vector<double>& luminance_sq_sum() const { return px_.luminance_sq_sum; }
     const std::vector<Color>& radiance_sq_sum() const { return px_.radiance_sq_sum; }
@@ -62,7 +70,7 @@ public:
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
     void reset(int w, int h);
-    Image radiance() const;                  // per-pixel mean radiance
+    Image radiance() const;                  // per-pixel mean radiance (compensated sums)
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
     // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
     // over the count (infinite below two samples). What `keithray compare --statistical` tests.
@@ -91,35 +99,18 @@ public:
     // sums added in order: the plan does not depend on threads.
     void plan_pass(const RenderSettings& settings);
 
-    // Adds a state that holds whole passes of the same pixels (the viewer renders each pass
-    // into a scratch state and merges it, so a cancelled pass adds nothing): the radiance with
-    // Neumaier-compensated sums (a naive double sum of 10^6 samples of 0.1 is off by 1.3e-11
-    // relative; this stays within an ulp or two), the other sums and the counters plainly,
-    // and one pass more.
-    void merge(const RenderState& pass);
-    // Zeroes the per-pixel sums and counters of samples kept, keeping sample_index (so the next
-    // pass draws the next samples), the adaptive mask and the Sobol keys: a scratch state
-    // ready for its next pass.
-    void clear_sums();
-
-    // A scratch state that renders passes of `totals` (the viewer's accumulation): takes its
-    // pass plan and adaptive mask.
-    void follow_plan(const RenderState& totals);
     // Samples every pixel again (no adaptive mask).
     void clear_adaptive() { px_.active.clear(); }
 
 private:
     PixelBuffers px_;
-    // merge()'s running radiance sums before correction and their corrections, per pixel
-    // (empty until the first merge); radiance_sum holds their corrected total.
-    std::vector<Color> merged_raw_, merged_compensation_;
 };
 
-// The bytes per pixel a RenderState holds once every buffer is in use: the six sums and
+// The bytes per pixel a RenderState holds once every buffer is in use: the seven sums and
 // counts, the adaptive mask, the pass plan and its credit, the three allocation buffers and
 // the Sobol keys.
 inline constexpr uint64_t kRenderStateBytesPerPixel =
-    2 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
+    3 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
     3 * sizeof(double) + sizeof(uint32_t);
 
 // An upper estimate of the memory a render of width x height pixels holds at its peak: the
@@ -137,7 +128,8 @@ inline constexpr int kMaxPassSamples = 64;         // per pixel and pass
 // Parallel over rows with OpenMP; each sample has its own RNG stream seeded by
 // (seed, pixel, sample index), so the image does not depend on threads or scheduling.
 // If `stop` becomes true the pass ends early and returns false; pixels it reached keep their
-// sample, others do not, so the state stays a valid (unevenly sampled) estimate.
+// sample, others do not: the state is then an unevenly sampled estimate, which
+// ProgressiveDriver's users drop (the viewer stops a pass only for an edit).
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop = nullptr);
 
@@ -182,10 +174,45 @@ public:
 // after its warm-up).
 bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state);
 
+// The one driver of progressive passes (yocto-gl's trace_samples): each pass() plans the
+// pass (plan_pass), lets `hooks` narrow it to this process's pixels, renders it
+// (render_pass), shares what the next step reads, and applies the noise rule; stop_reason()
+// says which rule ends the render. render_until loops over it for the CLI and MPI ranks; the
+// viewer's render thread calls pass() between its previews and edits, with a cancel flag,
+// under rules its user changes as it goes. The scene, settings, state and hooks must outlive
+// the driver.
+class ProgressiveDriver {
+public:
+    // A state restored from a checkpoint taken right after a noise check gets that check's
+    // verdict again (a pure function of the sums), so it goes on exactly as if never stopped.
+    ProgressiveDriver(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                      const StopRule& rule, PassHooks* hooks = nullptr);
+    // One pass under `rule`. A changed noise target samples every pixel again until it is
+    // checked. Returns false, and does nothing more, when `cancel` ended the pass early: the
+    // state then holds part of a pass (render_pass) and is to be reset or dropped.
+    bool pass(const StopRule& rule, const std::atomic<bool>* cancel = nullptr);
+    // The rule that ends the render now, if any, in this order: the noise target met at its
+    // last check (while `rule` keeps that target), the time (with hooks: the processes' common
+    // decision after the last pass), the passes.
+    std::optional<StopReason> stop_reason(const StopRule& rule) const;
+    // Seconds spent in completed passes (the time rule's clock).
+    double seconds() const { return seconds_; }
+
+private:
+    const RenderScene& scene_;
+    const RenderSettings& settings_;
+    RenderState& state_;
+    PassHooks* hooks_;
+    double seconds_ = 0;
+    bool time_agreed_ = false;             // with hooks: every process's time is up
+    std::optional<double> noise_checked_;  // the noise target the adaptive mask follows
+    bool noise_met_ = false;               // ... and whether its last check met it
+};
+
 // Runs passes until a rule stops it: state.passes counts towards rule.max_passes, so a state
 // restored from a checkpoint (render/checkpoint.h) goes on as if never stopped. `on_pass`,
-// if given, is called after each pass and may return false to cancel; `hooks` spread the
-// passes over processes.
+// if given, is called after each pass (and its noise check) and may return false to cancel;
+// `hooks` spread the passes over processes.
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                         const StopRule& rule, const std::function<bool(const RenderState&)>& on_pass = {},
                         PassHooks* hooks = nullptr);

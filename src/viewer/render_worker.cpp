@@ -2,12 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
 
-#include "viewer/accumulator.h"
 #include "viewer/inspect.h"
 
 namespace kr::viewer {
@@ -117,6 +117,18 @@ void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
     if (on_publish_) on_publish_();
 }
 
+namespace {
+
+const char* stop_name(StopReason reason) {
+    switch (reason) {
+    case StopReason::noise: return "noise";
+    case StopReason::time: return "time";
+    default: return "spp";
+    }
+}
+
+}  // namespace
+
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -124,51 +136,45 @@ void RenderWorker::run() {
     setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
     constexpr double kPreviewBudget = 0.010;  // seconds for the first preview pass
     RenderJob job;
-    bool have_job = false;
-    Accumulator accumulator;
+    RenderState state;  // the estimate of `job`, at full resolution
+    std::optional<ProgressiveDriver> driver;
     std::vector<int> previews;
     size_t next_preview = 0;
-    double seconds = 0, full_seconds = 0;
+    double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
 
-    bool noise_met = false;  // the noise rule's target was reached by this estimate
-    double noise_checked = 0;  // the target noise_met was checked against
-
     for (;;) {
-        double stop_noise = 0;
+        StopRule rule;
+        // The rules as the user has them now (called under the lock).
+        auto current_rule = [&] {
+            StopRule r;
+            r.max_passes = unlimited_ ? std::numeric_limits<int>::max() : target_spp_;
+            r.seconds = stop_seconds_;
+            r.noise = stop_noise_;
+            return r;
+        };
         // Which rule ends the refinement, if any (called under the lock).
-        auto stop_reason = [&]() -> const char* {
-            if (next_preview < previews.size()) return nullptr;
-            if (stop_noise_ > 0 && noise_met && noise_checked == stop_noise_) return "noise";
-            if (stop_seconds_ > 0 && full_seconds >= stop_seconds_) return "time";
-            if (!unlimited_ && accumulator.passes() >= target_spp_) return "spp";
-            return nullptr;
+        auto stop_reason = [&]() -> std::optional<StopReason> {
+            if (!driver || next_preview < previews.size()) return std::nullopt;
+            return driver->stop_reason(current_rule());
         };
         {
             std::unique_lock lock(mutex_);
-            auto finished = [&] { return stop_reason() != nullptr; };
-            changed_.wait(lock, [&] { return quit_ || pending_ || (have_job && !paused_ && !finished()); });
+            changed_.wait(lock, [&] { return quit_ || pending_ || (driver && !paused_ && !stop_reason()); });
             if (quit_) return;
             if (pending_) {
                 job = std::move(*pending_);
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
-                have_job = true;
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
-                accumulator.reset(w, h);
+                state.reset(w, h);
+                driver.emplace(*job.scene, job.settings, state, current_rule());
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
-                seconds = full_seconds = 0;
-                noise_met = false;
+                seconds = 0;
                 if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
-            stop_noise = stop_noise_;
-        }
-        if (stop_noise != noise_checked) {
-            // A new (or no) noise target: sample every pixel until it is checked again.
-            accumulator.clear_adaptive();
-            noise_met = false;
-            noise_checked = stop_noise;
+            rule = current_rule();
         }
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
@@ -178,39 +184,33 @@ void RenderWorker::run() {
             const int scale = previews[next_preview];
             RenderState preview(scaled(w, scale), scaled(h, scale));
             if (!kr::render_pass(*job.scene, job.settings, preview, &stop_)) continue;
-            const double dt = seconds_since(start);
-            seconds += dt;
+            seconds += seconds_since(start);
             ++next_preview;
             frame->scale = scale;
             frame->radiance = preview.radiance();
         } else {
-            if (!accumulator.render_pass(*job.scene, job.settings, &stop_)) continue;
+            // A pass stopped early is always an edit's: the next turn starts the new job.
+            if (!driver->pass(rule, &stop_)) continue;
             const double dt = seconds_since(start);
             seconds += dt;
-            full_seconds += dt;
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
-            frame->radiance = accumulator.mean();
-            // The noise rule as render_until applies it.
-            StopRule rule;
-            rule.noise = stop_noise;
-            if (noise_check_due(rule, accumulator.passes())) noise_met = accumulator.noise_target_met(rule);
+            frame->radiance = state.radiance();
         }
-        const RenderState& totals = accumulator.totals();
         frame->generation = job.generation;
-        frame->spp = accumulator.passes();
+        frame->spp = state.passes;
         frame->seconds = seconds;
-        frame->full_seconds = full_seconds;
-        frame->rays = totals.rays;
-        frame->relative_error = frame->spp >= 2 ? totals.relative_error() : INFINITY;
-        frame->nonfinite_samples = totals.nonfinite_samples;
-        if (frame->scale == 1) record_pixel_statistics(totals, *frame);
+        frame->full_seconds = driver->seconds();
+        frame->rays = state.rays;
+        frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
+        frame->nonfinite_samples = state.nonfinite_samples;
+        if (frame->scale == 1) record_pixel_statistics(state, *frame);
         {
             std::lock_guard lock(mutex_);
             frame->target_spp = target_spp_;
-            const char* reason = stop_reason();
-            frame->finished = reason != nullptr;
-            frame->stopped_by = reason ? reason : "";
+            const std::optional<StopReason> reason = stop_reason();
+            frame->finished = reason.has_value();
+            frame->stopped_by = reason ? stop_name(*reason) : "";
         }
         publish(std::move(frame));
     }
