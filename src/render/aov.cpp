@@ -30,10 +30,11 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
                 const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
                 const size_t i = size_t(y) * size_t(width) + size_t(x);
                 // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
-                // unless it totally reflects.
-                if (m.type == MaterialType::specular || (m.type == MaterialType::dielectric)) {
+                // unless it totally reflects (by the material's lobes, vertex.inc).
+                const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
+                if (!lobes.smooth && !lobes.rough) {
                     Vec3 next;
-                    if (m.type == MaterialType::specular) {
+                    if (!lobes.fresnel_split) {
                         next = ray.d - 2 * dot(ray.d, sp.ns()) * sp.ns();
                         tint *= m.rho;
                     } else {
@@ -46,7 +47,7 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
                     continue;
                 }
                 Color albedo = m.rho;
-                if (m.type == MaterialType::translucent) {
+                if (lobes.fresnel_split) {
                     const double r = split_dielectric(m, sp, ray.d).reflectance;
                     albedo = m.rho_r * r + m.rho_t * (1 - r);
                 }

@@ -151,45 +151,38 @@ struct Tracer {
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
-        switch (m.type) {
-            case MaterialType::diffuse:
-                // Every point light exactly; every area light with one sample (distributed RT).
-                for (const PointLight& light : scene.point_lights)
-                    L += medium.seen(point_light_now(light, m, hit, sp));
-                for (const AreaLight& light : scene.area_lights)
-                    L += medium.seen(area_light_now(light, m, hit, sp, sampler.next_2d()));
-                break;
-            case MaterialType::specular:
-                L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);
-                break;
-            case MaterialType::glossy: {
-                ScatterSample s;
-                const double u_lobe = sampler.next_1d();
-                if (sample_material(m, sp, ray.d, u_lobe, sampler.next_2d(), s))
-                    L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
-                break;
-            }
-            case MaterialType::dielectric:
-            case MaterialType::translucent: {
-                // Both branches, weighted by Fresnel: F rhoR L_r + (1 - F) rhoT L_t.
-                const DielectricSplit split = split_dielectric(m, sp, ray.d);
-                const double beta = m.type == MaterialType::translucent ? m.roughness : 0.0;
-                const Vec3 ns = sp.ns();
-                const Vec2 u_reflect = sampler.next_2d(), u_transmit = sampler.next_2d();
-                Vec3 dir = perturb_direction(split.reflected, beta, u_reflect.x, u_reflect.y);
-                if (dot(dir, ns) > 0)
-                    L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
-                if (split.reflectance < 1) {
-                    dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
-                    if (dot(dir, ns) < 0) {
-                        const MediumScale here = medium;
-                        medium.cross(m, sp.front);
-                        L += ((1 - split.reflectance) * m.rho_t) * whitted(spawn(hit, dir), event + 1, nullptr);
-                        medium = here;
-                    }
+        // By the material's lobes (vertex.inc's material_lobes), not its type.
+        const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
+        if (lobes.smooth) {
+            // Every point light exactly; every area light with one sample (distributed RT).
+            for (const PointLight& light : scene.point_lights) L += medium.seen(point_light_now(light, m, hit, sp));
+            for (const AreaLight& light : scene.area_lights)
+                L += medium.seen(area_light_now(light, m, hit, sp, sampler.next_2d()));
+        } else if (lobes.fresnel_split) {
+            // Both branches, weighted by Fresnel: F rhoR L_r + (1 - F) rhoT L_t.
+            const DielectricSplit split = split_dielectric(m, sp, ray.d);
+            const double beta = lobes.rough ? m.roughness : 0.0;
+            const Vec3 ns = sp.ns();
+            const Vec2 u_reflect = sampler.next_2d(), u_transmit = sampler.next_2d();
+            Vec3 dir = perturb_direction(split.reflected, beta, u_reflect.x, u_reflect.y);
+            if (dot(dir, ns) > 0) L += (split.reflectance * m.rho_r) * whitted(spawn(hit, dir), event + 1, nullptr);
+            if (split.reflectance < 1) {
+                dir = perturb_direction(split.transmitted, beta, u_transmit.x, u_transmit.y);
+                if (dot(dir, ns) < 0) {
+                    const MediumScale here = medium;
+                    medium.cross(m, sp.front);
+                    L += ((1 - split.reflectance) * m.rho_t) * whitted(spawn(hit, dir), event + 1, nullptr);
+                    medium = here;
                 }
-                break;
             }
+        } else if (lobes.rough) {
+            // One direction, as path tracing samples it.
+            ScatterSample s;
+            const double u_lobe = sampler.next_1d();
+            if (sample_material(m, sp, ray.d, u_lobe, sampler.next_2d(), s))
+                L += s.weight * whitted(spawn(hit, s.direction), event + 1, nullptr);
+        } else {
+            L += m.rho * whitted(spawn(hit, reflect(ray.d, sp.ns())), event + 1, nullptr);  // a mirror
         }
         return L;
     }

@@ -8,12 +8,12 @@ using vertex::OneMaterial;
 using vertex::OnePath;
 
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo) {
-    if (m.type != MaterialType::diffuse) return {};
+    if (!has_smooth_lobe(m)) return {};
     return m.rho * vertex::lambert<OnePath>(dot(sp.ns(), wo));
 }
 
 double pdf_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo) {
-    if (m.type != MaterialType::diffuse) return 0;
+    if (!has_smooth_lobe(m)) return 0;
     return vertex::cosine_pdf<OnePath>(dot(sp.ns(), wo));
 }
 

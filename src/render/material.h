@@ -44,18 +44,16 @@ struct MediumScale {
     Color seen(const Color& c) const { return radiance == 1 ? c : c * radiance; }
 };
 
-// Only the diffuse lobe is evaluated for next-event estimation; the others are
-// reached through sampling. True if the material has such a lobe.
-inline bool has_smooth_lobe(const Material& m) { return m.type == MaterialType::diffuse; }
+// Only the smooth lobe is evaluated for next-event estimation; the others are reached
+// through sampling. True if the material has such a lobe (vertex.inc's material_lobes).
+inline bool has_smooth_lobe(const Material& m) { return vertex::material_lobes(m.type).smooth; }
 // Which random numbers sample_material reads: the reflect-or-transmit choice, and the 2-D
 // direction sample (a diffuse bounce, or a direction perturbed by roughness; a perfect
 // mirror or sharp dielectric needs none).
-inline bool uses_lobe_choice(const Material& m) {
-    return m.type == MaterialType::dielectric || m.type == MaterialType::translucent;
-}
+inline bool uses_lobe_choice(const Material& m) { return vertex::material_lobes(m.type).fresnel_split; }
 inline bool uses_direction_sample(const Material& m) {
-    return m.type == MaterialType::diffuse ||
-           ((m.type == MaterialType::glossy || m.type == MaterialType::translucent) && m.roughness > 0);
+    const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
+    return lobes.smooth || (lobes.rough && m.roughness > 0);
 }
 
 // f(wi, wo) * |cos(wo)| of the smooth lobe, for wo a unit direction away from the surface.
