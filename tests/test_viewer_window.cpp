@@ -62,6 +62,19 @@ protected:
         const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' " : "";
         return kr::test::run_command(prefix + "'" + KEITHRAY_EXE + "' " + args, dir);
     }
+    // `keithray view` of brief scene n for `spp` passes with `flags`, in a window, then the
+    // headless render of the same passes (with `render_flags`) into dir/headless.ppm, whose
+    // failure is reported here. Returns the window's run.
+    ViewRun view_and_render(int n, int spp, const std::string& flags, const std::string& render_flags = "") {
+        const std::string passes = " --spp " + std::to_string(spp);
+        const ViewRun v = keithray(
+            "view '" + scene(n) + "'" + passes + " --frames " + std::to_string(spp) + " " + flags + " --timeout 300", true);
+        const ViewRun r = keithray("render '" + scene(n) + "'" + passes + " -q " + render_flags + " -o '" +
+                                       (dir / "headless.ppm").string() + "'",
+                                   false);
+        EXPECT_EQ(r.status, 0) << r.err;
+        return v;
+    }
 };
 
 }  // namespace
@@ -103,12 +116,8 @@ TEST_F(ViewerWindow, ScriptedEditsScreenshotMatchesHeadlessRender) {
 // Tone map options go to the display shader only; the screenshot follows kr::tonemap.
 TEST_F(ViewerWindow, LinearToneMapScreenshotMatchesHeadless) {
     const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
-    const ViewRun v = keithray("view '" + scene(7) + "' --spp 2 --frames 2 --tonemap linear --screenshot '" +
-                               shot.string() + "' --timeout 300",
-                           true);
+    const ViewRun v = view_and_render(7, 2, "--tonemap linear --screenshot '" + shot.string() + "'", "--tonemap linear");
     ASSERT_EQ(v.status, 0) << v.out << v.err;
-    const ViewRun r = keithray("render '" + scene(7) + "' --spp 2 -q --tonemap linear -o '" + headless.string() + "'", false);
-    ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_LE(max_channel_difference(kr::read_ppm(shot), kr::read_ppm(headless)), 1);
 }
 
@@ -122,8 +131,8 @@ TEST_F(ViewerWindow, BrokenSceneFailsScriptedRunWithItsError) {
 }
 
 // The compare views: the screenshot is what the window shows of the image, computed here on
-// the CPU from the headless render of the same passes (2 spp: the viewer's compensated
-// sums are then the plain ones) and the brief's reference, offered for its scene.
+// the CPU from the headless render of the same passes (the same driver and sums) and the
+// brief's reference, offered for its scene.
 namespace {
 
 fs::path reference(int n) {
@@ -134,11 +143,8 @@ fs::path reference(int n) {
 
 TEST_F(ViewerWindow, SplitViewShowsTheRenderLeftAndTheReferenceRight) {
     const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
-    const ViewRun v = keithray("view '" + scene(3) + "' --spp 2 --frames 2 --view split --split 0.25 --screenshot '" +
-                                   shot.string() + "' --timeout 300",
-                               true);
+    const ViewRun v = view_and_render(3, 2, "--view split --split 0.25 --screenshot '" + shot.string() + "'");
     ASSERT_EQ(v.status, 0) << v.out << v.err;
-    ASSERT_EQ(keithray("render '" + scene(3) + "' --spp 2 -q -o '" + headless.string() + "'", false).status, 0);
     const kr::Rgb8Image s = kr::read_ppm(shot), a = kr::read_ppm(headless), b = kr::read_ppm(reference(3));
     ASSERT_EQ(s.width, 512);
     ASSERT_EQ(s.height, 512);
@@ -156,11 +162,8 @@ TEST_F(ViewerWindow, SplitViewShowsTheRenderLeftAndTheReferenceRight) {
 
 TEST_F(ViewerWindow, ErrorViewIsTheFalseColourOfTheErrorAgainstTheReference) {
     const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
-    const ViewRun v = keithray("view '" + scene(4) + "' --spp 2 --frames 2 --view error --error relative --screenshot '" +
-                                   shot.string() + "' --timeout 300",
-                               true);
+    const ViewRun v = view_and_render(4, 2, "--view error --error relative --screenshot '" + shot.string() + "'");
     ASSERT_EQ(v.status, 0) << v.out << v.err;
-    ASSERT_EQ(keithray("render '" + scene(4) + "' --spp 2 -q -o '" + headless.string() + "'", false).status, 0);
     const std::vector<float> errors =
         kr::viewer::pixel_errors(kr::read_ppm(headless), kr::read_ppm(reference(4)), kr::viewer::ErrorMetric::relative);
     const kr::Rgb8Image expected =
@@ -185,11 +188,8 @@ TEST_F(ViewerWindow, SamplesViewShowsUniformAllocationAsOneColour) {
 
 TEST_F(ViewerWindow, LivePsnrEqualsThePsnrCommand) {
     const fs::path stats = dir / "stats.json", headless = dir / "headless.ppm";
-    const ViewRun v = keithray("view '" + scene(5) + "' --spp 4 --frames 4 --probe 200,300 --stats-json '" +
-                                   stats.string() + "' --timeout 300",
-                               true);
+    const ViewRun v = view_and_render(5, 4, "--probe 200,300 --stats-json '" + stats.string() + "'");
     ASSERT_EQ(v.status, 0) << v.out << v.err;
-    ASSERT_EQ(keithray("render '" + scene(5) + "' --spp 4 -q -o '" + headless.string() + "'", false).status, 0);
     const ViewRun p = keithray("psnr '" + headless.string() + "' '" + reference(5).string() + "'", false);
     ASSERT_EQ(p.status, 0) << p.err;
     const auto j = nlohmann::json::parse(kr::test::read_file(stats));
@@ -209,16 +209,13 @@ TEST_F(ViewerWindow, LivePsnrEqualsThePsnrCommand) {
 // At 4x each image pixel is a 4x4 block of the pixel's tone-mapped value.
 TEST_F(ViewerWindow, ZoomShowsBlocksOfTheImagesPixels) {
     const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
-    const ViewRun v = keithray("view '" + scene(3) + "' --spp 1 --frames 1 --zoom 4 --screenshot '" + shot.string() +
-                                   "' --timeout 300",
-                               true);
+    const ViewRun v = view_and_render(3, 1, "--zoom 4 --screenshot '" + shot.string() + "'");
     ASSERT_EQ(v.status, 0) << v.out << v.err;
     std::smatch m;
     ASSERT_TRUE(std::regex_search(v.out, m, std::regex("image pixel ([0-9.]+),([0-9.]+) at ([0-9.]+) screen pixels")))
         << v.out;
     const double x0 = std::stod(m[1]), y0 = std::stod(m[2]);
     ASSERT_EQ(std::stod(m[3]), 4);
-    ASSERT_EQ(keithray("render '" + scene(3) + "' --spp 1 -q -o '" + headless.string() + "'", false).status, 0);
     const kr::Rgb8Image s = kr::read_ppm(shot), h = kr::read_ppm(headless);
     ASSERT_GT(s.width, 200);
     ASSERT_GT(s.height, 200);
