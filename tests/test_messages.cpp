@@ -281,11 +281,12 @@ TEST_F(Hostile, SceneFileSizeIsBounded) {
 
 TEST(RenderMemory, EstimateCoversTheRenderState) {
     RenderState state(64, 32);
-    const uint64_t held = state.radiance_sum().capacity() * sizeof(Color) + state.depth_sum().capacity() * 8 +
+    const uint64_t held = state.radiance_sum().capacity() * sizeof(Color) +
+                          state.radiance_compensation().capacity() * sizeof(Color) + state.depth_sum().capacity() * 8 +
                           state.luminance_sq_sum().capacity() * 8 + state.radiance_sq_sum().capacity() * sizeof(Color) +
                           state.sample_count().capacity() * 4 + state.sample_index().capacity() * 4;
-    EXPECT_EQ(held, 64u * 32u * 72u);
-    EXPECT_GE(kRenderStateBytesPerPixel, 72u + 1u);
+    EXPECT_EQ(held, 64u * 32u * 96u);
+    EXPECT_GE(kRenderStateBytesPerPixel, 96u + 1u);
     EXPECT_GT(render_memory_bytes(64, 32, false), 64u * 32u * kRenderStateBytesPerPixel);
     EXPECT_GT(render_memory_bytes(64, 32, true), render_memory_bytes(64, 32, false));
     // The loader's largest image needs more than 100 GiB: refused on most machines.

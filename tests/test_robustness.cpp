@@ -129,7 +129,8 @@ double mean_z2(const RenderState& a, const RenderState& b) {
 }
 
 size_t state_bytes(const RenderState& s) {
-    return s.radiance_sum().capacity() * sizeof(Color) + s.depth_sum().capacity() * sizeof(double) +
+    return s.radiance_sum().capacity() * sizeof(Color) + s.radiance_compensation().capacity() * sizeof(Color) +
+           s.radiance_sq_sum().capacity() * sizeof(Color) + s.depth_sum().capacity() * sizeof(double) +
            s.luminance_sq_sum().capacity() * sizeof(double) + s.sample_count().capacity() * sizeof(uint32_t) +
            s.sample_index().capacity() * sizeof(uint32_t) + s.active().capacity();
 }
@@ -674,7 +675,7 @@ TEST(RobustRenderer, SamplesOneAndNonSquareStratified) {
 }
 
 // 1x1, 1x4096 and 4096x2160 images: correct sizes, finite, and the memory of the render
-// state (48 bytes per pixel) printed for docs/robustness.md.
+// state (96 bytes per pixel) printed for docs/robustness.md.
 TEST(RobustRenderer, ExtremeDimensions) {
     // A white mirror ball in a furnace of radiance 2: every pixel shows exactly 2.
     const RenderScene scene = furnace(MaterialType::specular, Color(1.0), 2.0).build();

@@ -42,12 +42,13 @@ void RenderState::reset(int w, int h) {
 
 namespace {
 
-// Neumaier's variant of Kahan summation: also exact when the addend is the larger term.
-// `sum` stays the plain running sum; `compensation` gathers what its roundings lost.
+// Compensated summation (Neumaier's, with Knuth's TwoSum for the rounding error of each
+// addition: exact whichever term is larger, and without a branch). `sum` stays the plain
+// running sum; `compensation` gathers what its roundings lost.
 inline void add_compensated(double& sum, double& compensation, double x) {
     const double t = sum + x;
-    if (std::abs(sum) >= std::abs(x)) compensation += (sum - t) + x;
-    else compensation += (x - t) + sum;
+    const double x_part = t - sum;
+    compensation += (sum - (t - x_part)) + (x - x_part);
     sum = t;
 }
 
