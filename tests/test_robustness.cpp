@@ -710,7 +710,7 @@ TEST(RobustRenderer, ExtremeDimensions) {
         const Rgb8Image img = tonemap(radiance, ToneMap::sigmoid);
         EXPECT_EQ(img.bytes.size(), size_t(4096) * 2160 * 3);
         const size_t bytes = state_bytes(big);
-        EXPECT_EQ(bytes, size_t(4096) * 2160 * 48);
+        EXPECT_EQ(bytes, size_t(4096) * 2160 * 96);
         std::printf("[ memory   ] RenderState 4096x2160: %zu bytes (%.1f MiB); radiance image %.1f MiB; "
                     "8-bit image %.1f MiB; 1 spp pass %.2f s\n",
                     bytes, bytes / 1048576.0, radiance.pixels.capacity() * sizeof(Color) / 1048576.0,
