@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/sampling.h"
+#include "render/vertex.h"
 
 namespace kr {
 
@@ -49,10 +50,7 @@ CameraModel CameraModel::from(const Camera& camera) {
 }
 
 CameraRay CameraModel::generate(double fx, double fy, double u1, double u2) const {
-    // Point on the image plane at distance 1 along forward.
-    const double px = (2.0 * fx - 1.0) * tan_half_fov * aspect;
-    const double py = (1.0 - 2.0 * fy) * tan_half_fov;
-    const Vec3 dir = normalize(forward + px * right + py * up);
+    const Vec3 dir = vertex::pinhole_direction<vertex::OnePath>(*this, fx, fy);
     if (lens_radius <= 0) return {position, dir};
     // Thin lens: every ray through the lens point meets the pinhole ray on the focal plane.
     // Both points are taken relative to the camera position (the lens offset, and the focus
