@@ -236,7 +236,6 @@ constexpr std::array<std::array<uint8_t, 3>, 9> kViridis{{{68, 1, 84},
                                                           {170, 220, 50},
                                                           {253, 231, 37}}};
 
-
 }  // namespace
 
 std::array<uint8_t, 3> viridis(double v) {

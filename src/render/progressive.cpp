@@ -239,7 +239,7 @@ void RenderState::plan_pass(const RenderSettings& settings) {
         active_count += row_active[size_t(y)];
     }
     const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
-    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over px_.active pixels
+    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
     if (!(total > 0) || !std::isfinite(total)) {
         px_.pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
         return;
@@ -254,7 +254,7 @@ void RenderState::plan_pass(const RenderSettings& settings) {
                 px_.pass_samples[i] = 0;
                 continue;
             }
-            // Quotas sum to the px_.active pixel count: the pass costs what a uniform one does.
+            // Quotas sum to the active pixel count: the pass costs what a uniform one does.
             const double quota = (weight[i] + floor) * quota_scale;
             const double credit = std::min<double>(px_.sample_credit[i] + quota, 4 * kMaxPassSamples);
             const int take = std::min(int(credit), kMaxPassSamples);

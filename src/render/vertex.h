@@ -1,7 +1,7 @@
 // The physics of a path vertex, written once over the lane type: the materials' lobes,
-// scattering and smooth (diffuse) lobe, the pinhole camera's ray direction, the Fresnel split, the choice of a light, the spherical
-// lights' `brief` and `cone` samples, the light a sample brings with its MIS weight, crossing a dielectric and Russian
-// roulette. One path (material.cpp, light.cpp, integrator.cpp) instantiates it with OnePath,
+// scattering and smooth (diffuse) lobe, the Fresnel split, the pinhole camera's ray
+// direction, the choice of a light, the spherical lights' `brief` and `cone` samples, the
+// light a sample brings with its MIS weight, crossing a dielectric and Russian roulette. One path (material.cpp, light.cpp, integrator.cpp) instantiates it with OnePath,
 // one double wide; the SIMD kernels (packet_lanes.inc) with their lanes, four doubles or eight
 // floats. So a new material or light is written here, once, for both.
 //
