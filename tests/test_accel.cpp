@@ -353,7 +353,11 @@ double total_luminance(const Image& image) {
 // its rounding), and that is the scale-1 image: the rules of Ray are scale-free.
 TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
     const RenderScene unit_scene = scaled_room(1, 34).build();
-    const Image unit = render_image(unit_scene, 2), unit_wrt = render_image(unit_scene, 1, Integrator::wrt);
+    // One path at a time: the BVHs against the plain path (the lanes' own tree and their
+    // rounding: ExtremeScalesInTheLanes below).
+    const PacketIsa one = PacketIsa::one_path;
+    const Image unit = render_image(unit_scene, 2, Integrator::pt, one),
+                unit_wrt = render_image(unit_scene, 1, Integrator::wrt);
     ASSERT_GT(total_luminance(unit), 0.0);
     ASSERT_GT(total_luminance(unit_wrt), 0.0);
     Ray centre;
@@ -367,7 +371,7 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
         const RenderScene automatic = scaled_room(scale, 34).build();
         RenderScene plain = automatic;
         plain.linear_scan = true;
-        const Image a = render_image(automatic, 2), p = render_image(plain, 2);
+        const Image a = render_image(automatic, 2, Integrator::pt, one), p = render_image(plain, 2, Integrator::pt, one);
         char where[64];
         std::snprintf(where, sizeof where, "scale %g (%s)", scale,
                       std::string(accel_backend_names.name(automatic.bvh.backend())).c_str());
@@ -389,21 +393,25 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
     }
 }
 
-// The same at a few spheres, where paths run in SIMD lanes: the single-precision ones only
-// where every length keeps its square a normal float (float_lanes_fit), the double ones at
-// every scale; their images are the one-path image to the lanes' rounding.
+// The same where paths run in SIMD lanes, at a few spheres (one leaf) and at 34 (the lanes'
+// tree, where its boxes fit single precision): the single-precision lanes only where every
+// length keeps its square a normal float (float_lanes_fit), the double ones at every scale;
+// their images are the one-path image to the lanes' rounding.
 TEST(Accel, ExtremeScalesInTheLanes) {
-    const Image unit = render_image(scaled_room(1, 4).build(), 2, Integrator::pt, PacketIsa::one_path);
-    for (double scale : {1e-100, 1e-40, 1e-20, 1e-13, 1e-6, 1.0, 1e6, 1e13, 1e20, 1e30, 1e100}) {
-        const RenderScene scene = scaled_room(scale, 4).build();
-        char where[32];
-        std::snprintf(where, sizeof where, "scale %g", scale);
-        EXPECT_EQ(float_lanes_fit(scene), scale >= 1e-6 && scale <= 1e6) << where;
-        const Image one_path = render_image(scene, 2, Integrator::pt, PacketIsa::one_path);
-        const Image lanes = render_image(scene, 2);
-        EXPECT_LE(largest_relative_difference(one_path, unit), 1e-9) << where;
-        // Single precision moves a rare sample by more (a path's decision near a boundary):
-        // a thousandth of the brightest pixel, against the whole of it for a wrong image.
-        EXPECT_LE(largest_relative_difference(lanes, one_path), float_lanes_fit(scene) ? 1e-3 : 1e-9) << where;
+    for (int spheres : {4, 34}) {
+        const Image unit = render_image(scaled_room(1, spheres).build(), 2, Integrator::pt, PacketIsa::one_path);
+        for (double scale : {1e-100, 1e-40, 1e-20, 1e-13, 1e-6, 1.0, 1e6, 1e13, 1e20, 1e30, 1e100}) {
+            const RenderScene scene = scaled_room(scale, spheres).build();
+            char where[48];
+            std::snprintf(where, sizeof where, "%d spheres, scale %g", spheres, scale);
+            if (spheres > 16) EXPECT_EQ(scene.bvh.packets(), scale <= 1e20) << where;  // the tree's boxes in floats
+            EXPECT_EQ(float_lanes_fit(scene), scale >= 1e-6 && scale <= 1e6) << where;
+            const Image one_path = render_image(scene, 2, Integrator::pt, PacketIsa::one_path);
+            const Image lanes = render_image(scene, 2);
+            EXPECT_LE(largest_relative_difference(one_path, unit), 1e-9) << where;
+            // Single precision moves a rare sample by more (a path's decision near a boundary):
+            // a thousandth of the brightest pixel, against the whole of it for a wrong image.
+            EXPECT_LE(largest_relative_difference(lanes, one_path), float_lanes_fit(scene) ? 1e-3 : 1e-9) << where;
+        }
     }
 }

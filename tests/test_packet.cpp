@@ -12,8 +12,10 @@
 #include <cstdio>
 #include <optional>
 #include <ostream>
+#include <utility>
 #include <vector>
 
+#include "core/rng.h"
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "scene/load.h"
@@ -251,6 +253,54 @@ TEST_P(Packet, PointLightsEveryMaterialAndPartialPackets) {
             EXPECT_LE(a.mismatches, a.samples / 500) << light_sampling_names.name(light) << ", " << count;
             EXPECT_GT(a.radiance_sum, 0);
         }
+    }
+}
+
+// Scenes of more than 16 spheres, whose rays the lanes cast down the lane tree (accel.h) and
+// whose per-sphere values they gather from wide columns: many spheres of every material (more
+// materials than 16), a floor, and area lights, 20 of them in the second scene (more lights
+// than 16), with point lights beside them.
+RenderScene many_spheres(int n, int lights, uint64_t seed) {
+    test::SceneBuilder b;
+    b.scene.renderer.width = b.scene.renderer.height = 64;
+    Rng rng(seed, 5);
+    std::vector<int> materials;
+    const MaterialType types[] = {MaterialType::diffuse, MaterialType::specular, MaterialType::glossy,
+                                  MaterialType::dielectric, MaterialType::translucent};
+    for (int i = 0; i < 20; ++i) {
+        const int m = b.material(types[i % 5], Color(0.3 + 0.6 * rng.next(), 0.3 + 0.6 * rng.next(), 0.8));
+        b.scene.materials[size_t(m)].roughness = 0.1 + 0.3 * rng.next();
+        materials.push_back(m);
+    }
+    b.sphere({0, -1004, 0}, 1000, materials[0]);
+    for (int i = 0; i < n; ++i)
+        b.sphere({8 * rng.next() - 4, 6 * rng.next() - 3.5, 8 * rng.next() - 2}, 0.2 + 0.5 * rng.next(),
+                 materials[size_t(i) % materials.size()]);
+    for (int i = 0; i < lights; ++i)
+        b.emitter({10 * rng.next() - 5, 4 + 2 * rng.next(), 8 * rng.next() - 4}, 0.3 + 0.3 * rng.next(),
+                  Color(3 + 3 * rng.next()), materials[0]);
+    b.point_light({0, 4, -2}, Color(20));
+    return b.build();
+}
+
+TEST_P(Packet, ManySpheresAsOneByOne) {
+    for (const auto& [n, lights] : {std::pair{40, 2}, std::pair{100, 20}}) {
+        const RenderScene scene = many_spheres(n, lights, uint64_t(n));
+        ASSERT_TRUE(scene.bvh.packets());
+        ASSERT_FALSE(scene.bvh.one_leaf());
+        ASSERT_FALSE(scene.bvh.lane_tree().nodes.empty());
+        for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area})
+            for (Estimator estimator : {Estimator::sobol, Estimator::uniform}) {
+                RenderSettings settings = settings_of(scene);
+                settings.light_sampling = light;
+                settings.estimator = estimator;
+                const Agreement a = compare(scene, settings, 10, 64);
+                const std::string where = std::to_string(n) + " spheres, " +
+                                          std::string(light_sampling_names.name(light)) + ", " +
+                                          std::string(estimator_names.name(estimator));
+                EXPECT_LE(a.mismatches, a.samples / 500) << where;
+                EXPECT_GT(a.radiance_sum, 0) << where;
+            }
     }
 }
 

@@ -28,7 +28,7 @@ namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
-                 [--kernels best|double|any|off]
+                 [--kernels best|double|any|off] [--lens R]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
@@ -38,6 +38,9 @@ constexpr const char* kBenchUsage = R"(Usage:
               and prints the median seconds and Mrays/s (all rays: camera, bounce, shadow),
               the seconds the file's full sample count takes at that speed, and the median
               time of one full-resolution 1-spp pass.
+--lens R      also renders each scene through a thin lens of radius R in place of its
+              camera (focused on the origin), interleaved with the scene's own camera,
+              and prints that row with its speed as a fraction of the other's.
 --linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
 --kernels     how paths are traced: best (default: in SIMD lanes with the AVX2/FMA
               kernels where the CPU has them, eight in single precision where the
@@ -45,8 +48,11 @@ constexpr const char* kBenchUsage = R"(Usage:
               double (always the four double lanes), any (in lanes with the kernels for
               any x86-64 CPU, SSE2) or off (one at a time), to measure what each buys.
               The table's last column says which ran for each scene.
---stress      generated scenes of N random spheres under a sphere light, path traced at
-              W x W (default 256) with 4 spp: ns per ray and ns per ray / log2(N).
+--stress      generated scenes of N random spheres (and a floor and a lamp, two spheres
+              more) under a sphere light, path traced at W x W (default 256) with 4 spp:
+              ns per ray and ns per ray / log2(N), and how paths were traced (the SIMD
+              lanes cast rays down their own tree under own and auto, up to
+              kLaneTreeMaxSpheres; embree traces one path at a time).
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
               own,embree where the build has Embree, else own). With --throughput, one
               of them (default auto).
@@ -129,6 +135,7 @@ struct BenchOptions {
     std::vector<fs::path> scenes;
     double fraction = 1.0 / 32;
     int runs = 3, threads = 0, size = 256;
+    double lens = 0;
     PacketIsa kernels = PacketIsa::best;
 };
 
@@ -144,6 +151,7 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
         else if (arg == "--size") o.size = int(parse_number(arg, value(), 1, 8192));
         else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
+        else if (arg == "--lens") o.lens = parse_number(arg, value(), 1e-9, 1e9);
         else if (arg == "--stress") {
             for (const std::string& item : split_list(value()))
                 o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
@@ -194,20 +202,36 @@ int bench_throughput(const BenchOptions& o) {
         settings.kernels = o.kernels;
         const int spp = std::max(1, int(std::lround(settings.target_spp * o.fraction)));
         const int w = scene.renderer.width, h = scene.renderer.height;
-        std::vector<double> seconds, mrays, pass_ms;
-        for (int run = 0; run < o.runs; ++run) {
-            const Timing t = time_render(scene, settings, w, h, spp);
-            seconds.push_back(t.seconds);
-            mrays.push_back(t.seconds > 0 ? t.rays / t.seconds * 1e-6 : 0);
-            // A lone first pass, as the viewer's first full-resolution refinement.
-            pass_ms.push_back(time_render(scene, settings, w, h, 1).seconds * 1e3);
+        // The scene's own camera, and with --lens the same view through a thin lens, their
+        // runs interleaved.
+        std::vector<RenderScene> cameras{scene};
+        if (o.lens > 0) {
+            cameras.push_back(scene);
+            cameras.back().camera.lens_radius = o.lens;
+            cameras.back().camera.focal_distance = std::max(length(scene.camera.position), 1e-3);
         }
-        const double s = median(seconds), estimate = s * settings.target_spp / spp;
-        total_estimate += estimate;
-        std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f | %s |\n", file.stem().string().c_str(),
-                    std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
-                    median(mrays), estimate, median(pass_ms),
-                    std::string(packet_kernels_names.name(packet_kernels(scene, settings))).c_str());
+        std::vector<std::vector<double>> seconds(cameras.size()), mrays(cameras.size()), pass_ms(cameras.size());
+        for (int run = 0; run < o.runs; ++run)
+            for (size_t c = 0; c < cameras.size(); ++c) {
+                const Timing t = time_render(cameras[c], settings, w, h, spp);
+                seconds[c].push_back(t.seconds);
+                mrays[c].push_back(t.seconds > 0 ? t.rays / t.seconds * 1e-6 : 0);
+                // A lone first pass, as the viewer's first full-resolution refinement.
+                pass_ms[c].push_back(time_render(cameras[c], settings, w, h, 1).seconds * 1e3);
+            }
+        for (size_t c = 0; c < cameras.size(); ++c) {
+            const double s = median(seconds[c]), estimate = s * settings.target_spp / spp;
+            if (c == 0) total_estimate += estimate;
+            std::string name = file.stem().string();
+            if (c == 1)
+                name += " (lens " + std::to_string(o.lens).substr(0, 6) + ": " +
+                        std::to_string(int(std::lround(100 * median(mrays[1]) / std::max(median(mrays[0]), 1e-9)))) +
+                        " % of its Mrays/s)";
+            std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f | %s |\n", name.c_str(),
+                        std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
+                        median(mrays[c]), estimate, median(pass_ms[c]),
+                        std::string(packet_kernels_names.name(packet_kernels(cameras[c], settings))).c_str());
+        }
         std::fflush(stdout);
     }
     std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s, --kernels %s).\n",
@@ -218,8 +242,8 @@ int bench_throughput(const BenchOptions& o) {
 }
 
 int bench_stress(const BenchOptions& o) {
-    std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N | paths |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int n : o.stress) {
         const double prepare_start = now_seconds();
         const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1).dump(), "stress.json").scene);
@@ -250,11 +274,12 @@ int bench_stress(const BenchOptions& o) {
             const SphereBvh& bvh = scenes[k].bvh;
             const bool own = bvh.backend() == AccelBackend::own;
             const double ns_ray = median(ns[k]);
-            std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f |\n", n,
+            std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f | %s |\n", n,
                         o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())).c_str(),
                         own ? std::to_string(bvh.node_count()).c_str() : "-",
                         own ? std::to_string(bvh.depth()).c_str() : "-", prepare_ms, build_ms[k], median(seconds[k]),
-                        ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1));
+                        ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1),
+                        std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))).c_str());
         }
         std::fflush(stdout);
     }

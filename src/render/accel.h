@@ -37,10 +37,37 @@ bool embree_available();
 inline constexpr double kEmbreeExtentMin = 0x1.0p-50, kEmbreeExtentMax = 0x1.0p50;
 bool embree_fits(const std::vector<SphereGeom>& spheres);
 
+// Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
+// well: above it Embree's tree, one path at a time, is the faster (docs/performance.md).
+inline constexpr size_t kLaneTreeMaxSpheres = 100000;
+
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
     double cx[4], cy[4], cz[4], r2[4];
     int64_t id[4];  // sphere index; 64-bit to match the lanes of the distance masks
+};
+
+// The tree the SIMD lanes walk (packet.cpp's kernels) for scenes of more than 16 spheres: our
+// BVH with small leaves, its boxes in single precision rounded outward and padded (so that a
+// box holds its spheres' hits as the lanes compute them), its spheres in leaf order in both
+// precisions.
+struct LaneNode {
+    float lo[3], hi[3];
+    uint32_t index = 0;  // leaf: first sphere in LaneTree's order; inner: the second child (the first is next)
+    uint16_t count = 0;  // leaf: its spheres; 0 for an inner node
+    uint8_t axis = 0;    // inner: split axis, to visit the nearer child first
+};
+template <class Real>
+struct LaneSphere {
+    Real x, y, z, r2;
+    Real centre_l1;  // |centre|_1, for the single-precision lanes' shadow segments
+    int32_t id;      // the sphere's index in the scene
+};
+struct LaneTree {
+    std::vector<LaneNode> nodes;  // empty: no tree (a one-leaf scene, or Embree's only)
+    std::vector<LaneSphere<float>> spheres_f;
+    std::vector<LaneSphere<double>> spheres_d;
+    int depth = 0;
 };
 
 struct BvhNode {
@@ -63,9 +90,15 @@ public:
     // Whether any sphere is accepted within [tmin, tmax].
     bool any(const Ray& ray) const;
 
-    // Whether the build is our one leaf (up to 16 spheres), whose spheres packet tracing
-    // (packet.cpp) tests in turn for four rays at once.
-    bool packets() const { return !embree_ && nodes_.size() == 1; }
+    // Whether the SIMD lanes (packet.cpp) can cast this scene's rays: it is our one leaf (up
+    // to 16 spheres), whose spheres they test in turn, or it has a lane tree (lane_tree()).
+    bool packets() const { return (!embree_ && nodes_.size() == 1) || !lane_tree_.nodes.empty(); }
+    // Whether it is our one leaf, which the lanes test sphere by sphere without a box.
+    bool one_leaf() const { return !embree_ && nodes_.size() == 1; }
+    // The tree the lanes walk, built beside ours or Embree's for more than 16 spheres: up to
+    // kLaneTreeMaxSpheres under `automatic`, at any count under `own`, never under `embree`
+    // (which so measures one path through Embree's tree).
+    const LaneTree& lane_tree() const { return lane_tree_; }
 
     // Whether this and `other` are copies of one build (their trees are the same).
     bool same_build(const SphereBvh& other) const { return build_id_ != 0 && build_id_ == other.build_id_; }
@@ -80,6 +113,7 @@ private:
     std::vector<BvhNode> nodes_;
     std::vector<SphereBlock> blocks_;
     int depth_ = 0;
+    LaneTree lane_tree_;
     std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
     uint64_t build_id_ = 0;                        // a number per build() in this process
 };

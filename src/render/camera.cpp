@@ -52,22 +52,9 @@ CameraModel CameraModel::from(const Camera& camera) {
 CameraRay CameraModel::generate(double fx, double fy, double u1, double u2) const {
     const Vec3 dir = vertex::pinhole_direction<vertex::OnePath>(*this, fx, fy);
     if (lens_radius <= 0) return {position, dir};
-    // Thin lens: every ray through the lens point meets the pinhole ray on the focal plane.
-    // Both points are taken relative to the camera position (the lens offset, and the focus
-    // point at focal_distance / cos along dir), so neither is lost against a large position;
-    // a focus point too far to be finite (focal distance near the largest double) gives rays
-    // parallel to the pinhole ray, its limit.
-    const Vec2 lens = sample_concentric_disk(u1, u2);
-    const Vec3 offset = (lens_radius * lens.x) * right + (lens_radius * lens.y) * up;
-    const Vec3 origin = position + offset;
-    const double to_plane = focal_distance / dot(dir, forward);
-    Vec3 direction = dir;
-    if (std::isfinite(to_plane)) {
-        // Halves again so the difference of two finite vectors cannot overflow.
-        Vec3 towards;
-        if (unit_direction(dir * (0.5 * to_plane) - 0.5 * offset, towards)) direction = towards;
-    }
-    return {origin, direction};
+    CameraRay ray;
+    vertex::thin_lens_ray<vertex::OnePath>(*this, dir, u1, u2, ray.origin, ray.direction);
+    return ray;
 }
 
 }  // namespace kr

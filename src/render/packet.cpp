@@ -22,6 +22,7 @@
 #include <limits>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "core/sampling.h"
 #include "render/lanes.h"
@@ -44,14 +45,15 @@ namespace kr {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-// A one-leaf scene has at most 16 spheres, so at most 16 materials are used.
-constexpr size_t kMaxPacketSpheres = 16, kMaxPacketMaterials = 16;
+// A one-leaf scene has at most 16 spheres: the lanes keep its per-sphere values in fixed
+// columns of 16.
+constexpr size_t kMaxPacketSpheres = 16;
 
-// Where packets apply: path tracing on a scene our one-leaf BVH takes (up to 16 spheres), not
-// the plain path. Embree's scenes and our trees cast rays one by one.
+// Where packets apply: path tracing on a scene whose rays the lanes can cast (one leaf of our
+// BVH, or the lane tree: SphereBvh::packets), not the plain path. Scenes with Embree's tree
+// only cast rays one by one.
 bool packets_apply(const RenderScene& scene, const RenderSettings& settings) {
-    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets() &&
-           scene.spheres.size() <= kMaxPacketSpheres && scene.materials.size() <= kMaxPacketMaterials;
+    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets();
 }
 
 // One sample's camera ray (CameraModel::generate), its sampler giving the sub-pixel position
@@ -197,11 +199,10 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results) {
 #ifdef KR_X86_64_V3
-    bool pinhole_sobol = scene.camera.lens_radius <= 0 && count > 1;
-    for (int k = 0; k < count && pinhole_sobol; ++k)
-        pinhole_sobol = samplers[k]->sobol() && samplers[k]->dimension() == 0;
-    if (pinhole_sobol && packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float)
-        return packet_f8::trace_pinhole_samples(scene, settings, width, height, xs, ys, samplers, count, results);
+    bool sobol = count > 1;
+    for (int k = 0; k < count && sobol; ++k) sobol = samplers[k]->sobol() && samplers[k]->dimension() == 0;
+    if (sobol && packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float)
+        return packet_f8::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
 #endif
     Ray rays[kSampleBatch];
     for (int first = 0; first < count; first += kSampleBatch) {

@@ -38,8 +38,8 @@ SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settin
 // The camera rays of `count` samples of pixels (xs[i], ys[i]) of a width x height image, each
 // sampler having given nothing yet: it gives the sub-pixel position and the lens numbers
 // (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp, where packet_kernels()
-// below has lanes) for Sobol samplers and a pinhole, each ray as one at a time gives it up
-// to rounding.
+// below has lanes) for Sobol samplers (pinhole or thin lens), each ray as one at a time gives
+// it up to rounding.
 void camera_rays(const RenderScene& scene, const RenderSettings& settings, int width, int height, const int* xs, const int* ys,
                  Sampler* const* samplers, int count, Ray* rays);
 
@@ -54,8 +54,8 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
                    int count, SampleResult* results);
 
 // camera_rays, then trace_samples: `count` camera samples at pixels (xs, ys). The
-// single-precision lanes make a pinhole's camera rays themselves, eight at a time, for
-// Sobol samplers (the same samples; packet.cpp).
+// single-precision lanes make the camera rays themselves (pinhole or thin lens), eight at a
+// time, for Sobol samplers (the same samples; packet.cpp).
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
 

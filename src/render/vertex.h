@@ -11,7 +11,7 @@
 // below needs: splat, index (an int in every lane), select (of Reals, Vecs, Masks and
 // Indices), any, mask_not, sqrt, lane/set_lane/on (one lane,
 // for the rare steps done one lane at a time), and the maths of sampling: sin_cos_turns,
-// cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize
+// concentric_disk, cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize
 // and log_positive. OnePath's are core's scalar functions; the lanes' are their lane-wise
 // copies, operation for operation, so the lanes trace one path's paths up to rounding.
 //
@@ -55,6 +55,10 @@ struct OnePath {
     static KR_LANES void set_lane(double& x, int, double value) { x = value; }
     static KR_LANES bool on(bool m, int) { return m; }
     static KR_LANES void sin_cos_turns(double t, double& s, double& c) { kr::sin_cos_turns(t, s, c); }
+    static KR_LANES void concentric_disk(double u1, double u2, double& x, double& y) {
+        const Vec2 d = sample_concentric_disk(u1, u2);
+        x = d.x, y = d.y;
+    }
     static KR_LANES Vec3 cosine_hemisphere(double u1, double u2) { return sample_cosine_hemisphere(u1, u2); }
     static KR_LANES Vec3 uniform_sphere(double u1, double u2) { return sample_uniform_sphere(u1, u2); }
     static KR_LANES Vec3 uniform_cone(double u1, double u2, double one_minus_cos_max) {
