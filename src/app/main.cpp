@@ -33,6 +33,7 @@
 #include "render/options.h"
 #include "render/progressive.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
 

@@ -14,6 +14,7 @@
 #include "core/image_io.h"
 #include "core/text.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 #include "scene/save.h"
 #include "viewer/ui_app.h"
 
