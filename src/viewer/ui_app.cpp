@@ -54,8 +54,8 @@ ViewerApp::ViewerApp(ViewOptions options)
     model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
-        s.stop_seconds = options_.render.stop_seconds;
-        s.stop_noise = options_.render.stop_noise;
+        s.stop_seconds = options_.render.stop.seconds;
+        s.stop_noise = options_.render.stop.noise;
     });
     try {
         model_.load(options_.scene);
@@ -555,8 +555,7 @@ bool ViewerApp::script_step(const PixelRect& rect) {
         std::fflush(stdout);
     }
     // Without an image to write, the latency run is over; an idle run ends in idle_measure_step.
-    if (!options_.screenshot && !options_.save_scene && !options_.stats_json && options_.frames == 0)
-        return options_.measure_idle <= 0;
+    if (!options_.writes_after_render()) return options_.measure_idle <= 0;
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int needed = script_passes_needed(options_, model_.settings());
     if (!(current && shown_->scale == 1 && shown_->spp >= needed)) return false;
@@ -577,6 +576,12 @@ bool ViewerApp::script_step(const PixelRect& rect) {
         if (options_.stats_json) {
             write_file_atomic(*options_.stats_json, stats_json(stats_figures()));
             std::printf("stats: %s\n", options_.stats_json->string().c_str());
+        }
+        if (options_.save_image) {
+            // The Save panel's code, without its overwrite question.
+            const std::filesystem::path& out = *options_.save_image;
+            save_output(image_save_kind(out), out, model_, shown_.get());
+            std::printf("image: %s (%d spp)\n", out.string().c_str(), shown_->spp);
         }
         if (options_.save_scene) {
             save_scene_json(model_.scene_for_saving(), *options_.save_scene);

@@ -14,6 +14,7 @@
 #include "core/image_io.h"
 #include "core/text.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 #include "scene/save.h"
 #include "viewer/ui_app.h"
 
@@ -434,21 +435,12 @@ void ViewerApp::panel_materials() {
         ImGui::PushID(index);
         if (ImGui::TreeNode(m.id.c_str())) {
             bool changed = combo("type", m.type, material_type_names);
-            switch (m.type) {
-                case MaterialType::diffuse:
-                case MaterialType::specular: changed |= field("rho", &m.rho.x, 3, 0.005f, 0.0, 1.0); break;
-                case MaterialType::glossy:
-                    changed |= field("rho", &m.rho.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field("roughness", &m.roughness, 1, 0.002f, 0.0, 0.999);
-                    break;
-                case MaterialType::dielectric:
-                case MaterialType::translucent:
-                    changed |= field("rhoR", &m.rho_r.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field("rhoT", &m.rho_t.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field("eta", &m.eta, 1, 0.002f, 1.0 / 4, 4.0);
-                    if (m.type == MaterialType::translucent)
-                        changed |= field("roughness", &m.roughness, 1, 0.002f, 0.0, 0.999);
-                    break;
+            for (const MaterialParam& param : material_params(m.type)) {
+                const std::string label(param.name);
+                if (param.colour) changed |= field(label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
+                else
+                    changed |= field(label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo,
+                                     param.edit_hi);
             }
             const std::string name = "material " + m.id;
             if (changed) edit(Edit::material, [&](Scene& s, ViewerSettings&) { s.materials[size_t(index)] = m; }, name, name);
