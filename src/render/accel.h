@@ -38,8 +38,10 @@ inline constexpr double kEmbreeExtentMin = 0x1.0p-50, kEmbreeExtentMax = 0x1.0p5
 bool embree_fits(const std::vector<SphereGeom>& spheres);
 
 // Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
-// well: above it Embree's tree, one path at a time, is the faster (docs/performance.md).
-inline constexpr size_t kLaneTreeMaxSpheres = 100000;
+// well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
+// "Scenes of more than 16 spheres in the lanes": the single-precision lanes 1.7x Embree at
+// 128 spheres, the double lanes even at 256 and behind from 512).
+inline constexpr size_t kLaneTreeMaxSpheres = 256;
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
