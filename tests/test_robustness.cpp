@@ -198,15 +198,6 @@ std::string scene_json(const std::string& output = "out.ppm", const std::string&
 })";
 }
 
-// `text` with its single occurrence of `from` replaced (failing the test if not found once).
-std::string edit(std::string text, const std::string& from, const std::string& to) {
-    const size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << "no " << from;
-    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "ambiguous " << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
-}
-
 // The SceneError message of loading `text`, or "" if it loads.
 std::string load_error(const std::string& text) {
     try {
@@ -641,7 +632,7 @@ TEST(RobustRenderer, DepthZeroOneTwentyAndAbove) {
         for (const Color& c : s.radiance().pixels) EXPECT_NEAR(c.x, depth * direct, tolerance) << depth;
     }
     // From the scene file: 25 becomes 20 (with a warning), and so does the default settings.
-    const LoadedScene loaded = parse_scene(edit(scene_json(), "\"depth\": 4", "\"depth\": 25"), "deep.json");
+    const LoadedScene loaded = parse_scene(test::edit_once(scene_json(), "\"depth\": 4", "\"depth\": 25"), "deep.json");
     ASSERT_EQ(loaded.warnings.size(), 1u);
     EXPECT_NE(loaded.warnings[0].find("clamped to 20"), std::string::npos);
     EXPECT_EQ(loaded.scene.renderer.depth, kMaxDepth);
@@ -955,7 +946,7 @@ TEST(RobustJson, NanAndInfinityLiteralsAreRefused) {
     const std::string base = scene_json();
     for (const char* literal : {"NaN", "nan", "Infinity", "-Infinity", "inf", "1e999", "-1e400"}) {
         std::string text = base;
-        text = edit(text, "\"radius\": 1", std::string("\"radius\": ") + literal);
+        text = test::edit_once(text, "\"radius\": 1", std::string("\"radius\": ") + literal);
         const std::string error = load_error(text);
         EXPECT_NE(error, "") << literal;
         EXPECT_NE(error.find("hostile.json"), std::string::npos) << error;
@@ -977,7 +968,7 @@ TEST(RobustJson, StringsForNumbers) {
     };
     for (const auto& [from, to] : cases) {
         std::string text = base;
-        text = edit(text, from, to);
+        text = test::edit_once(text, from, to);
         const std::string error = load_error(text);
         EXPECT_NE(error.find("got string"), std::string::npos) << to << ": " << error;
     }
@@ -990,13 +981,13 @@ TEST(RobustJson, HugeArrays) {
     for (int i = 1; i < 1000000; ++i) numbers += ",0";
     numbers += "]";
     std::string text = scene_json();
-    text = edit(text, "\"centre\": [0, 0, 0]", "\"centre\": " + numbers);
+    text = test::edit_once(text, "\"centre\": [0, 0, 0]", "\"centre\": " + numbers);
     std::string error = load_error(text);
     EXPECT_NE(error.find("/shapes/0/centre: expected an array of 3 finite numbers, got an array of 1000000 elements"),
               std::string::npos)
         << error.substr(0, 200);
     text = scene_json();
-    text = edit(text, "\"lights\": [\"lamp\"]", "\"lights\": " + numbers);
+    text = test::edit_once(text, "\"lights\": [\"lamp\"]", "\"lights\": " + numbers);
     error = load_error(text);
     EXPECT_NE(error.find("/scene/lights/0: expected a light id (a string), got number 0"), std::string::npos) << error;
 }
@@ -1015,7 +1006,7 @@ TEST(RobustJson, DeepNesting) {
         EXPECT_NE(error.find("nesting deeper than 64 levels"), std::string::npos) << error;
         // Inside a valid scene, unbalanced and never closed.
         std::string text = scene_json();
-        text = edit(text, "\"radius\": 1", "\"radius\": " + std::string(depth, '['));
+        text = test::edit_once(text, "\"radius\": 1", "\"radius\": " + std::string(depth, '['));
         error = load_error(text);
         EXPECT_NE(error.find("nesting deeper than 64 levels at line 4"), std::string::npos) << error;
     }
@@ -1026,22 +1017,22 @@ TEST(RobustJson, DeepNesting) {
 // DanglingMaterialId, DanglingCameraLightAndShapeIds).
 TEST(RobustJson, DuplicateAndDanglingIds) {
     std::string text = scene_json();
-    text = edit(text, "\"shapes\": [", "\"shapes\": [{\"id\": \"ball\", \"type\": \"sphere\", \"centre\": [1, 0, 0], \"radius\": 1}, ");
+    text = test::edit_once(text, "\"shapes\": [", "\"shapes\": [{\"id\": \"ball\", \"type\": \"sphere\", \"centre\": [1, 0, 0], \"radius\": 1}, ");
     EXPECT_NE(load_error(text).find("/shapes/1/id: duplicate shape id \"ball\""), std::string::npos) << load_error(text);
     text = scene_json();
-    text = edit(text, "\"cameras\": [", "\"cameras\": [{\"id\": \"cam\", \"type\": \"pinhole\", \"fov\": 45, \"aspect\": 1, \"position\": [0, 0, -5], "
+    text = test::edit_once(text, "\"cameras\": [", "\"cameras\": [{\"id\": \"cam\", \"type\": \"pinhole\", \"fov\": 45, \"aspect\": 1, \"position\": [0, 0, -5], "
                  "\"target\": [0, 0, 0]}, ");
     EXPECT_NE(load_error(text).find("duplicate camera id \"cam\""), std::string::npos) << load_error(text);
     // One id in every category (and repeated primitive ids): legal.
     text = scene_json("out.ppm", "[16, 12]",
                       R"({"id": "ball", "type": "point", "position": [0, 3, -3], "power": [50, 50, 50]})",
                       R"({"id": "ball", "type": "diffuse", "rho": [0.8, 0.8, 0.8]})");
-    text = edit(text, "\"lights\": [\"lamp\"]", "\"lights\": [\"ball\"]");
-    text = edit(text, "\"material\": \"white\"", "\"material\": \"ball\"");
+    text = test::edit_once(text, "\"lights\": [\"lamp\"]", "\"lights\": [\"ball\"]");
+    text = test::edit_once(text, "\"material\": \"white\"", "\"material\": \"ball\"");
     EXPECT_EQ(load_error(text), "");
     // Dangling: the light the scene lists, and an area light's shape.
     text = scene_json();
-    text = edit(text, "\"lights\": [\"lamp\"]", "\"lights\": [\"sun\"]");
+    text = test::edit_once(text, "\"lights\": [\"lamp\"]", "\"lights\": [\"sun\"]");
     EXPECT_NE(load_error(text).find("/scene/lights/0: no light with id \"sun\"; expected one of \"lamp\""),
               std::string::npos)
         << load_error(text);
