@@ -2,7 +2,7 @@
 # Figures for docs/scaling.md: keithray under mpirun on this machine.
 #   ratio:   1 process of 2 threads against mpirun -np 1 and -np 2 of 1 thread each, on one
 #            scene, interleaved, REPEATS rounds; prints each run's seconds and the medians' ratios.
-#   exchange: the per-pass statistics exchange alone (scripts/bench_mpi_exchange.cpp, built
+#   exchange: the per-pass statistics exchange alone (bench/mpi_exchange.cpp, built
 #            here with mpicxx) at 512x512 and 3840x2160, 2 and 4 ranks.
 #   balance: mpirun -np 4 (oversubscribed, 1 thread each) on scenes 3, 6 and 8 at their own
 #            spp; prints keithray's per-rank summary (busy CPU seconds, slowest vs mean).
@@ -47,7 +47,7 @@ balance)
   done
   ;;
 exchange)
-  mpicxx -O2 -o "$out/exchange" scripts/bench_mpi_exchange.cpp
+  mpicxx -O2 -o "$out/exchange" bench/mpi_exchange.cpp
   for n in 2 4; do
     for size in "512 512" "3840 2160"; do "${mpi[@]}" -np $n "$out/exchange" $size; done
   done

@@ -3,7 +3,7 @@
 # viewer's idle CPU once the render is done and once paused (% of one core over 10 s with no
 # input), and the latency from an orbit edit to the first frame of the new image on screen
 # (median and 90th percentile over 30 edits). Runs a real window under Xvfb. Then the
-# per-frame cost of the inspect and compare tools (scripts/bench_compare.cpp).
+# per-frame cost of the inspect and compare tools (bench/compare_tools.cpp).
 # Usage: scripts/bench_viewer.sh [build/keithray]   (docs/viewer.md records its figures)
 set -euo pipefail
 cd "$(dirname "$0")/.."

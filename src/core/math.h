@@ -71,17 +71,6 @@ struct Frame {
 // Mirror reflection of the incident direction wi (pointing towards the surface) about n.
 inline Vec3 reflect(const Vec3& wi, const Vec3& n) { return wi - 2.0 * dot(wi, n) * n; }
 
-// Refraction of wi (pointing towards the surface) through a surface with normal n facing
-// the incident side; eta_ratio = eta_incident / eta_transmitted. False on total internal reflection.
-inline bool refract(const Vec3& wi, const Vec3& n, double eta_ratio, Vec3& wt) {
-    const double cos_i = -dot(wi, n);
-    const double sin2_t = eta_ratio * eta_ratio * std::max(0.0, 1.0 - cos_i * cos_i);
-    if (sin2_t >= 1.0) return false;
-    const double cos_t = std::sqrt(1.0 - sin2_t);
-    wt = normalize(eta_ratio * wi + (eta_ratio * cos_i - cos_t) * n);
-    return true;
-}
-
 // Unpolarised Fresnel reflectance of a dielectric interface (exact, not Schlick).
 // cos_i >= 0 on the incident side; eta_ratio = eta_incident / eta_transmitted.
 inline double fresnel_dielectric(double cos_i, double eta_ratio) {
