@@ -18,7 +18,7 @@ void ViewerApp::reset_save_paths() {
 
 void ViewerApp::panel_save() {
     if (!ImGui::CollapsingHeader("Save", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    const bool full = shown_ && shown_->generation == model_.generation() && shown_->scale == 1;
+    const bool full = ui_.shown && ui_.shown->generation == model_.generation() && ui_.shown->scale == 1;
     ImGui::InputText("image", &save_paths_.image);
     ImGui::BeginDisabled(!full);
     if (ImGui::Button("Save PPM")) request_save(SaveKind::ppm, save_paths_.image);
@@ -61,7 +61,7 @@ void ViewerApp::overwrite_popup() {
     ImGui::SameLine();
     if (ImGui::Button("Cancel")) {
         pending_save_.reset();
-        status_ = "not saved";
+        messages_.status = "not saved";
         ImGui::CloseCurrentPopup();
     }
     ImGui::EndPopup();
@@ -69,12 +69,12 @@ void ViewerApp::overwrite_popup() {
 
 void ViewerApp::save_now(SaveKind kind, const fs::path& path) {
     try {
-        status_ = save_output(kind, path, model_, shown_.get(), convergence_.csv());
+        messages_.status = save_output(kind, path, model_, ui_.shown.get(), ui_.compare.convergence.csv());
         // Saving over the watched file should not read like an outside change.
         std::error_code ec;
-        if (kind == SaveKind::scene && fs::equivalent(path, watch_.file(), ec)) watch_.acknowledge();
+        if (kind == SaveKind::scene && fs::equivalent(path, ui_.files.watch.file(), ec)) ui_.files.watch.acknowledge();
     } catch (const std::exception& e) {
-        status_ = std::string("save failed: ") + e.what();
+        messages_.status = std::string("save failed: ") + e.what();
     }
 }
 
