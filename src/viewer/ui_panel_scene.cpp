@@ -41,19 +41,17 @@ void panel_scene(PanelContext& ctx) {
     ImGui::SameLine();
     if (ImGui::Button("Rescan folder")) files.folders.clear();
     ImGui::SameLine();
-    ImGui::BeginDisabled(!model.can_undo());
-    if (ImGui::Button("Undo")) {
-        model.undo();
-        ctx.messages.error.clear();
-    }
-    ImGui::EndDisabled();
+    auto history = [&](const char* label, bool can, bool (ViewerModel::*step)()) {
+        ImGui::BeginDisabled(!can);
+        if (ImGui::Button(label)) {
+            (model.*step)();
+            ctx.messages.error.clear();
+        }
+        ImGui::EndDisabled();
+    };
+    history("Undo", model.can_undo(), &ViewerModel::undo);
     ImGui::SameLine();
-    ImGui::BeginDisabled(!model.can_redo());
-    if (ImGui::Button("Redo")) {
-        model.redo();
-        ctx.messages.error.clear();
-    }
-    ImGui::EndDisabled();
+    history("Redo", model.can_redo(), &ViewerModel::redo);
     ImGui::SameLine();
     if (ImGui::Button("Reset view")) model.reset_view();
     ImGui::TextDisabled("the file is watched: saving it in an editor reloads it");
