@@ -309,14 +309,9 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     const auto start = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     double last_draw = -1;
-    StopRule rule;
-    rule.seconds = opt.render.stop_seconds;
-    rule.noise = opt.render.stop_noise;
-    const bool open_ended = opt.render.stop_seconds > 0 || opt.render.stop_noise > 0;
-    // Without --spp an open-ended render still ends: a noise target the scene cannot reach
-    // in reasonable time stops at the cap (core/limits.h).
+    const StopRule rule = render_stop_rule(opt.render, settings);
+    const bool open_ended = rule.open_ended();
     const bool capped = open_ended && !opt.render.spp;
-    rule.max_passes = capped ? kMaxOpenEndedPasses : settings.target_spp;
 
     const CheckpointKey key = checkpoint_key(loaded.scene, scene, settings, rule);
     if (opt.resume) {
@@ -370,14 +365,15 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
             if (flags & 2) return false;
         }
         if (show_progress && elapsed() - last_draw > 0.1) {
-            if (open_ended) {
-                std::fprintf(stderr, "\r  %d passes  %s  est. error %.4f   ", s.passes, format_seconds(elapsed()).c_str(),
-                             s.relative_error());
-                std::fflush(stderr);
-            } else {
-                draw_progress(double(s.passes) / settings.target_spp,
-                              std::to_string(s.passes) + "/" + std::to_string(settings.target_spp) + " spp", elapsed());
-            }
+            // The bar goes towards the rule nearest to ending the render.
+            const double noise = rule.noise > 0 ? s.relative_error() : 0;
+            const StopProgress progress = stop_progress(rule, s.passes, elapsed(), noise);
+            char what[96];
+            if (open_ended) std::snprintf(what, sizeof what, "%d passes", s.passes);
+            else std::snprintf(what, sizeof what, "%d/%d spp", s.passes, rule.max_passes);
+            if (rule.noise > 0)
+                std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), "  est. error %.4f", noise);
+            draw_progress(progress.fraction, what, elapsed());
             last_draw = elapsed();
         }
         return true;
@@ -406,10 +402,9 @@ bool render_scene_file(const fs::path& scene_file, const Options& opt, std::stri
     state.nonfinite_samples = total_nonfinite;
     const double seconds = elapsed();
     if (open_ended) {
-        const std::string by = reason == StopReason::noise ? "--noise"
-                               : reason == StopReason::time ? "--time"
-                               : capped ? "the cap of " + std::to_string(kMaxOpenEndedPasses) + " passes (no --spp)"
-                                        : "--spp";
+        const std::string by = reason == StopReason::passes && capped
+                                   ? "the cap of " + std::to_string(kMaxOpenEndedPasses) + " passes (no --spp)"
+                                   : "--" + std::string(stop_reason_names.name(reason));
         std::fprintf(stderr, "%s%s: stopped by %s after %d passes, estimated relative error %.4f\n",
                      show_progress ? "\n" : "", shown(scene_file.filename()).c_str(), by.c_str(), state.passes,
                      state.relative_error());

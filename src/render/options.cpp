@@ -14,9 +14,10 @@ void read_integer(const SharedFlag& f, const std::string& text, RenderOptions& o
     o.*Member = Value(parse_integer(std::string(f.name), text, (long long)f.lo, (long long)f.hi));
 }
 
-template <auto Member>
+// `Path`: a member of RenderOptions, then members of it (--time is o.stop.seconds).
+template <auto... Path>
 void read_decimal(const SharedFlag& f, const std::string& text, RenderOptions& o) {
-    o.*Member = parse_number(std::string(f.name), text, f.lo, f.hi, f.lo_open);
+    (o .* ... .* Path) = parse_number(std::string(f.name), text, f.lo, f.hi, f.lo_open);
 }
 
 template <const auto& Names, auto Member>
@@ -37,10 +38,10 @@ constexpr SharedFlag integer_flag(std::string_view name, std::string_view value,
     return {name, value, FlagKind::integer, double(lo), double(hi), false, nullptr, help, read_integer<Value, Member>};
 }
 
-template <auto Member>
+template <auto... Path>
 constexpr SharedFlag number_flag(std::string_view name, std::string_view value, double lo, double hi, bool lo_open,
                                  std::string_view help) {
-    return {name, value, FlagKind::number, lo, hi, lo_open, nullptr, help, read_decimal<Member>};
+    return {name, value, FlagKind::number, lo, hi, lo_open, nullptr, help, read_decimal<Path...>};
 }
 
 template <const auto& Names, auto Member>
@@ -54,11 +55,11 @@ const std::array kFlags{
     integer_flag<int, &O::spp>("--spp", "N", 1, kMaxSamples,
                                "samples per pixel, %r (default: the file's \"samples\"; with --time or --noise, "
                                "an upper bound)"),
-    number_flag<&O::stop_seconds>("--time", "SECONDS", 0, kMaxSeconds, true,
-                                  "stop after SECONDS of rendering, in %r (checked between passes)"),
-    number_flag<&O::stop_noise>("--noise", "X", kMinNoise, kMaxNoise, false,
-                                "stop when the estimated relative RMS error of the image falls below X, in %r "
-                                "(e.g. 0.01); adaptive: passes go to the noisiest pixels"),
+    number_flag<&O::stop, &StopRule::seconds>("--time", "SECONDS", 0, kMaxSeconds, true,
+                                              "stop after SECONDS of rendering, in %r (checked between passes)"),
+    number_flag<&O::stop, &StopRule::noise>("--noise", "X", kMinNoise, kMaxNoise, false,
+                                            "stop when the estimated relative RMS error of the image falls below X, "
+                                            "in %r (e.g. 0.01); adaptive: passes go to the noisiest pixels"),
     name_flag<integrator_names, &O::integrator>(
         "--integrator", "%r (default: the file's renderer type; pt-naive samples no area light, only point lights)"),
     name_flag<estimator_names, &O::estimator>(
@@ -151,6 +152,14 @@ RenderSettings apply_render_options(const RenderOptions& options, Scene& scene) 
     if (options.tonemap) scene.display.tonemap = *options.tonemap;
     if (options.exposure) scene.display.exposure = *options.exposure;
     return settings;
+}
+
+StopRule render_stop_rule(const RenderOptions& options, const RenderSettings& settings) {
+    StopRule rule = options.stop;
+    // Without --spp an open-ended render still ends: a noise target the scene cannot reach in
+    // reasonable time stops at the cap (core/limits.h).
+    rule.max_passes = rule.open_ended() && !options.spp ? kMaxOpenEndedPasses : settings.target_spp;
+    return rule;
 }
 
 }  // namespace kr

@@ -13,6 +13,7 @@
 
 #include "core/args.h"
 #include "render/settings.h"
+#include "render/stop_rule.h"
 #include "scene/scene.h"
 
 namespace kr {
@@ -27,10 +28,8 @@ struct RenderOptions {
     std::optional<LightSampling> light_sampling;
     std::optional<ToneMap> tonemap;
     std::optional<double> exposure;  // EV stops
-    // Stop rules (0: off): each command runs them its own way (render: StopRule; view: the
-    // render thread's rule).
-    double stop_seconds = 0;  // --time
-    double stop_noise = 0;    // --noise
+    // --time and --noise (0: off); the pass limit comes from --spp or the file.
+    StopRule stop;
 };
 
 enum class FlagKind { integer, number, name };
@@ -66,5 +65,9 @@ std::string shared_flags_help();
 // block) with the flags over them; the flags' tone map and exposure go into the scene's
 // display block.
 RenderSettings apply_render_options(const RenderOptions& options, Scene& scene);
+
+// `keithray render`'s stop rule: --time and --noise, with --spp (or the file's samples) as the
+// pass limit; open-ended without --spp, the cap of kMaxOpenEndedPasses.
+StopRule render_stop_rule(const RenderOptions& options, const RenderSettings& settings);
 
 }  // namespace kr

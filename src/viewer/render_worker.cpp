@@ -117,18 +117,6 @@ void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
     if (on_publish_) on_publish_();
 }
 
-namespace {
-
-const char* stop_name(StopReason reason) {
-    switch (reason) {
-    case StopReason::noise: return "noise";
-    case StopReason::time: return "time";
-    default: return "spp";
-    }
-}
-
-}  // namespace
-
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -210,7 +198,7 @@ void RenderWorker::run() {
             frame->target_spp = target_spp_;
             const std::optional<StopReason> reason = stop_reason();
             frame->finished = reason.has_value();
-            frame->stopped_by = reason ? stop_name(*reason) : "";
+            frame->stopped_by = reason ? stop_reason_names.name(*reason).data() : "";
         }
         publish(std::move(frame));
     }

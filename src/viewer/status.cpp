@@ -21,31 +21,18 @@ RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool
     st.noise = frame->spp >= 2 && std::isfinite(frame->relative_error) ? frame->relative_error : -1;
 
     // Progress towards each stop rule that is on; the first to be met ends the render.
-    const double per_pass = frame->spp > 0 ? frame->full_seconds / frame->spp : 0;
-    auto consider = [&](const char* rule, double fraction, double eta) {
-        fraction = std::clamp(fraction, 0.0, 1.0);
-        if (fraction > st.progress) {
-            st.progress = fraction;
-            st.rule = rule;
-        }
-        if (eta >= 0 && (st.eta < 0 || eta < st.eta)) st.eta = eta;
-    };
-    if (!settings.unlimited)
-        consider("target", double(frame->spp) / std::max(1, st.target),
-                 per_pass > 0 ? std::max(0, st.target - frame->spp) * per_pass : -1);
-    if (settings.stop_seconds > 0)
-        consider("time", frame->full_seconds / settings.stop_seconds,
-                 std::max(0.0, settings.stop_seconds - frame->full_seconds));
-    if (settings.stop_noise > 0 && st.noise > 0) {
-        // The error falls as 1/sqrt(spp): the target needs spp * (noise / target)^2 passes.
-        const double ratio = settings.stop_noise / st.noise;
-        const double passes_left = frame->spp * std::max(0.0, 1.0 / (ratio * ratio) - 1.0);
-        consider("noise", ratio * ratio, per_pass > 0 ? passes_left * per_pass : -1);
-    }
+    StopRule rule;
+    rule.max_passes = settings.unlimited ? kUnlimitedPasses : st.target;
+    rule.seconds = settings.stop_seconds;
+    rule.noise = settings.stop_noise;
+    const StopProgress progress = stop_progress(rule, frame->spp, frame->full_seconds, st.noise);
+    st.progress = progress.fraction;
+    st.eta = progress.eta;
+    if (progress.nearest) st.rule = stop_reason_names.name(*progress.nearest);
 
     // Done: a stop rule ended it, unless a raised target or "unlimited" lets it go on; or
     // the target was lowered below the passes already taken.
-    const bool spp_rule_over = std::string_view(frame->stopped_by) == "spp" && (settings.unlimited || frame->spp < st.target);
+    const bool spp_rule_over = std::string_view(frame->stopped_by) == stop_reason_names.name(StopReason::passes) && (settings.unlimited || frame->spp < st.target);
     const bool done = (frame->finished && !spp_rule_over) ||
                       (!settings.unlimited && !st.preview && frame->spp >= st.target);
     if (has_error) st.state = RunState::error;

@@ -27,7 +27,7 @@ struct RunStatus {
     double elapsed = 0;        // render seconds of this image
     double mrays_per_second = 0;
     double noise = -1;         // estimated relative RMS error; -1 before 2 spp
-    std::string rule;          // "target", "time" or "noise": the rule progress is towards
+    std::string rule;          // "spp", "time" or "noise" (stop_reason_names): the rule progress is towards
 };
 
 // `frame`: the newest snapshot of the current generation (null before the first).

@@ -51,8 +51,8 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
     model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
-        s.stop_seconds = options_.render.stop_seconds;
-        s.stop_noise = options_.render.stop_noise;
+        s.stop_seconds = options_.render.stop.seconds;
+        s.stop_noise = options_.render.stop.noise;
     });
     try {
         model_.load(options_.scene);

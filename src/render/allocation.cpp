@@ -1,0 +1,145 @@
+// Adaptive allocation: the plan of the next pass (samples per pixel by estimated noise) and
+// the noise rule's mask of pixels still above their share of the error.
+#include <algorithm>
+#include <cmath>
+
+#include "render/render_state.h"
+
+namespace kr {
+
+namespace {
+
+// The 3x3 guard on per-pixel values (variances): each value replaced by the larger of itself
+// and the mean over its 3x3 neighbourhood (the cells inside the image). A few samples can
+// miss a rare bright path and show almost no variance; variance varies smoothly over the
+// image, so the neighbours guard against that. Separable, in two loops over rows: first
+// each row's 3-wide sums, then the guarded value from three rows of those sums.
+void sum_three_along_row(const double* values, double* sums, size_t width) {
+    for (size_t x = 0; x < width; ++x)
+        sums[x] = (x > 0 ? values[x - 1] : 0.0) + values[x] + (x + 1 < width ? values[x + 1] : 0.0);
+}
+
+double guarded_3x3(const std::vector<double>& values, const std::vector<double>& row_sums, int width, int height,
+                   int y, size_t x) {
+    const size_t w = size_t(width), i = size_t(y) * w + x;
+    double sum = row_sums[i], cells = 1.0;
+    if (y > 0) sum += row_sums[i - w], cells += 1.0;
+    if (y + 1 < height) sum += row_sums[i + w], cells += 1.0;
+    cells *= 1.0 + (x > 0) + (x + 1 < w);
+    return std::max(values[i], sum / cells);
+}
+
+}  // namespace
+
+size_t RenderState::update_adaptive(double target, uint32_t min_samples) {
+    const size_t n = px_.sample_count.size(), w = size_t(width);
+    // Rows in parallel, their sums added in order (as plan_pass).
+    std::vector<double>& error_sq = px_.allocation_scratch[0];
+    std::vector<double>& row_sums = px_.allocation_scratch[1];
+    error_sq.resize(n);
+    row_sums.resize(n);
+    std::vector<double> row_signal(size_t(height), 0.0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            const double mean = px_.sample_count[i] ? luminance(px_.radiance_sum[i]) / px_.sample_count[i] : 0.0;
+            row_signal[size_t(y)] += mean * mean;
+            const double se = pixel_standard_error(i);
+            error_sq[i] = se * se;
+        }
+        sum_three_along_row(&error_sq[size_t(y) * w], &row_sums[size_t(y) * w], w);
+    }
+    double signal_sq = 0;
+    for (double s : row_signal) signal_sq += s;
+    const double share = target * target * signal_sq / double(std::max<size_t>(n, 1));
+    px_.active.resize(n);
+    std::vector<size_t> row_count(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * w + x;
+            const bool needs_more =
+                px_.sample_count[i] < min_samples || !(guarded_3x3(error_sq, row_sums, width, height, y, x) <= share);
+            px_.active[i] = needs_more;
+            row_count[size_t(y)] += needs_more;
+        }
+    size_t count = 0;
+    for (size_t c : row_count) count += c;
+    return count;
+}
+
+void RenderState::plan_pass(const RenderSettings& settings) {
+    if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
+        passes < kAllocationWarmup) {
+        px_.pass_samples.clear();
+        return;
+    }
+    const size_t n = px_.sample_count.size(), w = size_t(width);
+    // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
+    // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
+    // estimate may be too low, and bounds the bias of deciding from the samples themselves.
+    // Every loop runs over rows in parallel; sums are taken per row and then over the rows in
+    // order, so the plan is the same for any number of threads. The loops are fused:
+    // at 512x512 the plan is bound by memory traffic.
+    std::vector<double>& variance = px_.allocation_scratch[0];
+    std::vector<double>& row_sums = px_.allocation_scratch[1];  // 3-wide sums along each row
+    std::vector<double>& weight = px_.allocation_scratch[2];
+    variance.resize(n);
+    row_sums.resize(n);
+    weight.resize(n);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) variance[i] = sample_variance(i);
+        sum_three_along_row(&variance[size_t(y) * w], &row_sums[size_t(y) * w], w);
+    }
+    // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
+    // standard deviation, summed per row.
+    std::vector<double> row_weight(size_t(height), 0.0);
+    std::vector<size_t> row_active(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * w + x;
+            const bool on = px_.active.empty() || px_.active[i];
+            const double guarded = guarded_3x3(variance, row_sums, width, height, y, x);
+            weight[i] = on && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
+            row_weight[size_t(y)] += weight[i];
+            row_active[size_t(y)] += on;
+        }
+    double sum = 0;
+    size_t active_count = 0;
+    for (int y = 0; y < height; ++y) {
+        sum += row_weight[size_t(y)];
+        active_count += row_active[size_t(y)];
+    }
+    const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
+    const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
+    if (!(total > 0) || !std::isfinite(total)) {
+        px_.pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
+        return;
+    }
+    px_.sample_credit.resize(n, 0.0f);
+    px_.pass_samples.resize(n);
+    const double quota_scale = double(active_count) / total;
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            if (!(px_.active.empty() || px_.active[i])) {
+                px_.pass_samples[i] = 0;
+                continue;
+            }
+            // Quotas sum to the active pixel count: the pass costs what a uniform one does.
+            const double quota = (weight[i] + floor) * quota_scale;
+            const double credit = std::min<double>(px_.sample_credit[i] + quota, 4 * kMaxPassSamples);
+            const int take = std::min(int(credit), kMaxPassSamples);
+            px_.pass_samples[i] = static_cast<uint8_t>(take);
+            px_.sample_credit[i] = static_cast<float>(credit - take);
+        }
+}
+
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
+    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
+           state.passes >= kAllocationWarmup;
+}
+
+}  // namespace kr

@@ -1,0 +1,23 @@
+// One pass of a progressive render: each pixel's planned samples traced (in SIMD lanes where
+// they can be) and added to its sums.
+#pragma once
+
+#include <atomic>
+
+#include "render/render_scene.h"
+#include "render/render_state.h"
+#include "render/settings.h"
+
+namespace kr {
+
+// Adds one sample to every pixel of `state`, or the number state.pass_samples gives (sample
+// index = the pixel's own count of samples drawn).
+// Parallel over rows with OpenMP; each sample has its own RNG stream seeded by
+// (seed, pixel, sample index), so the image does not depend on threads or scheduling.
+// If `stop` becomes true the pass ends early and returns false; pixels it reached keep their
+// sample, others do not: the state is then an unevenly sampled estimate, which
+// ProgressiveDriver's users drop (the viewer stops a pass only for an edit).
+bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
+                 const std::atomic<bool>* stop = nullptr);
+
+}  // namespace kr

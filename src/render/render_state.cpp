@@ -1,0 +1,110 @@
+#include "render/render_state.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/trace.h"
+
+namespace kr {
+
+void RenderState::reset(int w, int h) {
+    width = w;
+    height = h;
+    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+    px_.radiance_sum.assign(n, Color());
+    px_.radiance_compensation.assign(n, Color());
+    px_.depth_sum.assign(n, 0.0);
+    px_.luminance_sq_sum.assign(n, 0.0);
+    px_.radiance_sq_sum.assign(n, Color());
+    px_.sample_count.assign(n, 0);
+    px_.sample_index.assign(n, 0);
+    passes = 0;
+    rays = 0;
+    nonfinite_samples = 0;
+    px_.active.clear();
+    px_.pass_samples.clear();
+    px_.sample_credit.clear();
+    for (auto& scratch : px_.allocation_scratch) scratch.clear();
+    px_.sobol_keys.clear();
+}
+
+uint64_t render_memory_bytes(int width, int height, bool blurred) {
+    const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
+    const uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
+    return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
+}
+
+Image RenderState::radiance() const {
+    Image img(width, height);
+    for (size_t i = 0; i < img.pixels.size(); ++i)
+        img.pixels[i] = px_.sample_count[i]
+                            ? (px_.radiance_sum[i] + px_.radiance_compensation[i]) / double(px_.sample_count[i])
+                            : Color();
+    return img;
+}
+
+std::vector<double> RenderState::mean_depth() const {
+    std::vector<double> d(px_.depth_sum.size(), kMissDepth);
+    for (size_t i = 0; i < d.size(); ++i)
+        if (px_.sample_count[i]) d[i] = px_.depth_sum[i] / double(px_.sample_count[i]);
+    return d;
+}
+
+std::vector<Color> RenderState::variance_of_mean() const {
+    std::vector<Color> v(px_.radiance_sum.size(), Color(kInfinity));
+    for (size_t i = 0; i < v.size(); ++i) {
+        const double n = px_.sample_count[i];
+        if (n < 2 || !is_finite(px_.radiance_sq_sum[i])) continue;  // unknown, as sample_variance
+        // The unbiased sample variance of each channel, then over n for the mean's.
+        auto channel = [&](double sum, double sq_sum) {
+            const double mean = sum / n;
+            return std::max(0.0, (sq_sum - n * mean * mean) / (n - 1)) / n;
+        };
+        v[i] = {channel(px_.radiance_sum[i].x, px_.radiance_sq_sum[i].x), channel(px_.radiance_sum[i].y, px_.radiance_sq_sum[i].y),
+                channel(px_.radiance_sum[i].z, px_.radiance_sq_sum[i].z)};
+    }
+    return v;
+}
+
+double RenderState::sample_variance(size_t i) const {
+    const double n = px_.sample_count[i];
+    // Below two samples there is no variance; a sum of squares that overflowed (radiance
+    // above ~1e154) would give inf - inf: the variance is unknown, not zero.
+    if (n < 2 || !std::isfinite(px_.luminance_sq_sum[i])) return kInfinity;
+    const double mean = luminance(px_.radiance_sum[i]) / n;
+    return std::max(0.0, (px_.luminance_sq_sum[i] - n * mean * mean) / (n - 1));  // unbiased
+}
+
+double RenderState::pixel_standard_error(size_t i) const {
+    return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
+}
+
+double RenderState::relative_error() const {
+    // Per-row sums in parallel, added in row order: the same estimate for any thread count.
+    // (The viewer shows it after every pass.)
+    const size_t w = size_t(width);
+    std::vector<double> row_error(size_t(height), 0.0), row_signal(size_t(height), 0.0);
+    std::vector<uint8_t> row_unknown(size_t(height), 0);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y)
+        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+            const double se = pixel_standard_error(i);
+            if (!std::isfinite(se)) {
+                row_unknown[size_t(y)] = 1;
+                break;
+            }
+            row_error[size_t(y)] += se * se;
+            const double mean = luminance(px_.radiance_sum[i]) / px_.sample_count[i];
+            row_signal[size_t(y)] += mean * mean;
+        }
+    double error_sq = 0, signal_sq = 0;
+    for (size_t y = 0; y < size_t(height); ++y) {
+        if (row_unknown[y]) return kInfinity;
+        error_sq += row_error[y];
+        signal_sq += row_signal[y];
+    }
+    if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
+    return std::sqrt(error_sq / signal_sq);
+}
+
+}  // namespace kr

@@ -1,0 +1,126 @@
+// The state of a progressive render: each pixel's sums, second moments and counts
+// (PixelBuffers, behind RenderState's readers), the statistics read from them (mean,
+// variances, the image's estimated error), the adaptive allocation that plans the next pass
+// from them (allocation.cpp), and the memory a render holds.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "core/image.h"
+#include "render/settings.h"
+
+namespace kr {
+
+// A RenderState's per-pixel buffers. The pass engine (render_pass, plan_pass,
+// update_adaptive), checkpoints and the process exchange of PassHooks write them through
+// RenderState::buffers(); everything else reads them through RenderState's readers.
+struct PixelBuffers {
+    std::vector<Color> radiance_sum;      // per pixel, sum of sample radiance (plainly rounded)
+    // Per pixel, Neumaier's running correction of radiance_sum: radiance_sum plus it is the
+    // sum to within an ulp or two after any number of samples, where the plain sum of 10^6
+    // samples of 0.1 is off by 1.3e-11 relative. The mean radiance uses both; the statistics
+    // (variances, plans, the noise rule) use radiance_sum alone, which processes share.
+    std::vector<Color> radiance_compensation;
+    std::vector<double> depth_sum;        // per pixel, sum of primary hit distances
+    std::vector<double> luminance_sq_sum; // per pixel, sum of squared sample luminance
+    std::vector<Color> radiance_sq_sum;   // per pixel and channel, sum of squared sample radiance
+    std::vector<uint32_t> sample_count;   // per pixel, samples accumulated
+    std::vector<uint32_t> sample_index;   // per pixel, samples drawn (accumulated + dropped)
+    // The noise rule (update_adaptive): render_pass samples only pixels whose entry is 1
+    // (empty: all of them).
+    std::vector<uint8_t> active;
+    // Samples per pixel in the next pass, set by plan_pass (empty: one each).
+    std::vector<uint8_t> pass_samples;
+    std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
+    std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's and update_adaptive's buffers
+    // The Sobol samplers' per-pixel keys (Sampler::pixel_key) for sobol_keys_seed: the same in
+    // every pass, so render_pass works them out once (empty until a Sobol pass).
+    std::vector<uint32_t> sobol_keys;
+    uint64_t sobol_keys_seed = 0;
+};
+
+class RenderState {
+public:
+    int width = 0, height = 0;
+    int passes = 0;                       // completed passes
+    uint64_t rays = 0;                    // every ray cast: camera, bounce and shadow rays
+    uint64_t nonfinite_samples = 0;       // samples dropped for NaN/Inf radiance
+
+    // The per-pixel buffers (PixelBuffers says what each holds).
+    const std::vector<Color>& radiance_sum() const { return px_.radiance_sum; }
+    const std::vector<Color>& radiance_compensation() const { return px_.radiance_compensation; }
+    const std::vector<double>& depth_sum() const { return px_.depth_sum; }
+    const std::vector<double>& luminance_sq_sum() const { return px_.luminance_sq_sum; }
+    const std::vector<Color>& radiance_sq_sum() const { return px_.radiance_sq_sum; }
+    const std::vector<uint32_t>& sample_count() const { return px_.sample_count; }
+    const std::vector<uint32_t>& sample_index() const { return px_.sample_index; }
+    const std::vector<uint8_t>& active() const { return px_.active; }
+    const std::vector<uint8_t>& pass_samples() const { return px_.pass_samples; }
+    const std::vector<float>& sample_credit() const { return px_.sample_credit; }
+    const PixelBuffers& buffers() const { return px_; }
+    // For the pass engine, checkpoints and PassHooks (see PixelBuffers).
+    PixelBuffers& buffers() { return px_; }
+
+    RenderState() = default;
+    RenderState(int w, int h) { reset(w, h); }
+    void reset(int w, int h);
+    Image radiance() const;                  // per-pixel mean radiance (compensated sums)
+    std::vector<double> mean_depth() const;  // per-pixel mean primary distance
+    // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
+    // over the count (infinite below two samples). What `keithray compare --statistical` tests.
+    std::vector<Color> variance_of_mean() const;
+
+    // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
+    double sample_variance(size_t i) const;
+    // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
+    // two samples).
+    double pixel_standard_error(size_t i) const;
+    // Estimated relative RMS error of the whole image: sqrt(sum of per-pixel variances of the
+    // mean) / sqrt(sum of squared mean luminances). Infinite before two samples per pixel.
+    double relative_error() const;
+
+    // Adaptive sampling towards an image relative error `target` (as relative_error()): a
+    // pixel stays active while the variance of its mean exceeds an equal share of the allowed
+    // total, target^2 * sum(mean^2) / pixels, or it has fewer than `min_samples` samples.
+    // When no pixel is active the image meets the target. Returns the active count.
+    size_t update_adaptive(double target, uint32_t min_samples = 16);
+
+    // Plans the next pass for `settings.allocation` (fills pass_samples). Adaptive: after
+    // kAllocationWarmup passes, each active pixel's share of the pass (as many samples as
+    // active pixels) is proportional to its estimated standard deviation (3x3 guarded, as
+    // update_adaptive) plus a floor, which minimises the summed variance of the pixel means
+    // for the budget; fractions carry over between passes. Parallel over rows, with the rows'
+    // sums added in order: the plan does not depend on threads.
+    void plan_pass(const RenderSettings& settings);
+
+    // Samples every pixel again (no adaptive mask).
+    void clear_adaptive() { px_.active.clear(); }
+
+private:
+    PixelBuffers px_;
+};
+
+// The bytes per pixel a RenderState holds once every buffer is in use: the seven sums and
+// counts, the adaptive mask, the pass plan and its credit, the three allocation buffers and
+// the Sobol keys.
+inline constexpr uint64_t kRenderStateBytesPerPixel =
+    3 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
+    3 * sizeof(double) + sizeof(uint32_t);
+
+// An upper estimate of the memory a render of width x height pixels holds at its peak: the
+// RenderState, then at the end the mean radiance (and, when blurred, two more radiance images),
+// the mean depth, and the larger output stage: the two 8-bit images and their encoded bytes,
+// or an EXR's 14 float layers and its encoded bytes.
+uint64_t render_memory_bytes(int width, int height, bool blurred);
+
+inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
+inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean
+inline constexpr int kMaxPassSamples = 64;         // per pixel and pass
+
+// Whether plan_pass reads the image's statistics for the next pass (adaptive allocation
+// after its warm-up).
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state);
+
+}  // namespace kr

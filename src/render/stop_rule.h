@@ -1,0 +1,56 @@
+// When a progressive render stops: the StopRule every driver of passes takes (the CLI, the
+// viewer's render thread, MPI ranks), the StopReason that ended it with its name table, the
+// noise rule's check, and the progress and ETA towards the rule that ends first.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <optional>
+
+#include "core/enum_names.h"
+#include "render/render_state.h"
+
+namespace kr {
+
+// max_passes of a render without a pass limit (the viewer's "unlimited").
+inline constexpr int kUnlimitedPasses = std::numeric_limits<int>::max();
+
+// When a progressive render stops: after `max_passes`, after `seconds` of wall time (checked
+// between passes), or when the estimated relative error reaches `noise` (adaptive sampling
+// then spends passes only on pixels above their share of the error). 0 disables a rule.
+struct StopRule {
+    int max_passes = 1;
+    double seconds = 0;
+    double noise = 0;
+    uint32_t min_samples = 16;  // per pixel before the noise rule trusts a variance
+    int adapt_every = 4;        // passes between updates of the adaptive mask
+
+    // Whether a time or noise rule can end the render before its passes.
+    bool open_ended() const { return seconds > 0 || noise > 0; }
+};
+
+// The rule that ended a render; the names are the flags' (`--spp`, `--time`, `--noise`).
+enum class StopReason { passes, time, noise, cancelled };
+inline constexpr EnumNames<StopReason, 4> stop_reason_names{{"spp", "time", "noise", "cancelled"}};
+
+// The noise rule of a StopRule, as every driver of passes applies it: checked after pass
+// `passes` when the rule has a target, from min_samples passes on and every adapt_every
+// passes (the adaptive mask is updated at the same checks).
+bool noise_check_due(const StopRule& rule, int passes);
+// The check itself: true when the image's estimated relative error is within the target, or
+// no pixel is above its share of it; otherwise updates `state`'s adaptive mask.
+bool noise_target_met(RenderState& state, const StopRule& rule);
+
+// Where a render stands against its StopRule, for a progress bar and its ETA.
+struct StopProgress {
+    double fraction = -1;             // 0..1 towards the rule nearest to ending it; -1: no rule
+    double eta = -1;                  // seconds until the first rule is met; -1: unknown
+    std::optional<StopReason> nearest;  // the rule `fraction` is towards
+};
+
+// After `passes` passes taking `seconds` (the time rule's clock), with the image's estimated
+// relative error `noise` (<= 0: not known yet). The noise rule's ETA assumes the error falls
+// as 1/sqrt(passes).
+StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise);
+
+}  // namespace kr
