@@ -51,8 +51,7 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
     model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
-        s.stop_seconds = options_.render.stop.seconds;
-        s.stop_noise = options_.render.stop.noise;
+        s.stop = options_.render.stop;
     });
     try {
         model_.load(options_.scene);
@@ -131,16 +130,14 @@ void ViewerApp::sync_worker() {
     const ViewerSettings& s = model_.settings();
     Submitted& sub = submitted_;
     if (s.paused != sub.paused) worker_->set_paused(sub.paused = s.paused);
-    if (s.unlimited != sub.unlimited) worker_->set_unlimited(sub.unlimited = s.unlimited);
-    if (s.stop_seconds != sub.stop_seconds || s.stop_noise != sub.stop_noise)
-        worker_->set_stop_rule(sub.stop_seconds = s.stop_seconds, sub.stop_noise = s.stop_noise);
+    const StopRule rule = s.stop_rule();
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
-        sub.target = s.render.target_spp;
-        worker_->submit({sub.generation, model_.prepared(), s.render});
+        sub.stop = rule;
+        worker_->submit({sub.generation, model_.prepared(), s.render, rule});
     }
-    // A new target keeps the samples taken (the reset rule: run control).
-    if (s.render.target_spp != sub.target) worker_->set_target_spp(sub.target = s.render.target_spp);
+    // A new rule (target, unlimited, time, noise) keeps the samples taken (the reset rule: run control).
+    if (rule != sub.stop) worker_->set_stop_rule(sub.stop = rule);
 }
 
 bool ViewerApp::fetch_frame() {

@@ -76,9 +76,8 @@ private:
     // What the render thread was last given.
     struct Submitted {
         uint64_t generation = 0;
-        bool paused = false, unlimited = false;
-        double stop_seconds = 0, stop_noise = 0;
-        int target = 0;
+        bool paused = false;
+        StopRule stop;
     } submitted_;
 
     // The window.

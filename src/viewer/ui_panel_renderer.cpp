@@ -40,13 +40,13 @@ void panel_renderer(PanelContext& ctx) {
     if (ImGui::Checkbox("pause (Space)", &paused))
         ctx.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.paused = paused; }, "pause");
     // The stop rules of render --time / --noise; 0 turns each off.
-    double stop_seconds = settings.stop_seconds, stop_noise_percent = 100 * settings.stop_noise;
+    double stop_seconds = settings.stop.seconds, stop_noise_percent = 100 * settings.stop.noise;
     ImGui::SetNextItemWidth(120);
     if (field(ctx, "stop after s (0: off)", &stop_seconds, 1, 0.5f, 0.0, 1e9, "%.1f"))
-        ctx.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.stop_seconds = stop_seconds; }, "stop after s");
+        ctx.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.stop.seconds = stop_seconds; }, "stop after s");
     ImGui::SetNextItemWidth(120);
     if (field(ctx, "stop at noise % (0: off, adaptive)", &stop_noise_percent, 1, 0.05f, 0.0, 100.0, "%.2f"))
-        ctx.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.stop_noise = stop_noise_percent / 100; },
+        ctx.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) { s.stop.noise = stop_noise_percent / 100; },
                  "stop at noise");
 }
 
