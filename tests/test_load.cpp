@@ -478,6 +478,35 @@ TEST_F(LoadErrors, TranslucentDielectricLoads) {
                  "/materials/1", "missing key \"roughness\"");
 }
 
+// The loader reads each material type's parameters from material_params (scene.h): every
+// parameter of the table is required, and a number outside its range is refused in its words.
+TEST_F(LoadErrors, MaterialParametersFollowTheTable) {
+    const std::string glass = R"({"id": "glass", "type": "fresnel dielectric", "rhoR": [1, 1, 1], "rhoT": [1, 1, 1], "eta": 1.5})";
+    for (const MaterialType type : {MaterialType::diffuse, MaterialType::specular, MaterialType::glossy,
+                                    MaterialType::dielectric, MaterialType::translucent}) {
+        const auto params = material_params(type);
+        ASSERT_FALSE(params.empty());
+        for (size_t missing = 0; missing < params.size(); ++missing) {
+            std::string m = R"({"id": "glass", "type": ")" + std::string(material_type_names.name(type)) + "\"";
+            for (size_t k = 0; k < params.size(); ++k)
+                if (k != missing)
+                    m += ", \"" + std::string(params[k].name) + "\": " + (params[k].colour ? "[0.5, 0.5, 0.5]" : "0.5");
+            m += "}";
+            expect_error(edit(kBaseScene, glass, m), "/materials/1",
+                         "missing key \"" + std::string(params[missing].name) + "\"");
+        }
+        for (const MaterialParam& param : params) {
+            if (param.colour) continue;
+            std::string m = R"({"id": "glass", "type": ")" + std::string(material_type_names.name(type)) + "\"";
+            for (const MaterialParam& k : params)
+                m += ", \"" + std::string(k.name) + "\": " + (k.colour ? "[0.5, 0.5, 0.5]" : &k == &param ? "-1" : "0.5");
+            m += "}";
+            expect_error(edit(kBaseScene, glass, m), "/materials/1/" + std::string(param.name),
+                         "expected " + std::string(param.expected) + ", got -1");
+        }
+    }
+}
+
 TEST_F(LoadErrors, LensCameraNeedsFocalDistanceAndAlpha) {
     expect_error(edit(kBaseScene, R"("type": "pinhole")", R"("type": "lens-based")"), "/cameras/0",
                  "missing key \"focal distance\"");

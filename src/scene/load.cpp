@@ -577,39 +577,38 @@ void Loader::read_camera(const Json& j, const std::string& pointer, size_t index
     out_.scene.cameras.push_back(std::move(cam));
 }
 
+// A material number's range as a missing key's message gives it: "in [0, 1)", "> 0".
+std::string number_range_text(const MaterialParam& param) {
+    auto text = [](double x) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", x);
+        return std::string(buf);
+    };
+    if (std::isinf(param.hi)) return (param.lo_open ? "> " : ">= ") + text(param.lo);
+    return std::string("in ") + (param.lo_open ? "(" : "[") + text(param.lo) + ", " + text(param.hi) +
+           (param.hi_open ? ")" : "]");
+}
+
 void Loader::read_material(const Json& j, const std::string& pointer, size_t index) {
     Material mat;
     const Owner owner{Category::materials, index};
     std::tie(mat.id, mat.type) = header(j, pointer, &materials_, material_type_names, "material");
-    auto rho = [this, owner](Color& target) {
-        return [this, owner, t = &target](const Json& v, const std::string& p) {
-            *t = color(v, p, owner, true);
-        };
-    };
-    const Field roughness{"roughness", "a number in [0, 1)", [&](const Json& v, const std::string& p) {
-                              mat.roughness = checked(v, p, owner, "a roughness in [0, 1)",
-                                                      [](double x) { return x >= 0 && x < 1; });
-                          }};
-    const Field eta{"eta", "a number > 0", [&](const Json& v, const std::string& p) {
-                        mat.eta = checked(v, p, owner, "a refractive index eta > 0",
-                                          [](double x) { return x > 0; });
-                    }};
-    const std::string colour = "an array of 3 numbers >= 0";
     std::vector<Field> fields = {id_field(), type_field()};
-    switch (mat.type) {
-        case MaterialType::diffuse:
-        case MaterialType::specular: fields.push_back({"rho", colour, rho(mat.rho)}); break;
-        case MaterialType::glossy:
-            fields.push_back({"rho", colour, rho(mat.rho)});
-            fields.push_back(roughness);
-            break;
-        case MaterialType::dielectric:
-        case MaterialType::translucent:
-            fields.push_back({"rhoR", colour, rho(mat.rho_r)});
-            fields.push_back({"rhoT", colour, rho(mat.rho_t)});
-            fields.push_back(eta);
-            if (mat.type == MaterialType::translucent) fields.push_back(roughness);
-            break;
+    for (const MaterialParam& param : material_params(mat.type)) {
+        if (param.colour)
+            fields.push_back({std::string(param.name), "an array of 3 numbers >= 0",
+                              [&, t = &(mat.*param.colour)](const Json& v, const std::string& p) {
+                                  *t = color(v, p, owner, true);
+                              }});
+        else
+            fields.push_back({std::string(param.name), "a number " + number_range_text(param),
+                              [&, t = &(mat.*param.number)](const Json& v, const std::string& p) {
+                                  const double x = number(v, p);
+                                  if (!param.in_range(x))
+                                      range_problem(owner, p, "expected " + std::string(param.expected) +
+                                                                  ", got " + number_text(v));
+                                  *t = x;
+                              }});
     }
     read_fields(j, pointer, fields);
     out_.scene.materials.push_back(std::move(mat));

@@ -33,20 +33,9 @@ Json material_json(const Material& m) {
     Json j;
     j["id"] = m.id;
     j["type"] = material_type_names.name(m.type);
-    switch (m.type) {
-        case MaterialType::diffuse:
-        case MaterialType::specular: j["rho"] = vec3(m.rho); break;
-        case MaterialType::glossy:
-            j["rho"] = vec3(m.rho);
-            j["roughness"] = m.roughness;
-            break;
-        case MaterialType::dielectric:
-        case MaterialType::translucent:
-            j["rhoR"] = vec3(m.rho_r);
-            j["rhoT"] = vec3(m.rho_t);
-            j["eta"] = m.eta;
-            if (m.type == MaterialType::translucent) j["roughness"] = m.roughness;
-            break;
+    for (const MaterialParam& param : material_params(m.type)) {
+        if (param.colour) j[std::string(param.name)] = vec3(m.*param.colour);
+        else j[std::string(param.name)] = m.*param.number;
     }
     return j;
 }

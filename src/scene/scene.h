@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -59,6 +60,26 @@ struct Material {
     double eta = 1.5;     // dielectrics: refractive index inside / outside
     double roughness = 0; // glossy reflection, translucent dielectric: beta in [0, 1)
 };
+
+// One parameter of a material type as the file names it, read by the loader, the saver and
+// the viewer's Materials panel: the member it sets, what the file may hold, and the panel's
+// slider. A colour is three reflectances >= 0 (above 1 warns); a number lies in
+// [lo, hi], with either end open.
+struct MaterialParam {
+    std::string_view name;                 // "rho", "rhoR", "eta", ...
+    Color Material::*colour = nullptr;     // a colour parameter, or
+    double Material::*number = nullptr;    // a number parameter
+    std::string_view expected;             // a number's range in words: "a roughness in [0, 1)"
+    double lo = 0, hi = 0;
+    bool lo_open = false, hi_open = false;
+    double edit_lo = 0, edit_hi = 1;       // the panel's slider range
+    float edit_speed = 0.005f;             // and its step per pixel dragged
+
+    bool in_range(double x) const { return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi); }
+};
+
+// The parameters of a material type, in the file's order.
+std::span<const MaterialParam> material_params(MaterialType type);
 
 struct Shape {
     std::string id;

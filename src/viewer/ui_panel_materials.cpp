@@ -1,4 +1,4 @@
-// The Materials panel: each used material's type and parameters.
+// The Materials panel: each used material's type and its parameters (material_params).
 #include <set>
 #include <string>
 
@@ -19,21 +19,13 @@ void panel_materials(PanelContext& ctx) {
         ImGui::PushID(index);
         if (ImGui::TreeNode(m.id.c_str())) {
             bool changed = combo("type", m.type, material_type_names);
-            switch (m.type) {
-                case MaterialType::diffuse:
-                case MaterialType::specular: changed |= field(ctx, "rho", &m.rho.x, 3, 0.005f, 0.0, 1.0); break;
-                case MaterialType::glossy:
-                    changed |= field(ctx, "rho", &m.rho.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field(ctx, "roughness", &m.roughness, 1, 0.002f, 0.0, 0.999);
-                    break;
-                case MaterialType::dielectric:
-                case MaterialType::translucent:
-                    changed |= field(ctx, "rhoR", &m.rho_r.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field(ctx, "rhoT", &m.rho_t.x, 3, 0.005f, 0.0, 1.0);
-                    changed |= field(ctx, "eta", &m.eta, 1, 0.002f, 1.0 / 4, 4.0);
-                    if (m.type == MaterialType::translucent)
-                        changed |= field(ctx, "roughness", &m.roughness, 1, 0.002f, 0.0, 0.999);
-                    break;
+            // The type's parameters as the file has them (scene.h's material_params).
+            for (const MaterialParam& param : material_params(m.type)) {
+                const std::string label(param.name);
+                if (param.colour) changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
+                else
+                    changed |= field(ctx, label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo,
+                                     param.edit_hi);
             }
             const std::string name = "material " + m.id;
             if (changed)
