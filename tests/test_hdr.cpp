@@ -22,6 +22,7 @@
 #include "core/image_compare.h"
 #include "core/image_hdr.h"
 #include "render/aov.h"
+#include "render/outputs.h"
 #include "test_util.h"
 #include "core/image_io.h"
 
@@ -266,7 +267,7 @@ HdrImage render_hdr(const Scene& scene, int spp, uint64_t seed, Estimator estima
     StopRule rule;
     rule.max_passes = spp;
     render_until(prepared, settings, state, rule);
-    return hdr_from_render(prepared, state, state.radiance(), true);
+    return hdr_from_developed(develop(prepared, render_estimates(state, kAllLayers), DevelopOptions{}));
 }
 
 // The scene's one active light, the camera, a material by name: the three changes.
@@ -365,7 +366,8 @@ TEST(HdrRender, ToneMappedExrRadianceEqualsTheEightBitImage) {
     rule.max_passes = 8;
     render_until(prepared, settings, state, rule);
     const Image radiance = state.radiance();
-    const HdrImage exr = decode_exr(encode_exr(hdr_from_render(prepared, state, radiance, true)), "mem.exr");
+    const HdrImage exr = decode_exr(
+        encode_exr(hdr_from_developed(develop(prepared, render_estimates(state, kAllLayers), DevelopOptions{}))), "mem.exr");
     const Rgb8Image direct = tonemap(radiance, ToneMap::sigmoid), from_exr = tonemap(exr.radiance(), ToneMap::sigmoid);
     int steps_crossed = 0;
     for (size_t i = 0; i < direct.bytes.size(); ++i) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/file_write.h"
+#include "core/image_formats.h"
 #include "core/image_io.h"
 #include "test_util.h"
 
@@ -350,4 +351,43 @@ TEST_F(Outputs, PsnrNamesFilesAndReportsAFailedOutput) {
                                            "' -q >/dev/full 2>/dev/null")
                                               .c_str());
     EXPECT_TRUE(WIFEXITED(render_status) && WEXITSTATUS(render_status) == 1) << render_status;
+}
+
+// The format table (core/image_formats.h): which format a name asks for, which files one
+// output writes, and every format read back, whatever its name, as render writes it.
+TEST_F(Outputs, FormatTableNamesEveryOutputAndReadsWhatRenderWrites) {
+    EXPECT_EQ(output_format("a.PNG").format, ImageFormat::png);
+    EXPECT_EQ(output_format("a.Exr").format, ImageFormat::exr);
+    EXPECT_EQ(output_format("a.pfm").format, ImageFormat::pfm);
+    EXPECT_EQ(output_format("a.jpg").format, ImageFormat::ppm);  // any other name: PPM
+    EXPECT_EQ(output_format("a").format, ImageFormat::ppm);
+    EXPECT_EQ(format_by_extension("a.jpg"), nullptr);
+    EXPECT_EQ(output_file_paths("x/a.exr"), std::vector<fs::path>{"x/a.exr"});
+    EXPECT_EQ(output_file_paths("x/a.pfm"), (std::vector<fs::path>{"x/a.pfm", "x/a-depth.pfm"}));
+    EXPECT_EQ(output_file_paths("a"), (std::vector<fs::path>{"a", "a-depth.ppm"}));
+    for (const ImageFormatInfo& f : kImageFormats) {
+        EXPECT_EQ(&format_info(f.format), &f);
+        EXPECT_EQ(format_by_extension(std::string("out") + f.extension), &f);
+        EXPECT_EQ(f.depth_beside, f.format != ImageFormat::exr) << f.name;
+        EXPECT_TRUE(f.layers & kLayerRadiance && f.layers & kLayerDepth) << f.name;
+    }
+
+    const fs::path s = scene();
+    for (const ImageFormatInfo& f : kImageFormats) {
+        const fs::path out = dir / (std::string("out") + f.extension);
+        const test::CommandResult r = cli("render '" + s.string() + "' -q -o '" + out.string() + "'");
+        ASSERT_EQ(r.status, 0) << r.err;
+        for (const fs::path& file : output_file_paths(out)) {
+            // Read by content: the same bytes under a name of no format read alike.
+            const fs::path renamed = dir / "renamed.bin";
+            fs::copy_file(file, renamed, fs::copy_options::overwrite_existing);
+            const ImageFile image = read_image_file(renamed);
+            EXPECT_EQ(image.hdr, f.hdr) << file;
+            EXPECT_EQ(image.width(), 16) << file;
+            EXPECT_EQ(image.height(), 12) << file;
+        }
+    }
+    const ImageFile exr = read_image_file(dir / "out.exr");
+    EXPECT_EQ(exr.radiance.albedo.size(), 3u * 16 * 12);
+    EXPECT_EQ(exr.radiance.variance.size(), 3u * 16 * 12);
 }

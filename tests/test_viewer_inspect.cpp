@@ -327,6 +327,9 @@ TEST(ViewOptions, CompareFlags) {
     EXPECT_EQ(o.reference, fs::path("r.exr"));
     EXPECT_TRUE(o.scripted());
     EXPECT_THROW(parse({"--view", "sideways"}), UsageError);
+    EXPECT_EQ(parse({"--save-image", "out.EXR"}).save_image, fs::path("out.EXR"));
+    EXPECT_TRUE(parse({"--save-image", "out.pfm"}).scripted());
+    EXPECT_THROW(parse({"--save-image", "scene.json"}), UsageError);
     EXPECT_THROW(parse({"--split", "1.5"}), UsageError);
     EXPECT_THROW(parse({"--zoom", "64"}), UsageError);
     EXPECT_THROW(parse({"--probe", "3"}), UsageError);

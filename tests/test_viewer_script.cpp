@@ -6,9 +6,12 @@
 #include <filesystem>
 #include <string>
 
+#include "core/image_hdr.h"
 #include "core/image_io.h"
+#include "render/outputs.h"
 #include "scene/load.h"
 #include "test_util.h"
+#include "viewer/inspect.h"
 #include "viewer/latency.h"
 #include "viewer/save_dialog.h"
 #include "viewer/script.h"
@@ -115,12 +118,29 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     EXPECT_THROW(save_output(SaveKind::png, dir / "a.png", m, nullptr), std::exception);
     EXPECT_FALSE(std::filesystem::exists(dir / "a.ppm"));
 
+    // A full-resolution frame of the current scene, with the layers Save develops.
     Snapshot full;
+    full.generation = m.generation();
     full.radiance = Image(4, 3);
+    full.depth.assign(12, 1.0);
+    full.sample_count.assign(12, 1);
+    full.variance.assign(36, 0.0f);
     EXPECT_EQ(save_output(SaveKind::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
     EXPECT_EQ(read_image(dir / "a.ppm").width, 4);
+    EXPECT_EQ(read_image(dir / "a-depth.ppm").width, 4);
     save_output(SaveKind::pfm, dir / "a.pfm", m, &full);
     EXPECT_TRUE(std::filesystem::exists(dir / "a.pfm"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "a-depth.pfm"));
+    // The kind is the name's format; a frame of an older scene is not saved.
+    EXPECT_THROW(save_output(SaveKind::png, dir / "b.ppm", m, &full), std::exception);
+    Snapshot old = full;
+    --old.generation;
+    EXPECT_THROW(save_output(SaveKind::ppm, dir / "c.ppm", m, &old), std::exception);
+    EXPECT_FALSE(std::filesystem::exists(dir / "b.ppm") || std::filesystem::exists(dir / "c.ppm"));
+    EXPECT_EQ(save_targets(SaveKind::exr, dir / "a.exr"), std::vector<std::filesystem::path>{dir / "a.exr"});
+    EXPECT_EQ(save_targets(SaveKind::png, dir / "a.png").back(), dir / "a-depth.png");
+    EXPECT_EQ(image_save_path(SaveKind::pfm, "x/out.exr"), std::filesystem::path("x/out.pfm"));
+    EXPECT_EQ(image_save_kind("OUT.EXR"), SaveKind::exr);
 
     // The scene: written as saved, and the model counts as saved.
     ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; }));
@@ -128,6 +148,47 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     save_output(SaveKind::scene, dir / "s.json", m, nullptr);
     EXPECT_FALSE(m.dirty());
     EXPECT_EQ(load_scene_file(dir / "s.json").scene.renderer.depth, 2);
+}
+
+// What the Save panel writes of a frame is what `render -o` writes of the state the frame
+// was taken from (render/outputs.h), for every format: every file, byte for byte.
+TEST_F(SaveDialog, ImageFilesAreTheRenderOutputsOfTheSameState) {
+    Scene scene = load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_06.json").scene;
+    scene.renderer.width = 24;
+    scene.renderer.height = 16;
+    ViewerModel m;
+    m.set_scene(scene);
+    RenderState state(24, 16);
+    StopRule rule;
+    rule.max_passes = 2;
+    render_until(*m.prepared(), m.settings().render, state, rule);
+    Snapshot frame;
+    frame.generation = m.generation();
+    frame.radiance = state.radiance();
+    record_pixel_statistics(state, frame);
+
+    for (const char* ext : {".ppm", ".png", ".exr", ".pfm"}) {
+        const std::filesystem::path saved = dir / (std::string("saved") + ext), rendered = dir / (std::string("cli") + ext);
+        save_output(image_save_kind(saved), saved, m, &frame);
+        OutputRequest request;
+        request.path = rendered;
+        request.display = m.settings().tone;
+        write_files_atomic(output_files(*m.prepared(), state, request));
+        const std::vector<std::filesystem::path> a = output_file_paths(saved), b = output_file_paths(rendered);
+        ASSERT_EQ(a.size(), b.size()) << ext;
+        EXPECT_EQ(a.size(), std::string(ext) == ".exr" ? 1u : 2u) << ext;
+        for (size_t i = 0; i < a.size(); ++i) {
+            EXPECT_FALSE(test::read_file(a[i]).empty()) << a[i];
+            EXPECT_EQ(test::read_file(a[i]), test::read_file(b[i])) << a[i];
+        }
+    }
+    // The EXR holds every layer.
+    const HdrImage exr = read_hdr(dir / "saved.exr");
+    EXPECT_EQ(exr.depth.size(), 24u * 16u);
+    EXPECT_EQ(exr.albedo.size(), 3u * 24u * 16u);
+    EXPECT_EQ(exr.normal.size(), 3u * 24u * 16u);
+    EXPECT_EQ(exr.samples.size(), 24u * 16u);
+    EXPECT_EQ(exr.variance.size(), 3u * 24u * 16u);
 }
 
 }  // namespace

@@ -18,6 +18,8 @@
 
 #include "core/image.h"
 #include "core/image_compare.h"
+#include "core/image_formats.h"
+#include "core/image_hdr.h"
 #include "core/image_io.h"
 #include "viewer/compare_view.h"
 #include "viewer/inspect.h"
@@ -111,6 +113,35 @@ TEST_F(ViewerWindow, ScriptedEditsScreenshotMatchesHeadlessRender) {
     const ViewRun plain = keithray("render '" + scene(3) + "' --spp 3 -q -o '" + (dir / "plain.ppm").string() + "'", false);
     ASSERT_EQ(plain.status, 0);
     EXPECT_LT(kr::psnr(a, kr::read_ppm(dir / "plain.ppm")), 30);
+}
+
+// The scripted --save-image goes through the Save panel's code, and writes what `render -o`
+// writes of the same render for the same name: every file, byte for byte, in each format
+// (the 8-bit image and its depth map, the EXR with every layer, the PFM and its depth).
+TEST_F(ViewerWindow, SaveImageWritesWhatRenderWritesForTheSameName) {
+    for (const std::string ext : {"ppm", "png", "exr", "pfm"}) {
+        const fs::path saved = dir / ("saved." + ext), rendered = dir / ("rendered." + ext);
+        const std::string flags = " --spp 2 --seed 5 --exposure 0.5";
+        const ViewRun v = keithray("view '" + scene(6) + "'" + flags + " --save-image '" + saved.string() +
+                                       "' --timeout 300",
+                                   true);
+        ASSERT_EQ(v.status, 0) << v.out << v.err;
+        EXPECT_NE(v.out.find("image: " + saved.string() + " (2 spp)"), std::string::npos) << v.out;
+        const ViewRun r = keithray("render '" + scene(6) + "'" + flags + " -q -o '" + rendered.string() + "'", false);
+        ASSERT_EQ(r.status, 0) << r.err;
+        const std::vector<fs::path> a = kr::output_file_paths(saved), b = kr::output_file_paths(rendered);
+        ASSERT_EQ(a.size(), ext == "exr" ? 1u : 2u);
+        ASSERT_EQ(a.size(), b.size());
+        for (size_t i = 0; i < a.size(); ++i) {
+            const std::string bytes = kr::test::read_file(a[i]);
+            EXPECT_GT(bytes.size(), 1000u) << a[i];
+            EXPECT_TRUE(bytes == kr::test::read_file(b[i])) << a[i] << " differs from " << b[i];
+        }
+    }
+    // Every layer is in the EXR.
+    const kr::HdrImage exr = kr::read_hdr(dir / "saved.exr");
+    EXPECT_FALSE(exr.depth.empty() || exr.albedo.empty() || exr.normal.empty() || exr.samples.empty() ||
+                 exr.variance.empty());
 }
 
 // Tone map options go to the display shader only; the screenshot follows kr::tonemap.

@@ -19,6 +19,7 @@
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 
 namespace fs = std::filesystem;
 

@@ -8,11 +8,12 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "core/args.h"
 #include "core/image_compare.h"
 #include "core/file_write.h"
-#include "core/image_hdr.h"
+#include "core/image_formats.h"
 #include "core/image_io.h"
 #include "core/text.h"
 
@@ -51,15 +52,12 @@ struct InputImage {
 };
 
 InputImage load_input(const std::string& path) {
+    ImageFile file = read_image_file(path);
     InputImage in;
     in.name = path;
-    if (is_hdr_file(path)) {
-        in.hdr = true;
-        in.radiance = read_hdr(path);
-        in.rgb8 = tonemap(in.radiance.radiance(), ToneMap::sigmoid);
-    } else {
-        in.rgb8 = read_image(path);
-    }
+    in.hdr = file.hdr;
+    in.radiance = std::move(file.radiance);
+    in.rgb8 = in.hdr ? tonemap(in.radiance.radiance(), ToneMap::sigmoid) : std::move(file.rgb8);
     return in;
 }
 
@@ -106,8 +104,8 @@ CompareOptions parse_compare(int argc, char** argv) {
     o.test = files[0];
     o.reference = files[1];
     if (o.diff) {
-        const std::string ext = std::filesystem::path(*o.diff).extension().string();
-        if (ext != ".png" && ext != ".PNG" && ext != ".ppm" && ext != ".PPM")
+        const ImageFormatInfo* format = format_by_extension(*o.diff);
+        if (!format || format->hdr)
             throw UsageError{"--diff writes an 8-bit picture: give it a name ending in .png or .ppm"};
         // The picture never replaces an image being compared.
         for (const std::string& input : files) {

@@ -24,6 +24,7 @@
 #include "core/image_io.h"
 #include "render/progressive.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 
 namespace fs = std::filesystem;
 

@@ -26,13 +26,13 @@
 #include "core/memory.h"
 #include "core/text.h"
 #include "core/file_write.h"
-#include "core/image_io.h"
-#include "core/image_hdr.h"
-#include "render/aov.h"
+#include "core/image_formats.h"
 #include "render/checkpoint.h"
 #include "render/options.h"
+#include "render/outputs.h"
 #include "render/progressive.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 #include "viewer/gl_offscreen.h"
 #include "viewer/viewer.h"
 
@@ -140,7 +140,7 @@ Options parse_options(int argc, char** argv) {
         throw UsageError{"-o needs exactly one scene file (it names a single output)"};
     if ((o.checkpoint || o.resume) && o.scenes.size() != 1)
         throw UsageError{"--checkpoint and --resume need exactly one scene file (a checkpoint holds one render)"};
-    if (o.gl && o.output && (is_exr_path(*o.output) || is_pfm_path(*o.output)))
+    if (o.gl && o.output && output_format(*o.output).hdr)
         throw UsageError{"--gl tone maps for an 8-bit output; an .exr or .pfm output is not tone mapped"};
     return o;
 }
@@ -222,232 +222,309 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
                 costs.front().exchanges, between);
 }
 
-// Loads, renders and writes one scene. Returns false (after printing why) on failure.
-// `stage` says what the work in progress needs memory for, for the caller's message.
-// Under MPI every rank runs it: rank 0 reads the scene and the checkpoint and sends their
-// bytes, every rank renders its rows, rank 0 gathers the state and writes.
-bool render_scene_file(const fs::path& scene_file, const Options& opt, std::string& stage, const Cluster& cluster) {
-    const std::string file = shown(scene_file);
-    const bool leader = cluster.leader();
-    LoadedScene loaded;
-    RenderScene scene;
-    std::vector<std::string> warnings;
-    try {
-        stage = "the scene";
-        std::string text;
-        bool read = true;
-        if (leader) try {
-                text = read_scene_text(scene_file);
-            } catch (const SceneError& e) {
-                std::fprintf(stderr, "error: %s\n", e.what());
-                read = false;
-            }
-        if (!cluster.broadcast(read)) return false;
-        cluster.broadcast(text);
-        loaded = parse_scene(text, scene_file);
-        warnings = loaded.warnings;
-        stage = "the prepared scene and its BVH";
-        scene = prepare_scene(loaded.scene, &warnings);
-    } catch (const SceneError& e) {
-        if (leader) std::fprintf(stderr, "error: %s\n", e.what());
-        return false;
-    }
-    if (leader)
-        for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-
-    // The file's renderer and display blocks, then the command line over them.
-    RenderSettings settings = apply_render_options(opt.render, loaded.scene);
-    settings.kernels = opt.kernels;
-
-    const fs::path output = opt.output ? *opt.output : loaded.scene.output_path();
-    // An EXR holds the depth as a layer; every other output has its depth map beside it.
-    const bool exr = is_exr_path(output), pfm = is_pfm_path(output);
-    const fs::path depth_output = depth_path_for(output);
-    std::vector<fs::path> outputs{output};
-    if (!exr) outputs.push_back(depth_output);
-    // No input of this command is ever overwritten: not this scene file, nor another one
-    // still to be rendered (nor one already rendered).
-    bool overwrites_input = false;
-    if (leader)  // the rank that writes
-        for (const fs::path& input : opt.scenes)
-            for (const fs::path& written : outputs)
-                if (!overwrites_input && same_file(written, input)) {
-                    std::fprintf(stderr,
-                                 "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
-                                 file.c_str(), shown(written).c_str(), shown(input).c_str(),
-                                 same_file(input, scene_file) ? " itself" : "");
-                    overwrites_input = true;
-                }
-    // The checkpoint is written during the render: never over a scene file or an output.
-    std::vector<fs::path> kept = opt.scenes;
-    kept.insert(kept.end(), outputs.begin(), outputs.end());
-    if (leader && opt.checkpoint)
-        for (const fs::path& other : kept)
-            if (!overwrites_input && same_file(*opt.checkpoint, other)) {
-                std::fprintf(stderr, "error: --checkpoint %s would overwrite %s; nothing written\n",
-                             shown(*opt.checkpoint).c_str(), shown(other).c_str());
-                overwrites_input = true;
-            }
-    if (cluster.broadcast(overwrites_input)) return false;
-
-    // Refused before allocating when the render cannot fit in the memory the process may use
-    // (core/memory.h): better at once than after hours, or by the kernel's OOM killer.
-    const int width = scene.renderer.width, height = scene.renderer.height;
-    const std::string image = std::to_string(width) + "x" + std::to_string(height) + " image";
-    const uint64_t needed = render_memory_bytes(width, height, opt.blur > 0);
-    const MemoryLimit limit = memory_limit();
-    if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
-        std::fprintf(stderr, "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)%s\n",
-                     file.c_str(), image.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
-                     format_bytes(limit.bytes).c_str(),
-                     cluster.distributed() ? (" on rank " + std::to_string(cluster.rank())).c_str() : "");
-    if (cluster.any_flags(needed > limit.bytes)) return false;
-    stage = "the render state of a " + image;
-    RenderState state;
-    state.reset(width, height);
-    const bool show_progress = leader && !opt.quiet && ::isatty(STDERR_FILENO);
-    const auto start = std::chrono::steady_clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-    double last_draw = -1;
-    const StopRule rule = render_stop_rule(opt.render, settings);
-    const bool open_ended = rule.open_ended();
-    const bool capped = open_ended && !opt.render.spp;
-
-    const CheckpointKey key = checkpoint_key(loaded.scene, scene, settings, rule);
-    if (opt.resume) {
-        stage = "the checkpoint of a " + image;
-        std::string bytes, error;
-        if (leader) try {
-                bytes = read_checkpoint_file(*opt.resume, key);
-            } catch (const std::runtime_error& e) {
-                error = e.what();
-            }
-        // Every rank decodes rank 0's bytes and so comes to the same verdict; rank 0 says it.
-        if (error.empty()) {
-            cluster.broadcast(bytes);
-            try {
-                decode_checkpoint(bytes, *opt.resume, key, state);
-            } catch (const std::runtime_error& e) {
-                error = e.what();
-            }
-        }
-        if (cluster.broadcast(!error.empty())) {
-            if (leader) std::fprintf(stderr, "error: --resume %s; nothing rendered\n", error.c_str());
-            return false;
-        }
-        if (!leader) state.rays = state.nonfinite_samples = 0;  // counted once, at rank 0
-    }
-    const uint64_t rays_before = state.rays;
-    auto last_checkpoint = std::chrono::steady_clock::now();
-    bool checkpoint_written = false;  // the last attempt succeeded (rank 0)
-    struct sigaction previous_int {}, previous_term {};
-    if (opt.checkpoint) {
-        // SIGINT and SIGTERM end the pass under way, write the checkpoint and stop.
+// A checkpointed render's SIGINT and SIGTERM handlers while it runs: they end the pass under
+// way, the checkpoint is written and the render stops. The previous handlers come back after.
+class StopSignals {
+public:
+    explicit StopSignals(bool install) : installed_(install) {
+        if (!installed_) return;
         struct sigaction stop {};
         stop.sa_handler = on_stop_signal;
         sigemptyset(&stop.sa_mask);
-        ::sigaction(SIGINT, &stop, &previous_int);
-        ::sigaction(SIGTERM, &stop, &previous_term);
+        ::sigaction(SIGINT, &stop, &previous_int_);
+        ::sigaction(SIGTERM, &stop, &previous_term_);
     }
-    const std::unique_ptr<PassHooks> hooks = cluster.deal_rows(open_ended);
+    ~StopSignals() {
+        if (!installed_) return;
+        ::sigaction(SIGINT, &previous_int_, nullptr);
+        ::sigaction(SIGTERM, &previous_term_, nullptr);
+    }
+    StopSignals(const StopSignals&) = delete;
+    StopSignals& operator=(const StopSignals&) = delete;
 
-    stage = "rendering a " + image;
-    const StopReason reason = render_until(scene, settings, state, rule, [&](const RenderState& s) {
-        if (opt.checkpoint) {
-            // One decision for every rank: rank 0's clock, any rank's signal.
-            const bool due = leader && std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                                     last_checkpoint).count() >= opt.checkpoint_every;
-            const int flags = cluster.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
-            if (flags) {
-                checkpoint_written = write_checkpoint(cluster, *opt.checkpoint, key, state);
-                last_checkpoint = std::chrono::steady_clock::now();
-            }
-            if (flags & 2) return false;
+private:
+    bool installed_;
+    struct sigaction previous_int_ {}, previous_term_ {};
+};
+
+// One scene's render, in the order its steps run: load, check the outputs, check the memory,
+// resume, render with checkpoints, gather and report, write. Each step that fails prints why
+// (rank 0) and returns false. `stage` says what the work in progress needs memory for, for
+// the caller's message. Under MPI every rank runs it: rank 0 reads the scene and the
+// checkpoint and sends their bytes, every rank renders its rows, rank 0 gathers the state
+// and writes.
+class SceneRender {
+public:
+    SceneRender(const fs::path& scene_file, const Options& opt, std::string& stage, const Cluster& cluster)
+        : scene_file_(scene_file), opt_(opt), stage_(stage), cluster_(cluster), file_(shown(scene_file)),
+          leader_(cluster.leader()) {}
+
+    bool run() {
+        if (!load() || !check_outputs() || !check_memory()) return false;
+        start_ = std::chrono::steady_clock::now();
+        set_stop_rule();
+        if (!resume()) return false;
+        const StopReason reason = render();
+        if (reason == StopReason::cancelled) {
+            if (leader_)
+                std::fprintf(stderr, "%s%s: stopped by a signal after %d passes; no image written; %s %s\n",
+                             show_progress_ ? "\n" : "", file_.c_str(), state_.passes, shown(*opt_.checkpoint).c_str(),
+                             checkpoint_written_ ? "holds them (go on with --resume)" : "could not be written (above)");
+            return false;
         }
-        if (show_progress && elapsed() - last_draw > 0.1) {
-            // The bar goes towards the rule nearest to ending the render.
-            const double noise = rule.noise > 0 ? s.relative_error() : 0;
-            const StopProgress progress = stop_progress(rule, s.passes, elapsed(), noise);
-            char what[96];
-            if (open_ended) std::snprintf(what, sizeof what, "%d passes", s.passes);
-            else std::snprintf(what, sizeof what, "%d/%d spp", s.passes, rule.max_passes);
-            if (rule.noise > 0)
-                std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), "  est. error %.4f", noise);
-            draw_progress(progress.fraction, what, elapsed());
-            last_draw = elapsed();
+        gather();
+        if (!leader_) return true;
+        report_stop(reason);
+        if (!write()) return false;
+        report_summary();
+        return true;
+    }
+
+private:
+    double elapsed() const {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    }
+
+    // Rank 0 reads the file and sends its text; every rank parses and prepares it.
+    bool load() {
+        std::vector<std::string> warnings;
+        try {
+            stage_ = "the scene";
+            std::string text;
+            bool read = true;
+            if (leader_) try {
+                    text = read_scene_text(scene_file_);
+                } catch (const SceneError& e) {
+                    std::fprintf(stderr, "error: %s\n", e.what());
+                    read = false;
+                }
+            if (!cluster_.broadcast(read)) return false;
+            cluster_.broadcast(text);
+            loaded_ = parse_scene(text, scene_file_);
+            warnings = loaded_.warnings;
+            stage_ = "the prepared scene and its BVH";
+            scene_ = prepare_scene(loaded_.scene, &warnings);
+        } catch (const SceneError& e) {
+            if (leader_) std::fprintf(stderr, "error: %s\n", e.what());
+            return false;
+        }
+        if (leader_)
+            for (const std::string& w : warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+        // The file's renderer and display blocks, then the command line over them.
+        settings_ = apply_render_options(opt_.render, loaded_.scene);
+        settings_.kernels = opt_.kernels;
+        output_ = opt_.output ? *opt_.output : loaded_.scene.output_path();
+        return true;
+    }
+
+    // No input of this command is ever overwritten: not this scene file, nor another one
+    // still to be rendered (nor one already rendered). The checkpoint, written during the
+    // render, never replaces a scene file or an output.
+    bool check_outputs() {
+        const std::vector<fs::path> outputs = output_file_paths(output_);
+        bool overwrites_input = false;
+        if (leader_)  // the rank that writes
+            for (const fs::path& input : opt_.scenes)
+                for (const fs::path& written : outputs)
+                    if (!overwrites_input && same_file(written, input)) {
+                        std::fprintf(stderr,
+                                     "error: %s: the output %s would overwrite the scene file %s%s; nothing written\n",
+                                     file_.c_str(), shown(written).c_str(), shown(input).c_str(),
+                                     same_file(input, scene_file_) ? " itself" : "");
+                        overwrites_input = true;
+                    }
+        std::vector<fs::path> kept = opt_.scenes;
+        kept.insert(kept.end(), outputs.begin(), outputs.end());
+        if (leader_ && opt_.checkpoint)
+            for (const fs::path& other : kept)
+                if (!overwrites_input && same_file(*opt_.checkpoint, other)) {
+                    std::fprintf(stderr, "error: --checkpoint %s would overwrite %s; nothing written\n",
+                                 shown(*opt_.checkpoint).c_str(), shown(other).c_str());
+                    overwrites_input = true;
+                }
+        return !cluster_.broadcast(overwrites_input);
+    }
+
+    // Refused before allocating when the render cannot fit in the memory the process may use
+    // (core/memory.h): better at once than after hours, or by the kernel's OOM killer.
+    bool check_memory() {
+        const int width = scene_.renderer.width, height = scene_.renderer.height;
+        image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
+        const uint64_t needed = render_memory_bytes(width, height, opt_.blur > 0);
+        const MemoryLimit limit = memory_limit();
+        if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
+            std::fprintf(stderr,
+                         "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)%s\n",
+                         file_.c_str(), image_.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
+                         format_bytes(limit.bytes).c_str(),
+                         cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
+        if (cluster_.any_flags(needed > limit.bytes)) return false;
+        stage_ = "the render state of a " + image_;
+        state_.reset(width, height);
+        show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
+        return true;
+    }
+
+    void set_stop_rule() {
+        rule_ = render_stop_rule(opt_.render, settings_);
+        open_ended_ = rule_.open_ended();
+        capped_ = open_ended_ && !opt_.render.spp;
+        key_ = checkpoint_key(loaded_.scene, scene_, settings_, rule_);
+    }
+
+    // --resume: every rank decodes rank 0's bytes and so comes to the same verdict; rank 0
+    // says it.
+    bool resume() {
+        if (opt_.resume) {
+            stage_ = "the checkpoint of a " + image_;
+            std::string bytes, error;
+            if (leader_) try {
+                    bytes = read_checkpoint_file(*opt_.resume, key_);
+                } catch (const std::runtime_error& e) {
+                    error = e.what();
+                }
+            if (error.empty()) {
+                cluster_.broadcast(bytes);
+                try {
+                    decode_checkpoint(bytes, *opt_.resume, key_, state_);
+                } catch (const std::runtime_error& e) {
+                    error = e.what();
+                }
+            }
+            if (cluster_.broadcast(!error.empty())) {
+                if (leader_) std::fprintf(stderr, "error: --resume %s; nothing rendered\n", error.c_str());
+                return false;
+            }
+            if (!leader_) state_.rays = state_.nonfinite_samples = 0;  // counted once, at rank 0
+        }
+        rays_before_ = state_.rays;
+        return true;
+    }
+
+    // The passes, with the checkpoints, the stop signals and the progress bar between them.
+    StopReason render() {
+        auto last_checkpoint = std::chrono::steady_clock::now();
+        double last_draw = -1;
+        const StopSignals signals(opt_.checkpoint.has_value());
+        hooks_ = cluster_.deal_rows(open_ended_);
+        stage_ = "rendering a " + image_;
+        return render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
+            if (opt_.checkpoint) {
+                // One decision for every rank: rank 0's clock, any rank's signal.
+                const bool due = leader_ && std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                                          last_checkpoint).count() >= opt_.checkpoint_every;
+                const int flags = cluster_.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
+                if (flags) {
+                    checkpoint_written_ = write_checkpoint(cluster_, *opt_.checkpoint, key_, state_);
+                    last_checkpoint = std::chrono::steady_clock::now();
+                }
+                if (flags & 2) return false;
+            }
+            if (show_progress_ && elapsed() - last_draw > 0.1) {
+                // The bar goes towards the rule nearest to ending the render.
+                const double noise = rule_.noise > 0 ? s.relative_error() : 0;
+                const StopProgress progress = stop_progress(rule_, s.passes, elapsed(), noise);
+                char what[96];
+                if (open_ended_) std::snprintf(what, sizeof what, "%d passes", s.passes);
+                else std::snprintf(what, sizeof what, "%d/%d spp", s.passes, rule_.max_passes);
+                if (rule_.noise > 0)
+                    std::snprintf(what + std::strlen(what), sizeof what - std::strlen(what), "  est. error %.4f", noise);
+                draw_progress(progress.fraction, what, elapsed());
+                last_draw = elapsed();
+            }
+            return true;
+        }, hooks_.get());
+    }
+
+    // Every rank's costs, and the state gathered at rank 0 with the job's counts.
+    void gather() {
+        if (cluster_.distributed()) {
+            RankCost mine = hooks_ ? Cluster::cost(*hooks_) : RankCost{};
+            mine.rays = state_.rays - rays_before_;
+            costs_ = cluster_.gather(mine);
+        }
+        uint64_t total_rays = 0, total_nonfinite = 0;
+        cluster_.gather_state(state_, total_rays, total_nonfinite);
+        if (!leader_) return;
+        state_.rays = total_rays;
+        state_.nonfinite_samples = total_nonfinite;
+        seconds_ = elapsed();
+    }
+
+    void report_stop(StopReason reason) const {
+        if (open_ended_) {
+            const std::string by = reason == StopReason::passes && capped_
+                                       ? "the cap of " + std::to_string(kMaxOpenEndedPasses) + " passes (no --spp)"
+                                       : "--" + std::string(stop_reason_names.name(reason));
+            std::fprintf(stderr, "%s%s: stopped by %s after %d passes, estimated relative error %.4f\n",
+                         show_progress_ ? "\n" : "", shown(scene_file_.filename()).c_str(), by.c_str(), state_.passes,
+                         state_.relative_error());
+        }
+        if (show_progress_) std::fprintf(stderr, "\n");
+    }
+
+    // Every file of the output, developed and encoded by render/outputs.h, committed
+    // together: all replaced, or none.
+    bool write() {
+        stage_ = "the output images of a " + image_;
+        try {
+            OutputRequest request;
+            request.path = output_;
+            request.develop.blur = opt_.blur;
+            request.display = loaded_.scene.display;
+            if (opt_.gl)
+                request.tone_map = [](const Image& radiance, const DisplaySettings& display) {
+                    return viewer::display_offscreen(radiance, display);
+                };
+            write_files_atomic(output_files(scene_, state_, request));
+        } catch (const std::exception& e) {
+            if (out_of_memory(e)) throw;
+            std::fprintf(stderr, "error: %s: %s\n", file_.c_str(), e.what());
+            return false;
         }
         return true;
-    }, hooks.get());
-    if (opt.checkpoint) {
-        ::sigaction(SIGINT, &previous_int, nullptr);
-        ::sigaction(SIGTERM, &previous_term, nullptr);
     }
-    if (reason == StopReason::cancelled) {
-        if (leader)
-            std::fprintf(stderr, "%s%s: stopped by a signal after %d passes; no image written; %s %s\n",
-                         show_progress ? "\n" : "", file.c_str(), state.passes, shown(*opt.checkpoint).c_str(),
-                         checkpoint_written ? "holds them (go on with --resume)" : "could not be written (above)");
-        return false;
-    }
-    std::vector<RankCost> costs;
-    if (cluster.distributed()) {
-        RankCost mine = hooks ? Cluster::cost(*hooks) : RankCost{};
-        mine.rays = state.rays - rays_before;
-        costs = cluster.gather(mine);
-    }
-    uint64_t total_rays = 0, total_nonfinite = 0;
-    cluster.gather_state(state, total_rays, total_nonfinite);
-    if (!leader) return true;
-    state.rays = total_rays;
-    state.nonfinite_samples = total_nonfinite;
-    const double seconds = elapsed();
-    if (open_ended) {
-        const std::string by = reason == StopReason::passes && capped
-                                   ? "the cap of " + std::to_string(kMaxOpenEndedPasses) + " passes (no --spp)"
-                                   : "--" + std::string(stop_reason_names.name(reason));
-        std::fprintf(stderr, "%s%s: stopped by %s after %d passes, estimated relative error %.4f\n",
-                     show_progress ? "\n" : "", shown(scene_file.filename()).c_str(), by.c_str(), state.passes,
-                     state.relative_error());
-    }
-    if (show_progress) std::fprintf(stderr, "\n");
 
-    stage = "the output images of a " + image;
-    try {
-        // The image and its depth map are committed together: both replaced, or neither.
-        const Image radiance = box_blur(state.radiance(), opt.blur);
-        std::vector<FileOutput> files;
-        if (exr) {
-            files.push_back({output, encode_exr(hdr_from_render(scene, state, radiance, opt.blur == 0))});
-        } else if (pfm) {
-            const std::vector<double> depth = state.mean_depth();
-            files.push_back({output, encode_pfm_rgb(hdr_from_radiance(radiance))});
-            files.push_back({depth_output, encode_pfm_gray(std::vector<float>(depth.begin(), depth.end()),
-                                                           state.width, state.height)});
-        } else {
-            const DisplaySettings& display = loaded.scene.display;
-            const Rgb8Image shown = opt.gl ? viewer::display_offscreen(radiance, display)
-                                           : tonemap(radiance, display.tonemap, display.exposure_scale());
-            files.push_back({output, encode_image(output, shown)});
-            files.push_back(
-                {depth_output, encode_image(depth_output, depth_to_rgb8(state.mean_depth(), state.width, state.height))});
-        }
-        write_files_atomic(files);
-    } catch (const std::exception& e) {
-        if (out_of_memory(e)) throw;
-        std::fprintf(stderr, "error: %s: %s\n", file.c_str(), e.what());
-        return false;
+    void report_summary() const {
+        if (state_.nonfinite_samples > 0)
+            std::fprintf(stderr, "warning: %s: %llu non-finite samples were dropped\n", file_.c_str(),
+                         static_cast<unsigned long long>(state_.nonfinite_samples));
+        std::printf("%s: %dx%d %s %d spp, %.2f s, %.1f Mrays/s (%.1f M rays) -> %s\n",
+                    shown(scene_file_.filename()).c_str(), state_.width, state_.height,
+                    std::string(integrator_names.name(settings_.integrator)).c_str(), state_.passes, seconds_,
+                    seconds_ > 0 ? double(state_.rays - rays_before_) / seconds_ * 1e-6 : 0.0,
+                    double(state_.rays) * 1e-6, shown(output_).c_str());
+        if (!costs_.empty()) print_rank_costs(costs_);
+        std::fflush(stdout);
     }
-    if (state.nonfinite_samples > 0)
-        std::fprintf(stderr, "warning: %s: %llu non-finite samples were dropped\n", file.c_str(),
-                     static_cast<unsigned long long>(state.nonfinite_samples));
-    std::printf("%s: %dx%d %s %d spp, %.2f s, %.1f Mrays/s (%.1f M rays) -> %s\n",
-                shown(scene_file.filename()).c_str(), state.width, state.height,
-                std::string(integrator_names.name(settings.integrator)).c_str(), state.passes, seconds,
-                seconds > 0 ? double(state.rays - rays_before) / seconds * 1e-6 : 0.0, double(state.rays) * 1e-6,
-                shown(output).c_str());
-    if (!costs.empty()) print_rank_costs(costs);
-    std::fflush(stdout);
-    return true;
+
+    const fs::path& scene_file_;
+    const Options& opt_;
+    std::string& stage_;
+    const Cluster& cluster_;
+    const std::string file_;  // the scene file as messages show it
+    const bool leader_;
+
+    LoadedScene loaded_;
+    RenderScene scene_;
+    RenderSettings settings_;
+    fs::path output_;
+    std::string image_;  // "WxH image", for messages
+    RenderState state_;
+    StopRule rule_;
+    bool open_ended_ = false, capped_ = false;
+    CheckpointKey key_;
+    uint64_t rays_before_ = 0;
+    bool show_progress_ = false;
+    bool checkpoint_written_ = false;  // the last attempt succeeded (rank 0)
+    std::chrono::steady_clock::time_point start_;
+    std::unique_ptr<PassHooks> hooks_;
+    std::vector<RankCost> costs_;
+    double seconds_ = 0;
+};
+
+bool render_scene_file(const fs::path& scene_file, const Options& opt, std::string& stage, const Cluster& cluster) {
+    return SceneRender(scene_file, opt, stage, cluster).run();
 }
 
 // Whether everything printed reached standard output: a full disk or /dev/full shows only

@@ -336,12 +336,6 @@ HdrImage decode_pfm(const std::string& bytes, const std::string& name) {
 
 namespace {
 
-bool has_extension(const std::filesystem::path& path, const char* ext) {
-    std::string e = path.extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return e == ext;
-}
-
 constexpr char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 
 std::string read_whole_file(const std::filesystem::path& path) {
@@ -360,9 +354,6 @@ std::string read_whole_file(const std::filesystem::path& path) {
 }
 
 }  // namespace
-
-bool is_exr_path(const std::filesystem::path& path) { return has_extension(path, ".exr"); }
-bool is_pfm_path(const std::filesystem::path& path) { return has_extension(path, ".pfm"); }
 
 bool is_hdr_file(const std::filesystem::path& path) {
     std::ifstream f(path, std::ios::binary);

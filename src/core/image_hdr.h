@@ -56,8 +56,4 @@ bool is_hdr_file(const std::filesystem::path& path);
 // Reads an OpenEXR or PFM file, told apart by their first bytes. Throws std::runtime_error.
 HdrImage read_hdr(const std::filesystem::path& path);
 
-// Whether a path names an HDR output by its extension (.exr or .pfm, any case).
-bool is_exr_path(const std::filesystem::path& path);
-bool is_pfm_path(const std::filesystem::path& path);
-
 }  // namespace kr

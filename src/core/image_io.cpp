@@ -13,6 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "core/image_formats.h"
+
 // Only the PNG decoder of stb_image is compiled in: the one format read besides PPM.
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
@@ -197,14 +199,8 @@ std::string encode_png(const Rgb8Image& image) {
     return bytes;
 }
 
-bool is_png_path(const fs::path& path) {
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".png";
-}
-
 std::string encode_image(const fs::path& path, const Rgb8Image& image) {
-    return is_png_path(path) ? encode_png(image) : encode_ppm(image);
+    return output_format(path).format == ImageFormat::png ? encode_png(image) : encode_ppm(image);
 }
 
 void write_ppm(const fs::path& path, const Rgb8Image& image) { write_file_atomic(path, encode_ppm(image)); }
@@ -222,3 +218,4 @@ Rgb8Image read_image(const fs::path& path) {
 }
 
 }  // namespace kr
+

@@ -26,8 +26,7 @@ inline constexpr size_t kMaxImageFileBytes = 3 * kMaxImagePixels + (size_t(1) <<
 // The file's bytes of each format.
 std::string encode_ppm(const Rgb8Image& image);
 std::string encode_png(const Rgb8Image& image);
-// PNG when the path ends in .png (any case), otherwise binary PPM.
-bool is_png_path(const std::filesystem::path& path);
+// PNG when the path ends in .png (any case), otherwise binary PPM (core/image_formats.h).
 std::string encode_image(const std::filesystem::path& path, const Rgb8Image& image);
 
 // One file, written atomically (write_file_atomic). Throw std::runtime_error.

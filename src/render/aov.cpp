@@ -59,28 +59,4 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
     return out;
 }
 
-HdrImage hdr_from_render(const RenderScene& scene, const RenderState& state, const Image& radiance,
-                         bool with_variance) {
-    HdrImage out = hdr_from_radiance(radiance);
-    const size_t n = out.pixel_count();
-    const std::vector<double> depth = state.mean_depth();
-    out.depth.assign(depth.begin(), depth.end());
-    out.samples.assign(state.sample_count().begin(), state.sample_count().end());
-    const SurfaceLayers surface = first_surface_layers(scene, state.width, state.height);
-    out.albedo.resize(3 * n);
-    out.normal.resize(3 * n);
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) {
-            out.albedo[3 * i + size_t(k)] = float(surface.albedo[i][k]);
-            out.normal[3 * i + size_t(k)] = float(surface.normal[i][k]);
-        }
-    if (with_variance) {
-        const std::vector<Color> variance = state.variance_of_mean();
-        out.variance.resize(3 * n);
-        for (size_t i = 0; i < n; ++i)
-            for (int k = 0; k < 3; ++k) out.variance[3 * i + size_t(k)] = float(variance[i][k]);
-    }
-    return out;
-}
-
 }  // namespace kr

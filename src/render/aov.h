@@ -1,9 +1,11 @@
-// The auxiliary layers (AOVs) of an HDR output: depth, albedo and normal of the first
-// non-specular hit, samples per pixel and the variance of the mean, beside the radiance.
+// The first-surface layers (AOVs) of an HDR output: albedo and normal of the first
+// non-specular hit. The other layers come from the render's state (render/outputs.h).
 #pragma once
 
-#include "core/image_hdr.h"
-#include "render/progressive.h"
+#include <vector>
+
+#include "core/math.h"
+#include "render/render_scene.h"
 
 namespace kr {
 
@@ -18,11 +20,5 @@ struct SurfaceLayers {
     std::vector<Color> albedo, normal;
 };
 SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int height, int max_chain = 16);
-
-// The HDR image of a render: `radiance` (the mean, possibly blurred, as the 8-bit output has
-// it) and the layers. `with_variance` false leaves the variance layer out (a blurred radiance
-// is not the mean the variance belongs to).
-HdrImage hdr_from_render(const RenderScene& scene, const RenderState& state, const Image& radiance,
-                         bool with_variance);
 
 }  // namespace kr

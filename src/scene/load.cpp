@@ -17,12 +17,12 @@
 #include <unordered_set>
 #include <utility>
 
-#include <nlohmann/json.hpp>
 #include <sys/stat.h>
 
 #include "core/limits.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "scene/json_reader.h"
 
 namespace kr {
 
@@ -49,257 +49,7 @@ std::string in_quotes(std::string_view s) { return quote_user_text(s); }
 
 namespace {
 
-// ordered_json keeps keys in document order, so "the first error" is the first in the file.
-using Json = nlohmann::ordered_json;
-
-constexpr int kMaxNesting = 64;
 constexpr size_t kMaxListedIds = 10;
-
-// ---------------------------------------------------------------------------------------
-// Small formatting helpers
-
-// RFC 6901 escaping: only '~' and '/' are special; spaces stay as they are.
-std::string child(const std::string& pointer, std::string_view key) {
-    std::string out = pointer + '/';
-    for (char c : key) {
-        if (c == '~') out += "~0";
-        else if (c == '/') out += "~1";
-        else out += c;
-    }
-    return out;
-}
-
-std::string child(const std::string& pointer, size_t index) {
-    return pointer + '/' + std::to_string(index);
-}
-
-// "a", "b", "c": the form used for lists of keys and ids.
-std::string quoted_list(const std::vector<std::string>& items) {
-    std::string out;
-    for (size_t i = 0; i < items.size(); ++i) {
-        if (i > 0) out += ", ";
-        out += in_quotes(items[i]);
-    }
-    return out;
-}
-
-std::string number_text(const Json& j) { return j.dump(); }
-
-// What a value is, for "expected X, got Y" messages.
-std::string describe(const Json& j) {
-    switch (j.type()) {
-        case Json::value_t::string: return "string " + in_quotes(j.get_ref<const std::string&>());
-        case Json::value_t::boolean: return j.get<bool>() ? "boolean true" : "boolean false";
-        case Json::value_t::null: return "null";
-        case Json::value_t::object: return "an object";
-        case Json::value_t::array:
-            return j.size() == 1 ? "an array of 1 element"
-                                 : "an array of " + std::to_string(j.size()) + " elements";
-        case Json::value_t::number_integer:
-        case Json::value_t::number_unsigned:
-        case Json::value_t::number_float: return "number " + number_text(j);
-        default: return "an unsupported value";
-    }
-}
-
-// ---------------------------------------------------------------------------------------
-// Text and syntax
-
-// nlohmann's DOM (and its destructor) are recursive, so hostile nesting is refused before
-// parsing. Brackets inside strings do not count.
-void check_nesting(std::string_view text, const std::string& file) {
-    int depth = 0, line = 1, column = 0;
-    bool in_string = false, escaped = false;
-    for (char c : text) {
-        if (c == '\n') {
-            ++line;
-            column = 0;
-        } else {
-            ++column;
-        }
-        if (in_string) {
-            if (escaped) escaped = false;
-            else if (c == '\\') escaped = true;
-            else if (c == '"') in_string = false;
-            continue;
-        }
-        if (c == '"') {
-            in_string = true;
-        } else if (c == '{' || c == '[') {
-            if (++depth > kMaxNesting)
-                throw SceneError(file, "",
-                                 "JSON nesting deeper than " + std::to_string(kMaxNesting) +
-                                     " levels at line " + std::to_string(line) + ", column " +
-                                     std::to_string(column));
-        } else if ((c == '}' || c == ']') && depth > 0) {
-            --depth;
-        }
-    }
-}
-
-// Builds the DOM from nlohmann's SAX events. Doing it here rather than with a parser
-// callback keeps parsing linear (the callback parser rescans the parent array at every
-// object end), and lets us refuse duplicate keys and know the JSON pointer of the value
-// being parsed, where nlohmann itself only knows a byte offset.
-class DomBuilder : public nlohmann::json_sax<Json> {
-public:
-    Json root;
-    // Set when parsing stopped on our own finding rather than a syntax error.
-    std::optional<std::string> duplicate_key;
-    std::string error_pointer;                 // where parsing stopped
-    int error_id = 0;                          // nlohmann's exception id (101, 406, ...)
-    std::string error_text;
-
-    bool null() override { return add(Json(nullptr)); }
-    bool boolean(bool v) override { return add(Json(v)); }
-    bool number_integer(number_integer_t v) override { return add(Json(v)); }
-    bool number_unsigned(number_unsigned_t v) override { return add(Json(v)); }
-    bool number_float(number_float_t v, const string_t&) override { return add(Json(v)); }
-    bool string(string_t& v) override { return add(Json(std::move(v))); }
-    bool binary(binary_t&) override { return add(Json(nullptr)); }  // not produced by JSON text
-
-    bool start_object(std::size_t) override { return open(Json::object()); }
-    bool start_array(std::size_t) override { return open(Json::array()); }
-    bool key(string_t& k) override {
-        Level& top = levels_.back();
-        top.key = k;
-        if (!top.keys.insert(k).second) {
-            duplicate_key = k;
-            error_pointer = pointer();
-            return false;
-        }
-        return true;
-    }
-    bool end_object() override { return close(); }
-    bool end_array() override { return close(); }
-
-    bool parse_error(std::size_t, const std::string&, const nlohmann::json::exception& e) override {
-        error_id = e.id;
-        error_text = e.what();
-        error_pointer = pointer();
-        return false;
-    }
-
-private:
-    struct Level {
-        Json* value;
-        std::string key;   // objects: the key whose value is being parsed
-        size_t count = 0;  // arrays: elements completed so far = index of the current one
-        std::unordered_set<std::string> keys;
-    };
-
-    // Pointer of the value being parsed now.
-    std::string pointer() const {
-        std::string out;
-        for (const Level& level : levels_)
-            out = level.value->is_object() ? child(out, level.key) : child(out, level.count);
-        return out;
-    }
-
-    // Stores a value in the innermost container and returns where it now lives. Only that
-    // container grows while it is open, so the pointers held in levels_ stay valid.
-    Json* place(Json&& value) {
-        if (levels_.empty()) {
-            root = std::move(value);
-            return &root;
-        }
-        Level& top = levels_.back();
-        if (top.value->is_array()) {
-            auto& array = top.value->get_ref<Json::array_t&>();
-            array.push_back(std::move(value));
-            return &array.back();
-        }
-        // Keys are known unique (key() checked), so skip ordered_map's linear lookup.
-        auto& object = top.value->get_ref<Json::object_t&>();
-        object.Container::emplace_back(top.key, std::move(value));
-        return &object.back().second;
-    }
-
-    bool add(Json&& value) {
-        place(std::move(value));
-        element_done();
-        return true;
-    }
-    bool open(Json&& container) {
-        Json* where = place(std::move(container));
-        levels_.push_back({where, {}, 0, {}});
-        return true;
-    }
-    bool close() {
-        levels_.pop_back();
-        element_done();
-        return true;
-    }
-    void element_done() {
-        if (!levels_.empty() && levels_.back().value->is_array()) ++levels_.back().count;
-    }
-
-    std::vector<Level> levels_;
-};
-
-// Frees a DOM without allocating. nlohmann's destructor first moves a container's children
-// onto a heap stack (to avoid recursion); when memory ran out building a huge DOM that
-// allocation fails too, inside a destructor, and the process aborts. Popping children from
-// the back allocates nothing, and check_nesting bounds this recursion to 64 levels.
-void release(Json& j) {
-    if (j.is_array()) {
-        auto& array = j.get_ref<Json::array_t&>();
-        while (!array.empty()) {
-            release(array.back());
-            array.pop_back();
-        }
-    } else if (j.is_object()) {
-        auto& object = j.get_ref<Json::object_t&>();
-        while (!object.empty()) {
-            release(object.back().second);
-            object.pop_back();
-        }
-    }
-}
-
-SceneError out_of_memory(const std::string& file, std::string_view text) {
-    return SceneError(file, "", "not enough memory for the scene (" + format_bytes(text.size()) + " of JSON)");
-}
-
-Json parse_json(std::string_view text, const std::string& file) {
-    check_nesting(text, file);
-    DomBuilder builder;
-    try {
-        if (Json::sax_parse(text.begin(), text.end(), &builder)) return std::move(builder.root);
-    } catch (const std::bad_alloc&) {
-        release(builder.root);
-        throw out_of_memory(file, text);
-    }
-
-    if (builder.duplicate_key)
-        throw SceneError(file, builder.error_pointer,
-                         "duplicate key " + in_quotes(*builder.duplicate_key) +
-                             "; each key may appear only once in an object");
-    if (builder.error_id == 406) {
-        // A float literal such as 1e999 that overflows to infinity: nlohmann's text
-        // quotes it as "number overflow parsing '1e999'".
-        const std::string& what = builder.error_text;
-        const size_t open = what.find('\''), close = what.rfind('\'');
-        const std::string token =
-            open != std::string::npos && close > open ? what.substr(open + 1, close - open - 1) : "";
-        throw SceneError(file, builder.error_pointer,
-                         "number " + show_user_text(token, 40) + " is not a finite number; expected a finite number");
-    }
-    // nlohmann's text reads "[json.exception.parse_error.101] parse error at line 4, ...".
-    std::string detail = builder.error_text;
-    const size_t at = detail.find("at line ");
-    if (at != std::string::npos) detail = detail.substr(at);
-    // Its "last read" excerpt is the file's text (a whole token: a million-digit number is a
-    // million bytes), so it is quoted and bounded like any user text.
-    const std::string last_read = "; last read: '";
-    if (const size_t from = detail.find(last_read); from != std::string::npos) {
-        const size_t begin = from + last_read.size(), end = detail.rfind('\'');
-        const std::string token = detail.substr(begin, end > begin ? end - begin : std::string::npos);
-        detail = detail.substr(0, from) + "; last read: " + quote_user_text(token, 40) +
-                 (end > begin && end + 1 < detail.size() ? detail.substr(end + 1) : "");
-    }
-    throw SceneError(file, "", "malformed JSON " + show_user_text(detail, 400));
-}
 
 // ---------------------------------------------------------------------------------------
 // The scene format
@@ -369,6 +119,10 @@ private:
     std::string nonempty_string(const Json& j, const std::string& pointer, std::string_view expected) const;
     size_t resolve(const IdIndex& index, const Json& j, const std::string& pointer) const;
 
+    // An enum's value by its name table: `what` names it in messages ("camera type").
+    template <typename Enum, size_t N>
+    Enum read_enum(const Json& j, const std::string& pointer, const EnumNames<Enum, N>& names,
+                   std::string_view what) const;
     template <typename Enum, size_t N>
     std::pair<std::string, Enum> header(const Json& j, const std::string& pointer,
                                         IdIndex* index, const EnumNames<Enum, N>& names,
@@ -492,6 +246,18 @@ size_t Loader::resolve(const IdIndex& index, const Json& j, const std::string& p
     fail(pointer, message);
 }
 
+template <typename Enum, size_t N>
+Enum Loader::read_enum(const Json& j, const std::string& pointer, const EnumNames<Enum, N>& names,
+                       std::string_view what) const {
+    const std::string what_text(what);
+    if (!j.is_string()) fail(pointer, "expected a " + what_text + " (a string), got " + describe(j));
+    const auto parsed = names.parse(j.get_ref<const std::string&>());
+    if (!parsed)
+        fail(pointer, "unknown " + what_text + " " + in_quotes(j.get_ref<const std::string&>()) + "; expected " +
+                          names.list());
+    return *parsed;
+}
+
 // The id and type of a category entry: needed before its other keys can be checked.
 template <typename Enum, size_t N>
 std::pair<std::string, Enum> Loader::header(const Json& j, const std::string& pointer,
@@ -502,14 +268,7 @@ std::pair<std::string, Enum> Loader::header(const Json& j, const std::string& po
     if (!j.contains("id")) fail(pointer, "missing key \"id\"; expected a non-empty string");
     const std::string id = nonempty_string(j["id"], child(pointer, "id"), "a non-empty string id");
     if (!j.contains("type")) fail(pointer, "missing key \"type\"; expected " + names.list());
-    const Json& type = j["type"];
-    if (!type.is_string())
-        fail(child(pointer, "type"), "expected a " + kind_text + " type (a string), got " + describe(type));
-    const auto parsed = names.parse(type.get_ref<const std::string&>());
-    if (!parsed)
-        fail(child(pointer, "type"), "unknown " + kind_text + " type " +
-                                         in_quotes(type.get_ref<const std::string&>()) + "; expected " +
-                                         names.list());
+    const Enum type = read_enum(j["type"], child(pointer, "type"), names, kind_text + " type");
     if (index) {
         const size_t position = index->ids.size();
         const auto [it, inserted] = index->by_id.emplace(id, position);
@@ -520,7 +279,7 @@ std::pair<std::string, Enum> Loader::header(const Json& j, const std::string& po
                                            "; ids must be unique within " + in_quotes(index->plural));
         index->ids.push_back(id);
     }
-    return {id, *parsed};
+    return {id, type};
 }
 
 template <typename Item>
@@ -684,14 +443,7 @@ void Loader::read_renderer(const Json& j, const std::string& pointer) {
     read_fields(
         j, pointer,
         {{"type", renderer_type_names.list(),
-          [&](const Json& v, const std::string& p) {
-              if (!v.is_string()) fail(p, "expected a renderer type (a string), got " + describe(v));
-              const auto type = renderer_type_names.parse(v.get_ref<const std::string&>());
-              if (!type)
-                  fail(p, "unknown renderer type " + in_quotes(v.get_ref<const std::string&>()) +
-                              "; expected " + renderer_type_names.list());
-              r.type = *type;
-          }},
+          [&](const Json& v, const std::string& p) { r.type = read_enum(v, p, renderer_type_names, "renderer type"); }},
          {"dimensions", "an array of 2 integers [width, height]",
           [&](const Json& v, const std::string& p) {
               if (!v.is_array() || v.size() != 2)
@@ -774,14 +526,7 @@ void Loader::read_display(const Json& j, const std::string& pointer) {
     read_fields(
         j, pointer,
         {{"tonemap", tonemap_names.list(),
-          [&](const Json& v, const std::string& p) {
-              if (!v.is_string()) fail(p, "expected a tone map (a string), got " + describe(v));
-              const auto op = tonemap_names.parse(v.get_ref<const std::string&>());
-              if (!op)
-                  fail(p, "unknown tone map " + in_quotes(v.get_ref<const std::string&>()) + "; expected " +
-                              tonemap_names.list());
-              d.tonemap = *op;
-          },
+          [&](const Json& v, const std::string& p) { d.tonemap = read_enum(v, p, tonemap_names, "tone map"); },
           false},
          {"exposure", stops,
           [&](const Json& v, const std::string& p) {
@@ -899,22 +644,5 @@ std::string read_scene_text(const std::filesystem::path& file) {
 }
 
 LoadedScene load_scene_file(const std::filesystem::path& file) { return parse_scene(read_scene_text(file), file); }
-
-std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& folder) {
-    std::vector<std::filesystem::path> found;
-    std::error_code ec;
-    for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
-        if (entry.path().extension() == ".json") found.push_back(entry.path());
-    std::sort(found.begin(), found.end());
-    return found;
-}
-
-std::vector<std::filesystem::path> default_scenes() {
-    std::vector<std::filesystem::path> found = list_scenes("res/scenes");
-#ifdef KEITHRAY_SCENES_DIR
-    if (found.empty()) found = list_scenes(KEITHRAY_SCENES_DIR);
-#endif
-    return found;
-}
 
 }  // namespace kr

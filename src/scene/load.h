@@ -44,11 +44,4 @@ LoadedScene load_scene_file(const std::filesystem::path& file);
 // Same, from text; `file` is only used in messages and to resolve the output path.
 LoadedScene parse_scene(std::string_view json_text, const std::filesystem::path& file);
 
-// The *.json files of `folder`, sorted; none if it cannot be read.
-std::vector<std::filesystem::path> list_scenes(const std::filesystem::path& folder);
-
-// The bundled scenes, list_scenes() of res/scenes under the working directory, else of the
-// source tree's res/scenes.
-std::vector<std::filesystem::path> default_scenes();
-
 }  // namespace kr

@@ -2,9 +2,9 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
-#include "core/image_hdr.h"
-#include "core/image_io.h"
+#include "core/image_formats.h"
 
 namespace kr::viewer {
 
@@ -15,8 +15,9 @@ Rgb8Image CompareImage::display(const ToneSettings& tone) const {
 CompareImage load_reference(const std::filesystem::path& path) {
     CompareImage image;
     image.name = path.filename().string();
-    if (is_hdr_file(path)) image.radiance = read_hdr(path).radiance();
-    else image.bytes = read_image(path);
+    ImageFile file = read_image_file(path);
+    if (file.hdr) image.radiance = file.radiance.radiance();
+    else image.bytes = std::move(file.rgb8);
     return image;
 }
 

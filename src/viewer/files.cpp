@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <system_error>
 
-#include "scene/load.h"  // list_scenes
+#include "scene/load.h"
+#include "scene/scene_list.h"  // list_scenes
 
 namespace kr::viewer {
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/image_compare.h"
+#include "render/outputs.h"
 
 namespace kr::viewer {
 
@@ -12,6 +13,9 @@ void record_pixel_statistics(const RenderState& totals, Snapshot& frame) {
     frame.sample_count = totals.sample_count();
     frame.standard_error.resize(n);
     for (size_t i = 0; i < n; ++i) frame.standard_error[i] = float(totals.pixel_standard_error(i));
+    RenderEstimates layers = render_estimates(totals, kLayerDepth | kLayerVariance);
+    frame.depth = std::move(layers.depth);
+    frame.variance = std::move(layers.variance);
 }
 
 std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int height, int x, int y,

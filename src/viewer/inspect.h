@@ -14,8 +14,9 @@
 
 namespace kr::viewer {
 
-// Copies the per-pixel statistics the inspector and the noise view read from the running
-// totals into a full-resolution snapshot.
+// Copies the per-pixel statistics the inspector, the noise view and Save (the depth and
+// variance layers, viewer/save_dialog.h) read from the running totals into a
+// full-resolution snapshot.
 void record_pixel_statistics(const RenderState& totals, Snapshot& frame);
 
 // One pixel as the inspector shows it.

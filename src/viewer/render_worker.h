@@ -45,6 +45,10 @@ struct Snapshot {
     // and the standard error of the mean luminance (infinite below two samples).
     std::vector<uint32_t> sample_count;
     std::vector<float> standard_error;
+    // And what Save develops with the radiance and the counts (render/outputs.h): the mean
+    // depth and, 3 per pixel, the variance of the mean radiance.
+    std::vector<double> depth;
+    std::vector<float> variance;
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished

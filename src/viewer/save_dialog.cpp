@@ -3,26 +3,79 @@
 #include <stdexcept>
 
 #include "core/file_write.h"
-#include "core/image_hdr.h"
-#include "core/image_io.h"
 #include "core/text.h"
+#include "render/outputs.h"
 #include "scene/save.h"
 
 namespace kr::viewer {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+constexpr SaveKind kImageKinds[] = {SaveKind::ppm, SaveKind::png, SaveKind::exr, SaveKind::pfm};
+
+bool is_image(SaveKind kind) { return kind != SaveKind::scene && kind != SaveKind::convergence; }
+
+ImageFormat image_format(SaveKind kind) {
+    switch (kind) {
+    case SaveKind::png: return ImageFormat::png;
+    case SaveKind::exr: return ImageFormat::exr;
+    case SaveKind::pfm: return ImageFormat::pfm;
+    default: return ImageFormat::ppm;
+    }
+}
+
+std::string extension(SaveKind kind) { return format_info(image_format(kind)).extension; }
+
+// Writes the shown frame as `render -o path` writes a render: its estimates developed and
+// encoded by render/outputs.h, every file committed together.
+void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, const Snapshot* shown) {
+    if (!shown || shown->scale != 1) throw std::runtime_error("no full-resolution image yet");
+    // The first-surface layers are traced in the model's scene: it must be the frame's.
+    if (shown->generation != model.generation() || !model.prepared())
+        throw std::runtime_error("the image shown is not of the current scene yet");
+    const size_t n = shown->radiance.pixels.size();
+    if (shown->depth.size() != n || shown->sample_count.size() != n || shown->variance.size() != 3 * n)
+        throw std::runtime_error("no full-resolution image yet");
+    if (image_save_kind(path) != kind)
+        throw std::invalid_argument(quoted_path(path) + ": a " + format_info(image_format(kind)).name +
+                                    " image needs a name ending in " + extension(kind));
+    RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance};
+    OutputRequest request;
+    request.path = path;
+    request.display = model.settings().tone;
+    write_files_atomic(output_files(*model.prepared(), std::move(estimates), request));
+}
+
+}  // namespace
+
 SavePaths SavePaths::for_scene(const Scene& scene) {
     SavePaths paths;
     fs::path image = scene.output_path();
     if (image.empty()) image = "keithray.ppm";
-    paths.image = image.replace_extension(".ppm").string();
-    paths.png = fs::path(image).replace_extension(".png").string();
-    paths.hdr = fs::path(image).replace_extension(".exr").string();
+    paths.image = image_save_path(SaveKind::ppm, image).string();
+    paths.png = image_save_path(SaveKind::png, image).string();
+    paths.hdr = image_save_path(SaveKind::exr, image).string();
     paths.convergence = (image.parent_path() / (image.stem().string() + "-convergence.csv")).string();
     const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
     paths.scene = (source.parent_path() / (source.stem().string() + "-edited.json")).string();
     return paths;
+}
+
+SaveKind image_save_kind(const fs::path& path) {
+    const ImageFormat format = output_format(path).format;
+    for (SaveKind kind : kImageKinds)
+        if (image_format(kind) == format) return kind;
+    return SaveKind::ppm;
+}
+
+fs::path image_save_path(SaveKind kind, const fs::path& path) {
+    return fs::path(path).replace_extension(extension(kind));
+}
+
+std::vector<fs::path> save_targets(SaveKind kind, const fs::path& path) {
+    return is_image(kind) ? output_file_paths(path) : std::vector<fs::path>{path};
 }
 
 std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model, const Snapshot* shown,
@@ -33,16 +86,7 @@ std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model,
         save_scene_json(model.scene_for_saving(), path);
         model.mark_saved();  // the edits are in a file now
     } else {
-        if (!shown || shown->scale != 1) throw std::runtime_error("no full-resolution image yet");
-        if (kind == SaveKind::exr || kind == SaveKind::pfm) {
-            const HdrImage hdr = hdr_from_radiance(shown->radiance);
-            write_file_atomic(path, kind == SaveKind::exr ? encode_exr(hdr) : encode_pfm_rgb(hdr));
-        } else {
-            const ToneSettings& tone = model.settings().tone;
-            const Rgb8Image image = tonemap(shown->radiance, tone.tonemap, tone.exposure_scale());
-            if (kind == SaveKind::ppm) write_ppm(path, image);
-            else write_png(path, image);
-        }
+        save_image(kind, path, model, shown);
     }
     return "saved " + show_user_text(path.string());
 }

@@ -1,11 +1,14 @@
 // The viewer's Save panel without its widgets: the paths it offers for a scene and what
 // each of its buttons writes. GL-free; ui_save.cpp draws the panel and asks before it
-// overwrites a file.
+// overwrites a file. An image is written as `keithray render -o` writes the same name
+// (render/outputs.h): the same bytes for the same render.
 #pragma once
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
+#include "core/image_formats.h"
 #include "scene/scene.h"
 #include "viewer/model.h"
 #include "viewer/render_worker.h"
@@ -24,10 +27,19 @@ struct SavePaths {
     static SavePaths for_scene(const Scene& scene);
 };
 
+// The image kind an output named `path` is (its format, core/image_formats.h).
+SaveKind image_save_kind(const std::filesystem::path& path);
+// `path` with the extension of image kind `kind` (what the panel's image buttons save to).
+std::filesystem::path image_save_path(SaveKind kind, const std::filesystem::path& path);
+// Every file saving `kind` to `path` writes: an image's depth file too (output_file_paths).
+std::vector<std::filesystem::path> save_targets(SaveKind kind, const std::filesystem::path& path);
+
 // Writes `kind` to `path`: the edited scene as ViewerModel::scene_for_saving (the model then
-// counts as saved), or the `shown` full-resolution image, tone mapped as the window shows
-// it (PPM, PNG) or its radiance as floats (EXR, PFM), or `convergence_csv`. Returns the
-// status line; throws std::exception with the reason when nothing was written.
+// counts as saved), or `convergence_csv`, or the `shown` full-resolution image of the
+// model's current scene with every file and layer `keithray render -o PATH` writes (an
+// image's kind must be its name's format): the radiance tone mapped with the model's tone
+// settings and the depth map, or the radiance and the layers as floats. Returns the status
+// line; throws std::exception with the reason when nothing was written.
 std::string save_output(SaveKind kind, const std::filesystem::path& path, ViewerModel& model, const Snapshot* shown,
                         const std::string& convergence_csv = {});
 

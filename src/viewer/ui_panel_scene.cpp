@@ -7,7 +7,7 @@
 
 #include <imgui.h>
 
-#include "scene/load.h"
+#include "scene/scene_list.h"
 #include "viewer/ui_panels.h"
 
 namespace kr::viewer {

@@ -21,18 +21,19 @@ void ViewerApp::panel_save() {
     const bool full = ui_.shown && ui_.shown->generation == model_.generation() && ui_.shown->scale == 1;
     ImGui::InputText("image", &save_paths_.image);
     ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save PPM")) request_save(SaveKind::ppm, save_paths_.image);
+    // Each image as `render -o` writes it, the path's extension set to match.
+    if (ImGui::Button("Save PPM")) request_save(SaveKind::ppm, image_save_path(SaveKind::ppm, save_paths_.image));
     ImGui::EndDisabled();
     ImGui::InputText("png", &save_paths_.png);
     ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save PNG")) request_save(SaveKind::png, save_paths_.png);
+    if (ImGui::Button("Save PNG")) request_save(SaveKind::png, image_save_path(SaveKind::png, save_paths_.png));
     ImGui::EndDisabled();
-    // The radiance as floats: OpenEXR (R, G, B) or PFM, the path's extension set to match.
+    // The radiance as floats: OpenEXR (with every layer) or PFM (and the depth beside it).
     ImGui::InputText("hdr", &save_paths_.hdr);
     ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save EXR")) request_save(SaveKind::exr, fs::path(save_paths_.hdr).replace_extension(".exr"));
+    if (ImGui::Button("Save EXR")) request_save(SaveKind::exr, image_save_path(SaveKind::exr, save_paths_.hdr));
     ImGui::SameLine();
-    if (ImGui::Button("Save PFM")) request_save(SaveKind::pfm, fs::path(save_paths_.hdr).replace_extension(".pfm"));
+    if (ImGui::Button("Save PFM")) request_save(SaveKind::pfm, image_save_path(SaveKind::pfm, save_paths_.hdr));
     ImGui::EndDisabled();
     ImGui::InputText("scene", &save_paths_.scene);
     if (ImGui::Button("Save scene JSON")) request_save(SaveKind::scene, save_paths_.scene);
@@ -40,9 +41,10 @@ void ViewerApp::panel_save() {
 }
 
 void ViewerApp::request_save(SaveKind kind, const fs::path& path) {
-    std::error_code ec;
-    if (fs::exists(path, ec)) {
-        // Never overwrite silently: the popup asks.
+    // Never overwrite silently (an image's depth file included): the popup asks.
+    for (const fs::path& target : save_targets(kind, path)) {
+        std::error_code ec;
+        if (!fs::exists(target, ec)) continue;
         pending_save_ = std::make_pair(kind, path);
         ImGui::OpenPopup("Overwrite?");
         return;

@@ -7,6 +7,7 @@
 #include "core/file_write.h"
 #include "core/image_io.h"
 #include "scene/save.h"
+#include "viewer/save_dialog.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
 
@@ -50,8 +51,7 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
         std::fflush(stdout);
     }
     // Without an image to write, the latency run is over; an idle run ends in idle_step.
-    if (!options_.screenshot && !options_.save_scene && !options_.stats_json && options_.frames == 0)
-        return options_.measure_idle <= 0;
+    if (!options_.writes_after_render()) return options_.measure_idle <= 0;
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int needed = script_passes_needed(options_, model.settings());
     if (!(current && current->scale == 1 && current->spp >= needed)) return false;
@@ -72,6 +72,12 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
         if (options_.stats_json) {
             write_file_atomic(*options_.stats_json, stats_json(stats_figures(ctx)));
             std::printf("stats: %s\n", options_.stats_json->string().c_str());
+        }
+        if (options_.save_image) {
+            // The Save panel's code, without its overwrite question.
+            const std::filesystem::path& out = *options_.save_image;
+            save_output(image_save_kind(out), out, ctx.model, current);
+            std::printf("image: %s (%d spp)\n", out.string().c_str(), current->spp);
         }
         if (options_.save_scene) {
             save_scene_json(model.scene_for_saving(), *options_.save_scene);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/image_formats.h"
 #include "core/limits.h"
 #include "viewer/image_view.h"
 
@@ -40,6 +41,10 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --frames N            accumulate N full-resolution passes (at most the target spp)
   --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
   --save-scene OUT.json then save the edited scene
+  --save-image OUT.ppm  then save the image as the Save panel does, which is what
+                        'keithray render -o OUT.ppm' writes of the same render: OUT.ppm (or
+                        .png) and its depth map OUT-depth.ppm, OUT.exr with every layer, or
+                        OUT.pfm and OUT-depth.pfm
   --window-shot OUT.ppm and the whole window, panels included (.png: as PNG)
   --measure-latency N   time N orbit edits from the edit to the first frame on screen
   --measure-idle S      once done, the process's CPU over S seconds with no input; then
@@ -74,6 +79,13 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--frames") o.frames = int(parse_integer(arg, value(), 1, kMaxSamples));
         else if (arg == "--screenshot") o.screenshot = value();
         else if (arg == "--save-scene") o.save_scene = value();
+        else if (arg == "--save-image") {
+            o.save_image = value();
+            // Named as the Save panel names it: never a scene file, nor a name of no format.
+            if (!format_by_extension(*o.save_image))
+                throw UsageError{"--save-image needs a name ending in .ppm, .png, .exr or .pfm, got " +
+                                 quote_user_text(o.save_image->string(), 80)};
+        }
         else if (arg == "--window-shot") o.window_shot = value();
         else if (arg == "--measure-latency") o.measure_latency = int(parse_integer(arg, value(), 1, 10000));
         else if (arg == "--measure-idle") o.measure_idle = parse_number(arg, value(), 0.1, 3600);

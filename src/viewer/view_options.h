@@ -23,6 +23,7 @@ struct ViewOptions {
     std::optional<double> aperture;                        // thin lens with this radius
     std::optional<std::filesystem::path> screenshot;       // image region, read back from GL
     std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
+    std::optional<std::filesystem::path> save_image;       // as the Save panel (and render -o) write it
     std::optional<std::filesystem::path> window_shot;      // the whole window, panels included
     int measure_latency = 0;  // edits to time, edit to first displayed frame
     double measure_idle = 0;  // seconds of idle CPU to measure, done and then paused
@@ -35,9 +36,9 @@ struct ViewOptions {
     std::optional<std::filesystem::path> stats_json;  // figures written when a scripted run ends
     double timeout = 600;     // seconds: a scripted run that gets stuck fails
     bool help = false;        // -h, --help
-    bool scripted() const {
-        return frames > 0 || screenshot || save_scene || stats_json || measure_latency > 0 || measure_idle > 0;
-    }
+    // Something a scripted run writes once the render has its passes (or --frames alone).
+    bool writes_after_render() const { return frames > 0 || screenshot || save_scene || save_image || stats_json; }
+    bool scripted() const { return writes_after_render() || measure_latency > 0 || measure_idle > 0; }
 };
 
 // Reads the arguments after "view". Throws UsageError (core/args.h) on bad usage.

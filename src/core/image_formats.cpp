@@ -1,0 +1,44 @@
+#include "core/image_formats.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include "core/image_io.h"
+
+namespace kr {
+
+const ImageFormatInfo& format_info(ImageFormat format) {
+    for (const ImageFormatInfo& f : kImageFormats)
+        if (f.format == format) return f;
+    return kImageFormats[0];
+}
+
+const ImageFormatInfo* format_by_extension(const std::filesystem::path& path) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const ImageFormatInfo& f : kImageFormats)
+        if (ext == f.extension) return &f;
+    return nullptr;
+}
+
+const ImageFormatInfo& output_format(const std::filesystem::path& path) {
+    const ImageFormatInfo* f = format_by_extension(path);
+    return f ? *f : format_info(ImageFormat::ppm);
+}
+
+std::vector<std::filesystem::path> output_file_paths(const std::filesystem::path& path) {
+    std::vector<std::filesystem::path> paths{path};
+    if (output_format(path).depth_beside) paths.push_back(depth_path_for(path));
+    return paths;
+}
+
+ImageFile read_image_file(const std::filesystem::path& path) {
+    ImageFile file;
+    file.hdr = is_hdr_file(path);
+    if (file.hdr) file.radiance = read_hdr(path);
+    else file.rgb8 = read_image(path);
+    return file;
+}
+
+}  // namespace kr

@@ -1,0 +1,104 @@
+#include "render/outputs.h"
+
+#include <stdexcept>
+#include <utility>
+
+#include "core/image_hdr.h"
+#include "core/image_io.h"
+#include "render/aov.h"
+
+namespace kr {
+
+namespace {
+
+std::vector<float> floats(const std::vector<Color>& values) {
+    std::vector<float> out(3 * values.size());
+    for (size_t i = 0; i < values.size(); ++i)
+        for (int k = 0; k < 3; ++k) out[3 * i + size_t(k)] = float(values[i][k]);
+    return out;
+}
+
+// The layers worth making for an output: the format's, less the variance of a blurred image.
+unsigned layers_for(const OutputRequest& request) {
+    const unsigned layers = output_format(request.path).layers;
+    return request.develop.blur > 0 ? layers & ~unsigned(kLayerVariance) : layers;
+}
+
+}  // namespace
+
+RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
+    RenderEstimates out;
+    if (layers & kLayerRadiance) out.radiance = state.radiance();
+    if (layers & kLayerDepth) out.depth = state.mean_depth();
+    if (layers & kLayerSamples) out.samples = state.sample_count();
+    if (layers & kLayerVariance) out.variance = floats(state.variance_of_mean());
+    return out;
+}
+
+Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,
+                  unsigned layers) {
+    Developed out;
+    const int width = estimates.radiance.width, height = estimates.radiance.height;
+    out.radiance = options.blur > 0 ? box_blur(estimates.radiance, options.blur) : std::move(estimates.radiance);
+    if (layers & kLayerDepth) out.depth = std::move(estimates.depth);
+    if (layers & kLayerSamples) out.samples = std::move(estimates.samples);
+    // The variance belongs to the mean, not to its blurred picture.
+    if ((layers & kLayerVariance) && options.blur == 0) out.variance = std::move(estimates.variance);
+    if (layers & (kLayerAlbedo | kLayerNormal)) {
+        const SurfaceLayers surface = first_surface_layers(scene, width, height);
+        if (layers & kLayerAlbedo) out.albedo = floats(surface.albedo);
+        if (layers & kLayerNormal) out.normal = floats(surface.normal);
+    }
+    return out;
+}
+
+HdrImage hdr_from_developed(Developed image) {
+    HdrImage out = hdr_from_radiance(image.radiance);
+    out.depth.assign(image.depth.begin(), image.depth.end());
+    out.albedo = std::move(image.albedo);
+    out.normal = std::move(image.normal);
+    out.samples = std::move(image.samples);
+    out.variance = std::move(image.variance);
+    return out;
+}
+
+std::vector<FileOutput> encode_outputs(const std::filesystem::path& path, Developed image,
+                                       const DisplaySettings& display, const ToneMapper& tone_map) {
+    const ImageFormatInfo& format = output_format(path);
+    const int width = image.radiance.width, height = image.radiance.height;
+    if (format.depth_beside && image.depth.size() != image.radiance.pixels.size())
+        throw std::invalid_argument("encode_outputs: " + std::string(format.name) + " output without its depth layer");
+    std::vector<FileOutput> files;
+    const std::filesystem::path depth_file = depth_path_for(path);
+    switch (format.format) {
+    case ImageFormat::ppm:
+    case ImageFormat::png: {
+        const auto encode = format.format == ImageFormat::png ? encode_png : encode_ppm;
+        const Rgb8Image shown = tone_map ? tone_map(image.radiance, display)
+                                         : tonemap(image.radiance, display.tonemap, display.exposure_scale());
+        files.push_back({path, encode(shown)});
+        files.push_back({depth_file, encode(depth_to_rgb8(image.depth, width, height))});
+        break;
+    }
+    case ImageFormat::exr:
+        files.push_back({path, encode_exr(hdr_from_developed(std::move(image)))});
+        break;
+    case ImageFormat::pfm:
+        files.push_back({path, encode_pfm_rgb(hdr_from_radiance(image.radiance))});
+        files.push_back({depth_file, encode_pfm_gray(std::vector<float>(image.depth.begin(), image.depth.end()),
+                                                     width, height)});
+        break;
+    }
+    return files;
+}
+
+std::vector<FileOutput> output_files(const RenderScene& scene, RenderEstimates estimates, const OutputRequest& request) {
+    return encode_outputs(request.path, develop(scene, std::move(estimates), request.develop, layers_for(request)),
+                          request.display, request.tone_map);
+}
+
+std::vector<FileOutput> output_files(const RenderScene& scene, const RenderState& state, const OutputRequest& request) {
+    return output_files(scene, render_estimates(state, layers_for(request)), request);
+}
+
+}  // namespace kr

@@ -1,0 +1,79 @@
+// What a finished render writes, decided once for `keithray render` and the viewer's Save:
+// the render's per-pixel estimates are developed (the box blur; the first-surface layers
+// where the format holds them) and encoded into every file of one output, the format
+// chosen by the output's name (core/image_formats.h). The caller commits the files together
+// with write_files_atomic.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <vector>
+
+#include "core/file_write.h"
+#include "core/image.h"
+#include "core/image_formats.h"
+#include "render/progressive.h"
+#include "render/render_scene.h"
+#include "scene/scene.h"
+
+namespace kr {
+
+// A render's per-pixel estimates as develop reads them: from a RenderState's sums
+// (render_estimates), or the viewer's copy of them in its snapshot. A layer left empty was
+// not asked for.
+struct RenderEstimates {
+    Image radiance;                 // the mean radiance (compensated sums)
+    std::vector<double> depth;      // the mean primary hit distance
+    std::vector<uint32_t> samples;  // samples per pixel
+    std::vector<float> variance;    // 3 per pixel: the variance of the mean radiance
+};
+// The estimates of `state` for the layers `layers` asks for (RenderLayer bits).
+RenderEstimates render_estimates(const RenderState& state, unsigned layers);
+
+// How a render is developed into its images. A new step (a denoiser reading the albedo and
+// normal layers) is one more option here and one more step in develop().
+struct DevelopOptions {
+    int blur = 0;  // box blur radius of the radiance (0: none)
+};
+
+// A developed render: the images an output's files are encoded from. Empty layers are absent.
+struct Developed {
+    Image radiance;                // after the blur
+    std::vector<double> depth;     // the mean primary hit distance
+    std::vector<float> albedo;     // 3 per pixel (render/aov.h)
+    std::vector<float> normal;     // 3 per pixel
+    std::vector<uint32_t> samples;
+    std::vector<float> variance;   // 3 per pixel; left out when blurred (not the blurred mean's)
+};
+// Develops `estimates` of a render of `scene` into `layers` (RenderLayer bits): blurs the
+// radiance, traces the first-surface layers where asked, and drops the variance of a
+// blurred radiance.
+Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,
+                  unsigned layers = kAllLayers);
+
+// An 8-bit picture of the radiance for display settings: kr::tonemap by default; `render
+// --gl` passes the viewer's display shader.
+using ToneMapper = std::function<Rgb8Image(const Image& radiance, const DisplaySettings& display)>;
+
+// Every file of the output named `path` (format: output_format), encoded from `image`: the
+// radiance tone mapped with `display` (8-bit) or as floats, and the depth as a layer (EXR
+// with every layer) or in the depth file beside it (the 8-bit depth map, or a PFM of the
+// distances).
+std::vector<FileOutput> encode_outputs(const std::filesystem::path& path, Developed image,
+                                       const DisplaySettings& display, const ToneMapper& tone_map = {});
+
+// One output of a finished render: develop for the format's layers, then encode_outputs.
+struct OutputRequest {
+    std::filesystem::path path;
+    DevelopOptions develop;
+    DisplaySettings display;
+    ToneMapper tone_map;  // empty: kr::tonemap
+};
+std::vector<FileOutput> output_files(const RenderScene& scene, RenderEstimates estimates, const OutputRequest& request);
+std::vector<FileOutput> output_files(const RenderScene& scene, const RenderState& state, const OutputRequest& request);
+
+// The HDR image of a developed render (its layers as floats).
+HdrImage hdr_from_developed(Developed image);
+
+}  // namespace kr
