@@ -59,9 +59,7 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
         messages_.error = e.what();
     }
     ui_.files.watch.watch(options_.scene);
-    ui_.save_paths = &save_paths_;
-    ui_.request_save = [this](SaveKind kind, const std::filesystem::path& path) { request_save(kind, path); };
-    reset_save_paths();
+    if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene());
     CompareTool& tool = ui_.compare;
     tool.comparison.settings = options_.compare;
     tool.locked_probe = options_.probe;
@@ -256,7 +254,7 @@ void ViewerApp::draw_panels() {
     if (quit_popup(quit_asked_)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
     discard_popup(ctx_);
     if (!ui_.panel_visible) {
-        overwrite_popup();
+        overwrite_popup(ctx_);
         return;
     }
     const ImGuiIO& io = ImGui::GetIO();
@@ -272,8 +270,7 @@ void ViewerApp::draw_panels() {
     // The width the user dragged it to, for the next frame's layout.
     if (ImGui::IsWindowFocused() && io.MouseDown[0]) width = ImGui::GetWindowWidth();
     draw_panel_list(ctx_);
-    if (model_.has_scene()) panel_save();
-    overwrite_popup();
+    overwrite_popup(ctx_);
     ImGui::End();
 }
 

@@ -1,22 +1,17 @@
 // The viewer window: the GLFW context, the display, the render thread, and the frame loop
 // that draws the panel column (ui_panels.h), the status bar and popups (ui_overlays.h), the
 // image and the inspector (ui_compare.h), and handles the input (ui_input.h) and the scripted
-// runs (ui_script.h). What they share is in ui_context.h; the save dialog's logic is
-// viewer/save_dialog.h, its panel ui_save.cpp.
+// runs (ui_script.h). What they share is in ui_context.h.
 #pragma once
 
 #include <cstdint>
-#include <filesystem>
 #include <memory>
-#include <optional>
 #include <string>
-#include <utility>
 
 #include "viewer/gl_display.h"
 #include "viewer/gl_functions.h"
 #include "viewer/model.h"
 #include "viewer/render_worker.h"
-#include "viewer/save_dialog.h"
 #include "viewer/ui_context.h"
 #include "viewer/ui_input.h"
 #include "viewer/ui_script.h"
@@ -54,13 +49,6 @@ private:
     void toggle_fullscreen();
     Rgb8Image read_image_region(const PixelRect& rect) const;
 
-    // The Save panel (ui_save.cpp).
-    void panel_save();
-    void overwrite_popup();
-    void request_save(SaveKind kind, const std::filesystem::path& path);
-    void save_now(SaveKind kind, const std::filesystem::path& path);
-    void reset_save_paths();
-
     ViewOptions options_;
     GLFWwindow* window_ = nullptr;
     GlFunctions gl_;
@@ -90,9 +78,6 @@ private:
     int settle_frames_ = 0;   // frames still to draw after input, so ImGui settles
     bool input_seen_ = false; // set by the GLFW callbacks
     UiClock::time_point last_frame_{};
-
-    SavePaths save_paths_;  // the Save panel's fields
-    std::optional<std::pair<SaveKind, std::filesystem::path>> pending_save_;
 };
 
 }  // namespace kr::viewer

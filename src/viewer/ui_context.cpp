@@ -63,7 +63,7 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file) {
         ctx.messages.error.clear();
         if (file != files.watch.file()) {
             files.watch.watch(file);
-            if (ctx.ui.save_paths) *ctx.ui.save_paths = SavePaths::for_scene(ctx.model.scene());
+            ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene());
             // The brief's reference follows the scene; one the user chose stays.
             CompareTool& tool = ctx.ui.compare;
             if (tool.reference_automatic || !tool.comparison.reference()) {

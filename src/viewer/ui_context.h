@@ -73,6 +73,12 @@ struct SceneFiles {
     bool ask_discard = false;                           // open that question this frame
 };
 
+// The Save panel's paths (edited by the user) and the save awaiting the overwrite question.
+struct SaveTool {
+    SavePaths paths;
+    std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
+};
+
 // The window's state that the panels, the input handling and the scripted mode share.
 struct UiState {
     TypedFields typed;                       // numbers being typed into panel fields
@@ -86,9 +92,7 @@ struct UiState {
     double ui_fps = 0, ui_work = 0;          // UI frames per second, seconds of work each (smoothed)
     SceneFiles files;
     CompareTool compare;
-    // The Save panel's paths and its request (ViewerApp, ui_save.cpp).
-    SavePaths* save_paths = nullptr;
-    std::function<void(SaveKind, const std::filesystem::path&)> request_save;
+    SaveTool save;
 };
 
 // What a panel is drawn over: the model, the edit path, the messages and the window's state.
@@ -115,5 +119,11 @@ struct PanelContext {
 void open_scene(PanelContext& ctx, const std::filesystem::path& file);
 // The same, asking first when there are unsaved edits.
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file);
+
+// Writes `kind` to `path` (viewer/save_dialog.h), asking first when a file would be
+// replaced; the outcome is the status message (ui_panel_save.cpp).
+void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path& path);
+// The overwrite question, drawn every frame where request_save may have opened it.
+void overwrite_popup(PanelContext& ctx);
 
 }  // namespace kr::viewer

@@ -72,9 +72,9 @@ void plot_convergence(PanelContext& ctx) {
     ImGui::TextColored(ImVec4(0.35f, 0.67f, 1, 1), "estimated relative error");
     ImGui::SameLine();
     ImGui::TextColored(ImVec4(1, 0.63f, 0.24f, 1), ctx.ui.compare.comparison.reference() ? "RMSE vs reference" : "(no reference)");
-    ImGui::InputText("csv", &ctx.ui.save_paths->convergence);
+    ImGui::InputText("csv", &ctx.ui.save.paths.convergence);
     ImGui::BeginDisabled(points.empty());
-    if (ImGui::Button("Save convergence CSV")) ctx.ui.request_save(SaveKind::convergence, ctx.ui.save_paths->convergence);
+    if (ImGui::Button("Save convergence CSV")) request_save(ctx, SaveKind::convergence, ctx.ui.save.paths.convergence);
     ImGui::EndDisabled();
 }
 

@@ -15,7 +15,8 @@
     PANEL(tone_map, with_scene)  \
     PANEL(renderer, with_scene)  \
     PANEL(compare, with_scene)   \
-    PANEL(stats, with_scene)
+    PANEL(stats, with_scene)     \
+    PANEL(save, with_scene)
 
 namespace kr::viewer {
 
