@@ -179,7 +179,7 @@ TEST(Accel, AutomaticChoiceBySphereCount) {
     // The brief's scenes are small: always our own one-leaf blocks.
     for (int n = 1; n <= 8; ++n) {
         const RenderScene scene = prepare_scene(
-            load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
+            load_scene_file(test::brief_scene_file(n)).scene);
         EXPECT_EQ(scene.bvh.backend(), AccelBackend::own) << "scene " << n;
     }
     // Spheres beyond single precision's range: our tree, which works in double throughout.
@@ -275,7 +275,7 @@ TEST(Accel, EmbreeImageIsThePlainPaths) {
 TEST(Accel, ImagesMatchLinearScan) {
     for (int n : {3, 8}) {
         RenderScene scene =
-            prepare_scene(load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
+            prepare_scene(load_scene_file(test::brief_scene_file(n)).scene);
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
         settings.target_spp = 2;
         RenderState fast(128, 128), plain(128, 128);

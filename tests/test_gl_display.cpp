@@ -12,6 +12,7 @@
 
 #include "core/image.h"
 #include "core/image_io.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
@@ -46,7 +47,7 @@ protected:
 TEST_P(GlDisplay, MatchesCpuToneMap) {
     const auto [n, tonemap] = GetParam();
     const std::string scene =
-        (fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json")).string();
+        kr::test::brief_scene_file(n).string();
     // The brief's sigmoid at EV 0; the others with an exposure, which the linear map's scale
     // and the sRGB curve take on the CPU and in the shader alike.
     const std::string exposure = tonemap == "sigmoid" ? "" : " --exposure 0.5";

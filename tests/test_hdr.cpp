@@ -249,14 +249,6 @@ TEST(HdrStatistics, NormalQuantileMatchesKnownValues) {
 
 namespace {
 
-Scene brief_scene(int number, int size) {
-    Scene scene = load_scene_file(fs::path(KEITHRAY_RES_DIR) / "scenes" /
-                                  ("assignment_0" + std::to_string(number) + ".json"))
-                      .scene;
-    scene.renderer.width = scene.renderer.height = size;
-    return scene;
-}
-
 HdrImage render_hdr(const Scene& scene, int spp, uint64_t seed, Estimator estimator = Estimator::sobol) {
     const RenderScene prepared = prepare_scene(scene);
     RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
@@ -294,7 +286,7 @@ Scene green_rho_lowered(Scene s) {
 // 50 pairs of renders of one scene with different seeds: the failures must fit the stated
 // false-alarm rate (the Sobol samples' variance estimates are conservative, so fewer is fine).
 TEST(HdrStatistics, SameSceneDifferentSeedsPassAtTheFalseAlarmRate) {
-    const Scene scene = brief_scene(3, 32);
+    const Scene scene = test::brief_scene(3, 32);
     int failures_default = 0, failures_loose = 0;
     constexpr int kPairs = 50;
     for (int pair = 0; pair < kPairs; ++pair) {
@@ -313,7 +305,7 @@ TEST(HdrStatistics, SameSceneDifferentSeedsPassAtTheFalseAlarmRate) {
 // Independent (uniform) samples, whose variance estimates are not conservative as Sobol's
 // are, spread by the default adaptive allocation: the failures still fit the rate.
 TEST(HdrStatistics, IndependentSamplesWithAdaptiveAllocationPassAtTheFalseAlarmRate) {
-    const Scene scene = brief_scene(3, 32);
+    const Scene scene = test::brief_scene(3, 32);
     int failures_default = 0, failures_loose = 0;
     constexpr int kPairs = 25;
     for (int pair = 0; pair < kPairs; ++pair) {
@@ -335,7 +327,7 @@ TEST(HdrStatistics, IndependentSamplesWithAdaptiveAllocationPassAtTheFalseAlarmR
 class HdrChanges : public testing::TestWithParam<int> {};
 
 TEST_P(HdrChanges, EachChangeFailsAndTheSameSceneAgrees) {
-    const Scene scene = brief_scene(GetParam(), 64);
+    const Scene scene = test::brief_scene(GetParam(), 64);
     // The reference at 256 spp, as README's CI recipe keeps one: its own noise then adds a
     // quarter of the test's to the difference rather than as much again.
     const HdrImage reference = render_hdr(scene, 256, 1);
@@ -357,7 +349,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes3And6, HdrChanges, testing::Values(3, 6));
 // The 8-bit image from the EXR's float radiance is the one from the render's double radiance,
 // except where the float's rounding (2^-24) crosses a quantisation step.
 TEST(HdrRender, ToneMappedExrRadianceEqualsTheEightBitImage) {
-    const Scene scene = brief_scene(6, 32);
+    const Scene scene = test::brief_scene(6, 32);
     const RenderScene prepared = prepare_scene(scene);
     RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
     settings.target_spp = 8;

@@ -10,6 +10,7 @@
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "scene/load.h"
+#include "test_util.h"
 
 using namespace kr;
 
@@ -18,11 +19,11 @@ namespace {
 const std::string kRes = KEITHRAY_RES_DIR;
 
 Scene load(int n) {
-    return load_scene_file(kRes + "/scenes/assignment_0" + std::to_string(n) + ".json").scene;
+    return load_scene_file(test::brief_scene_file(n)).scene;
 }
 
 Rgb8Image reference(int n) {
-    return read_ppm(kRes + "/references/assignment_0" + std::to_string(n) + ".ppm");
+    return read_ppm(test::brief_reference_file(n));
 }
 
 Rgb8Image render(const Scene& authored, int spp) {

@@ -9,15 +9,12 @@
 #include <string>
 
 #include "scene/load.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 
 namespace kr {
 namespace {
-
-fs::path scene_file(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
-}
 
 int find_id(const auto& items, const std::string& id) {
     for (size_t i = 0; i < items.size(); ++i)
@@ -28,10 +25,10 @@ int find_id(const auto& items, const std::string& id) {
 TEST(LoadReferenceScenes, AllEightLoadWithoutWarnings) {
     for (int n = 1; n <= 8; ++n) {
         SCOPED_TRACE(n);
-        const LoadedScene loaded = load_scene_file(scene_file(n));
+        const LoadedScene loaded = load_scene_file(test::brief_scene_file(n));
         const Scene& s = loaded.scene;
         EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
-        EXPECT_EQ(s.source_file, scene_file(n));
+        EXPECT_EQ(s.source_file, test::brief_scene_file(n));
         EXPECT_EQ(s.cameras[size_t(s.camera)].id, "pinhole");
         EXPECT_EQ(s.renderer.width, 512);
         EXPECT_EQ(s.renderer.height, 512);
@@ -44,7 +41,7 @@ TEST(LoadReferenceScenes, AllEightLoadWithoutWarnings) {
 }
 
 TEST(LoadReferenceScenes, Assignment01Content) {
-    const Scene s = load_scene_file(scene_file(1)).scene;
+    const Scene s = load_scene_file(test::brief_scene_file(1)).scene;
     EXPECT_EQ(s.cameras.size(), 1u);
     EXPECT_EQ(s.materials.size(), 7u);
     EXPECT_EQ(s.shapes.size(), 7u);
@@ -80,7 +77,7 @@ TEST(LoadReferenceScenes, Assignment01Content) {
 }
 
 TEST(LoadReferenceScenes, Assignment03LensCameraAndAreaLight) {
-    const Scene s = load_scene_file(scene_file(3)).scene;
+    const Scene s = load_scene_file(test::brief_scene_file(3)).scene;
     ASSERT_EQ(s.cameras.size(), 2u);
     const int lens = find_id(s.cameras, "lens-based");
     ASSERT_GE(lens, 0);
@@ -108,7 +105,7 @@ TEST(LoadReferenceScenes, Assignment03LensCameraAndAreaLight) {
 }
 
 TEST(LoadReferenceScenes, Assignment04RepeatsAPrimitive) {
-    const Scene s = load_scene_file(scene_file(4)).scene;
+    const Scene s = load_scene_file(test::brief_scene_file(4)).scene;
     ASSERT_EQ(s.primitives.size(), 5u);
     EXPECT_EQ(s.primitives[1].id, "floor");
     EXPECT_EQ(s.primitives[2].id, "floor");
@@ -117,7 +114,7 @@ TEST(LoadReferenceScenes, Assignment04RepeatsAPrimitive) {
 }
 
 TEST(LoadReferenceScenes, Assignment07TwoPointLights) {
-    const Scene s = load_scene_file(scene_file(7)).scene;
+    const Scene s = load_scene_file(test::brief_scene_file(7)).scene;
     ASSERT_EQ(s.active_lights.size(), 2u);
     EXPECT_EQ(s.lights[size_t(s.active_lights[0])].power, Color(320, 300, 280));
     EXPECT_EQ(s.lights[size_t(s.active_lights[1])].power, Color(50, 60, 70));
@@ -126,7 +123,7 @@ TEST(LoadReferenceScenes, Assignment07TwoPointLights) {
 }
 
 TEST(LoadReferenceScenes, Assignment08TwoEmissivePrimitives) {
-    const Scene s = load_scene_file(scene_file(8)).scene;
+    const Scene s = load_scene_file(test::brief_scene_file(8)).scene;
     std::vector<const Primitive*> emissive;
     for (const Primitive& p : s.primitives)
         if (p.type == PrimitiveType::emissive) emissive.push_back(&p);
@@ -189,15 +186,6 @@ constexpr const char* kBaseScene = R"({
                  "output": "out.ppm"}
   }
 })";
-
-// Replaces the single occurrence of `from` (failing the test if it is not there once).
-std::string edit(std::string text, const std::string& from, const std::string& to) {
-    const size_t at = text.find(from);
-    EXPECT_NE(at, std::string::npos) << "base scene lacks: " << from;
-    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "ambiguous edit: " << from;
-    if (at != std::string::npos) text.replace(at, from.size(), to);
-    return text;
-}
 
 class LoadErrors : public ::testing::Test {
 protected:
@@ -282,7 +270,7 @@ TEST_F(LoadErrors, MalformedJsonNamesLineAndColumn) {
 }
 
 TEST_F(LoadErrors, DuplicateKey) {
-    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("rho": [0.9, 0, 0], "rho": [1, 1, 1]})"),
+    expect_error(test::edit_once(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("rho": [0.9, 0, 0], "rho": [1, 1, 1]})"),
                  "/materials/0/rho", "duplicate key \"rho\"");
 }
 
@@ -291,34 +279,34 @@ TEST_F(LoadErrors, NestingTooDeep) {
     expect_error(deep, "", "nesting deeper than 64");
     // Brackets inside strings do not count.
     std::string text = kBaseScene;
-    text = edit(text, R"("output": "out.ppm")", R"("output": ")" + std::string(100, '[') + R"(.ppm")");
+    text = test::edit_once(text, R"("output": "out.ppm")", R"("output": ")" + std::string(100, '[') + R"(.ppm")");
     EXPECT_NO_THROW(load_ok(text));
 }
 
 TEST_F(LoadErrors, InfiniteNumber) {
-    expect_error(edit(kBaseScene, R"("radius": 1})", R"("radius": 1e999})"), "/shapes/0/radius",
+    expect_error(test::edit_once(kBaseScene, R"("radius": 1})", R"("radius": 1e999})"), "/shapes/0/radius",
                  "not a finite number");
-    expect_error(edit(kBaseScene, R"("position": [0, 4, 0])", R"("position": [0, -1e400, 0])"),
+    expect_error(test::edit_once(kBaseScene, R"("position": [0, 4, 0])", R"("position": [0, -1e400, 0])"),
                  "/lights/1/position/1", "1e400");
 }
 
 TEST_F(LoadErrors, MissingField) {
-    expect_error(edit(kBaseScene, R"(, "radius": 1})", "}"), "/shapes/0", "missing key \"radius\"");
-    expect_error(edit(kBaseScene, R"("lights": ["lamp"],)", ""), "/scene", "missing key \"lights\"");
+    expect_error(test::edit_once(kBaseScene, R"(, "radius": 1})", "}"), "/shapes/0", "missing key \"radius\"");
+    expect_error(test::edit_once(kBaseScene, R"("lights": ["lamp"],)", ""), "/scene", "missing key \"lights\"");
 }
 
 TEST_F(LoadErrors, StringForANumber) {
-    expect_error(edit(kBaseScene, R"("fov": 45)", R"("fov": "45")"), "/cameras/0/fov",
+    expect_error(test::edit_once(kBaseScene, R"("fov": 45)", R"("fov": "45")"), "/cameras/0/fov",
                  "expected a number, got string \"45\"");
 }
 
 TEST_F(LoadErrors, NotAVec3) {
-    expect_error(edit(kBaseScene, R"("target": [0, 0, 0])", R"("target": [0, 0])"), "/cameras/0/target",
+    expect_error(test::edit_once(kBaseScene, R"("target": [0, 0, 0])", R"("target": [0, 0])"), "/cameras/0/target",
                  "expected an array of 3 finite numbers, got an array of 2 elements");
 }
 
 TEST_F(LoadErrors, UnknownMaterialTypeListsTheValidOnes) {
-    expect_error(edit(kBaseScene, R"("type": "diffuse", "rho": [0.9, 0, 0])",
+    expect_error(test::edit_once(kBaseScene, R"("type": "diffuse", "rho": [0.9, 0, 0])",
                       R"("type": "plastic", "rho": [0.9, 0, 0])"),
                  "/materials/0/type",
                  "unknown material type \"plastic\"; expected \"diffuse\", \"specular reflection\", "
@@ -326,12 +314,12 @@ TEST_F(LoadErrors, UnknownMaterialTypeListsTheValidOnes) {
 }
 
 TEST_F(LoadErrors, UnknownKey) {
-    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("colour": [0.9, 0, 0]})"),
+    expect_error(test::edit_once(kBaseScene, R"("rho": [0.9, 0, 0]})", R"("colour": [0.9, 0, 0]})"),
                  "/materials/0/colour", "unknown key \"colour\"; expected one of \"id\", \"type\", \"rho\"");
-    expect_error(edit(kBaseScene, R"("cameras": [)", R"("textures": [], "cameras": [)"), "/textures",
+    expect_error(test::edit_once(kBaseScene, R"("cameras": [)", R"("textures": [], "cameras": [)"), "/textures",
                  "unknown key \"textures\"");
     // "light" belongs to emissive primitives only.
-    expect_error(edit(kBaseScene, R"("material": "red"},)", R"("material": "red", "light": "lamp"},)"),
+    expect_error(test::edit_once(kBaseScene, R"("material": "red"},)", R"("material": "red", "light": "lamp"},)"),
                  "/scene/primitives/0/light", "unknown key \"light\"");
 }
 
@@ -341,7 +329,7 @@ TEST_F(LoadErrors, DisplayBlockIsOptionalAndStrict) {
     EXPECT_EQ(plain.scene.display.tonemap, ToneMap::sigmoid);
     EXPECT_EQ(plain.scene.display.exposure, 0.0);
     auto with_display = [](const std::string& block) {
-        return edit(kBaseScene, R"("renderer": {)", R"("display": )" + block + R"(, "renderer": {)");
+        return test::edit_once(kBaseScene, R"("renderer": {)", R"("display": )" + block + R"(, "renderer": {)");
     };
     const LoadedScene loaded = load_ok(with_display(R"({"tonemap": "linear", "exposure": -1.5})"));
     EXPECT_TRUE(loaded.warnings.empty());
@@ -358,76 +346,76 @@ TEST_F(LoadErrors, DisplayBlockIsOptionalAndStrict) {
 }
 
 TEST_F(LoadErrors, DanglingMaterialId) {
-    expect_error(edit(kBaseScene, R"("material": "glass")", R"("material": "chalk")"),
+    expect_error(test::edit_once(kBaseScene, R"("material": "glass")", R"("material": "chalk")"),
                  "/scene/primitives/1/material",
                  "no material with id \"chalk\"; expected one of \"red\", \"glass\", \"shiny\", \"spare\"");
 }
 
 TEST_F(LoadErrors, DanglingCameraLightAndShapeIds) {
-    expect_error(edit(kBaseScene, R"("camera": "cam")", R"("camera": "eye")"), "/scene/camera",
+    expect_error(test::edit_once(kBaseScene, R"("camera": "cam")", R"("camera": "eye")"), "/scene/camera",
                  "no camera with id \"eye\"; expected one of \"cam\"");
-    expect_error(edit(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "sun"])"), "/scene/lights/1",
+    expect_error(test::edit_once(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "sun"])"), "/scene/lights/1",
                  "no light with id \"sun\"");
-    expect_error(edit(kBaseScene, R"("shape": "lamp", "power")", R"("shape": "moon", "power")"),
+    expect_error(test::edit_once(kBaseScene, R"("shape": "lamp", "power")", R"("shape": "moon", "power")"),
                  "/lights/0/shape", "no shape with id \"moon\"");
 }
 
 TEST_F(LoadErrors, LightListedTwice) {
-    expect_error(edit(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "lamp"])"),
+    expect_error(test::edit_once(kBaseScene, R"("lights": ["lamp"])", R"("lights": ["lamp", "lamp"])"),
                  "/scene/lights/1", "already listed at /scene/lights/0");
 }
 
 TEST_F(LoadErrors, EmissivePrimitiveNeedsAnAreaLight) {
-    expect_error(edit(kBaseScene, R"("light": "lamp")", R"("light": "bulb")"), "/scene/primitives/3/light",
+    expect_error(test::edit_once(kBaseScene, R"("light": "lamp")", R"("light": "bulb")"), "/scene/primitives/3/light",
                  "expects an \"area\" light");
 }
 
 TEST_F(LoadErrors, NegativeRadius) {
-    expect_error(edit(kBaseScene, R"("radius": 1})", R"("radius": -1})"), "/shapes/0/radius",
+    expect_error(test::edit_once(kBaseScene, R"("radius": 1})", R"("radius": -1})"), "/shapes/0/radius",
                  "expected a radius > 0, got -1");
 }
 
 TEST_F(LoadErrors, EtaNotPositive) {
-    expect_error(edit(kBaseScene, R"("eta": 1.5)", R"("eta": 0)"), "/materials/1/eta",
+    expect_error(test::edit_once(kBaseScene, R"("eta": 1.5)", R"("eta": 0)"), "/materials/1/eta",
                  "expected a refractive index eta > 0, got 0");
 }
 
 TEST_F(LoadErrors, RoughnessOne) {
-    expect_error(edit(kBaseScene, R"("roughness": 0.2)", R"("roughness": 1)"), "/materials/2/roughness",
+    expect_error(test::edit_once(kBaseScene, R"("roughness": 0.2)", R"("roughness": 1)"), "/materials/2/roughness",
                  "expected a roughness in [0, 1), got 1");
 }
 
 TEST_F(LoadErrors, NegativeReflectance) {
-    expect_error(edit(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [0.9, -0.5, 0])"), "/materials/0/rho/1",
+    expect_error(test::edit_once(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [0.9, -0.5, 0])"), "/materials/0/rho/1",
                  "expected a value >= 0, got -0.5");
 }
 
 TEST_F(LoadErrors, ZeroDimension) {
-    expect_error(edit(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [0, 48])"),
+    expect_error(test::edit_once(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [0, 48])"),
                  "/scene/renderer/dimensions/0", "expected an integer in [1, 32768], got 0");
-    expect_error(edit(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [64, 40000])"),
+    expect_error(test::edit_once(kBaseScene, R"("dimensions": [64, 48])", R"("dimensions": [64, 40000])"),
                  "/scene/renderer/dimensions/1", "expected an integer in [1, 32768], got 40000");
 }
 
 TEST_F(LoadErrors, ZeroSamples) {
-    expect_error(edit(kBaseScene, R"("samples": 4)", R"("samples": 0)"), "/scene/renderer/samples",
+    expect_error(test::edit_once(kBaseScene, R"("samples": 4)", R"("samples": 0)"), "/scene/renderer/samples",
                  "expected an integer in [1, 16777216], got 0");
-    expect_error(edit(kBaseScene, R"("samples": 4)", R"("samples": 2.5)"), "/scene/renderer/samples",
+    expect_error(test::edit_once(kBaseScene, R"("samples": 4)", R"("samples": 2.5)"), "/scene/renderer/samples",
                  "got number 2.5");
 }
 
 TEST_F(LoadErrors, UnknownRendererType) {
-    expect_error(edit(kBaseScene, R"("type": "PT")", R"("type": "MLT")"), "/scene/renderer/type",
+    expect_error(test::edit_once(kBaseScene, R"("type": "PT")", R"("type": "MLT")"), "/scene/renderer/type",
                  "unknown renderer type \"MLT\"; expected \"WRT\" or \"PT\"");
 }
 
 TEST_F(LoadErrors, PositionEqualsTarget) {
-    expect_error(edit(kBaseScene, R"("position": [0, 0, -10])", R"("position": [0, 0, 0])"), "/cameras/0",
+    expect_error(test::edit_once(kBaseScene, R"("position": [0, 0, -10])", R"("position": [0, 0, 0])"), "/cameras/0",
                  "camera position equals target");
 }
 
 TEST_F(LoadErrors, DuplicateIdInACategory) {
-    expect_error(edit(kBaseScene, R"("id": "spare")", R"("id": "glass")"), "/materials/3/id",
+    expect_error(test::edit_once(kBaseScene, R"("id": "spare")", R"("id": "glass")"), "/materials/3/id",
                  "duplicate material id \"glass\": also the id of /materials/1");
 }
 
@@ -437,7 +425,7 @@ TEST_F(LoadErrors, TopLevelMustBeAnObjectWithAScene) {
 }
 
 TEST_F(LoadErrors, DepthAboveTwentyIsClampedWithAWarning) {
-    const LoadedScene loaded = load_ok(edit(kBaseScene, R"("depth": 6)", R"("depth": 25)"));
+    const LoadedScene loaded = load_ok(test::edit_once(kBaseScene, R"("depth": 6)", R"("depth": 25)"));
     EXPECT_EQ(loaded.scene.renderer.depth, kMaxDepth);
     ASSERT_EQ(loaded.warnings.size(), 1u);
     EXPECT_NE(loaded.warnings[0].find("/scene/renderer/depth"), std::string::npos) << loaded.warnings[0];
@@ -445,20 +433,20 @@ TEST_F(LoadErrors, DepthAboveTwentyIsClampedWithAWarning) {
 }
 
 TEST_F(LoadErrors, OutOfRangeInUnreferencedObjectsIsOnlyAWarning) {
-    std::string text = edit(kBaseScene, R"("rho": [0.5, 0.5, 0.5])", R"("rho": [-1, 0.5, 0.5])");
-    text = edit(text, R"("power": [100, 100, 100])", R"("power": [100, -2, 100])");
+    std::string text = test::edit_once(kBaseScene, R"("rho": [0.5, 0.5, 0.5])", R"("rho": [-1, 0.5, 0.5])");
+    text = test::edit_once(text, R"("power": [100, 100, 100])", R"("power": [100, -2, 100])");
     const LoadedScene loaded = load_ok(text);
     ASSERT_EQ(loaded.warnings.size(), 2u);
     EXPECT_NE(loaded.warnings[0].find(": /materials/3/rho/0: expected a value >= 0, got -1"), std::string::npos)
         << loaded.warnings[0];
     EXPECT_NE(loaded.warnings[1].find(": /lights/1/power/1: "), std::string::npos) << loaded.warnings[1];
     // Used by a primitive, the same value is an error.
-    expect_error(edit(text, R"("material": "glass")", R"("material": "spare")"), "/materials/3/rho/0",
+    expect_error(test::edit_once(text, R"("material": "glass")", R"("material": "spare")"), "/materials/3/rho/0",
                  "expected a value >= 0, got -1");
 }
 
 TEST_F(LoadErrors, ReflectanceAboveOneIsAWarning) {
-    const LoadedScene loaded = load_ok(edit(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [1.2, 0, 0])"));
+    const LoadedScene loaded = load_ok(test::edit_once(kBaseScene, R"("rho": [0.9, 0, 0])", R"("rho": [1.2, 0, 0])"));
     ASSERT_EQ(loaded.warnings.size(), 1u);
     EXPECT_NE(loaded.warnings[0].find("/materials/0/rho/0: "), std::string::npos) << loaded.warnings[0];
     EXPECT_NE(loaded.warnings[0].find("not energy conserving"), std::string::npos) << loaded.warnings[0];
@@ -466,7 +454,7 @@ TEST_F(LoadErrors, ReflectanceAboveOneIsAWarning) {
 
 TEST_F(LoadErrors, TranslucentDielectricLoads) {
     const LoadedScene loaded =
-        load_ok(edit(kBaseScene, R"("type": "fresnel dielectric", "rhoR": [1, 1, 1], "rhoT": [1, 1, 1], "eta": 1.5})",
+        load_ok(test::edit_once(kBaseScene, R"("type": "fresnel dielectric", "rhoR": [1, 1, 1], "rhoT": [1, 1, 1], "eta": 1.5})",
                      R"("type": "translucent dielectric", "rhoR": [1, 1, 1], "rhoT": [0.8, 0.8, 0.8], "eta": 1.33, "roughness": 0.3})"));
     const Material& m = loaded.scene.materials[1];
     EXPECT_EQ(m.type, MaterialType::translucent);
@@ -474,7 +462,7 @@ TEST_F(LoadErrors, TranslucentDielectricLoads) {
     EXPECT_DOUBLE_EQ(m.roughness, 0.3);
     EXPECT_EQ(m.rho_t, Color(0.8));
     // Its roughness is required and range checked like a glossy one.
-    expect_error(edit(kBaseScene, R"("type": "fresnel dielectric")", R"("type": "translucent dielectric")"),
+    expect_error(test::edit_once(kBaseScene, R"("type": "fresnel dielectric")", R"("type": "translucent dielectric")"),
                  "/materials/1", "missing key \"roughness\"");
 }
 
@@ -492,7 +480,7 @@ TEST_F(LoadErrors, MaterialParametersFollowTheTable) {
                 if (k != missing)
                     m += ", \"" + std::string(params[k].name) + "\": " + (params[k].colour ? "[0.5, 0.5, 0.5]" : "0.5");
             m += "}";
-            expect_error(edit(kBaseScene, glass, m), "/materials/1",
+            expect_error(test::edit_once(kBaseScene, glass, m), "/materials/1",
                          "missing key \"" + std::string(params[missing].name) + "\"");
         }
         for (const MaterialParam& param : params) {
@@ -501,16 +489,16 @@ TEST_F(LoadErrors, MaterialParametersFollowTheTable) {
             for (const MaterialParam& k : params)
                 m += ", \"" + std::string(k.name) + "\": " + (k.colour ? "[0.5, 0.5, 0.5]" : &k == &param ? "-1" : "0.5");
             m += "}";
-            expect_error(edit(kBaseScene, glass, m), "/materials/1/" + std::string(param.name),
+            expect_error(test::edit_once(kBaseScene, glass, m), "/materials/1/" + std::string(param.name),
                          "expected " + std::string(param.expected) + ", got -1");
         }
     }
 }
 
 TEST_F(LoadErrors, LensCameraNeedsFocalDistanceAndAlpha) {
-    expect_error(edit(kBaseScene, R"("type": "pinhole")", R"("type": "lens-based")"), "/cameras/0",
+    expect_error(test::edit_once(kBaseScene, R"("type": "pinhole")", R"("type": "lens-based")"), "/cameras/0",
                  "missing key \"focal distance\"");
-    expect_error(edit(kBaseScene, R"("type": "pinhole")",
+    expect_error(test::edit_once(kBaseScene, R"("type": "pinhole")",
                       R"("type": "lens-based", "focal distance": -3, "alpha": 0.5)"),
                  "/cameras/0/focal distance", "expected a focal distance > 0, got -3");
 }

@@ -103,7 +103,7 @@ Ray camera_ray_one_by_one(const RenderScene& scene, int width, int height, int x
 
 RenderScene brief_scene(int n) {
     return prepare_scene(
-        load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene);
+        load_scene_file(test::brief_scene_file(n)).scene);
 }
 
 // The kernels a test runs with: its settings' `kernels`.

@@ -11,6 +11,7 @@
 #include "render/progressive.h"
 #include "scene/load.h"
 #include "scene/save.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -79,10 +80,6 @@ void expect_equal_scenes(const Scene& a, const Scene& b, bool compare_output = t
     EXPECT_EQ(a.output_path(), b.output_path());
 }
 
-fs::path scene_file(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
-}
-
 class SaveScene : public testing::TestWithParam<int> {
 protected:
     fs::path dir;
@@ -98,7 +95,7 @@ protected:
 
 // load -> text -> load, read as if from the same file: the structs are equal, output included.
 TEST_P(SaveScene, TextRoundTripIsExact) {
-    const fs::path file = scene_file(GetParam());
+    const fs::path file = test::brief_scene_file(GetParam());
     const Scene original = load_scene_file(file).scene;
     const LoadedScene again = parse_scene(scene_to_json(original), file);
     expect_equal_scenes(original, again.scene);
@@ -107,7 +104,7 @@ TEST_P(SaveScene, TextRoundTripIsExact) {
 
 // load -> save elsewhere -> load: equal, and the output still names the same file.
 TEST_P(SaveScene, FileRoundTripKeepsOutputTarget) {
-    const Scene original = load_scene_file(scene_file(GetParam())).scene;
+    const Scene original = load_scene_file(test::brief_scene_file(GetParam())).scene;
     const fs::path saved = dir / "nested" / "copy.json";
     save_scene_json(original, saved);
     const Scene again = load_scene_file(saved).scene;
@@ -119,7 +116,7 @@ TEST_P(SaveScene, FileRoundTripKeepsOutputTarget) {
 
 // The saved file renders bit for bit the same image (a small crop of the view, 1 spp).
 TEST_P(SaveScene, SavedSceneRendersTheSameImage) {
-    Scene original = load_scene_file(scene_file(GetParam())).scene;
+    Scene original = load_scene_file(test::brief_scene_file(GetParam())).scene;
     original.renderer.width = original.renderer.height = 24;
     const fs::path saved = dir / "small.json";
     save_scene_json(original, saved);

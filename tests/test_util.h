@@ -92,9 +92,27 @@ protected:
     }
 };
 
-// Scene `n` of the brief (res/scenes/assignment_0n.json) at size x size pixels.
+// The brief's scene `n` (res/scenes/assignment_0n.json) and its reference render.
+inline std::filesystem::path brief_scene_file(int n) {
+    return std::filesystem::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
+}
+inline std::filesystem::path brief_reference_file(int n) {
+    return std::filesystem::path(KEITHRAY_RES_DIR) / "references" / ("assignment_0" + std::to_string(n) + ".ppm");
+}
+
+// `text` with its one occurrence of `from` replaced by `to`; the test fails where `from` is
+// not there exactly once.
+inline std::string edit_once(std::string text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << "no " << from;
+    EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "ambiguous " << from;
+    if (at != std::string::npos) text.replace(at, from.size(), to);
+    return text;
+}
+
+// Scene `n` of the brief at size x size pixels.
 inline Scene brief_scene(int n, int size) {
-    Scene scene = load_scene_file(std::string(KEITHRAY_RES_DIR) + "/scenes/assignment_0" + std::to_string(n) + ".json").scene;
+    Scene scene = load_scene_file(brief_scene_file(n)).scene;
     scene.renderer.width = scene.renderer.height = size;
     return scene;
 }

@@ -17,6 +17,7 @@
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
 #include "viewer/status.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -24,13 +25,9 @@ using namespace kr::viewer;
 
 namespace {
 
-fs::path scene_file(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
-}
-
 ViewerModel model_of(int n) {
     ViewerModel m;
-    m.load(scene_file(n));
+    m.load(test::brief_scene_file(n));
     return m;
 }
 
@@ -138,7 +135,7 @@ TEST(TargetSpp, ChangingTheTargetKeepsTheImage) {
 }
 
 TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
-    Scene authored = load_scene_file(scene_file(2)).scene;
+    Scene authored = load_scene_file(test::brief_scene_file(2)).scene;
     authored.renderer.width = 20;
     authored.renderer.height = 16;
     auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
@@ -349,14 +346,14 @@ TEST(ReloadChoice, AsksOnlyWithUnsavedEdits) {
     ASSERT_TRUE(m.redo());
     EXPECT_EQ(m.on_file_changed(), WatchAction::ask);
     // "Reload": the file's scene, no undo history, nothing unsaved.
-    m.load(scene_file(3));
+    m.load(test::brief_scene_file(3));
     EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
     EXPECT_FALSE(m.can_undo());
 }
 
 // Defect 7: the display settings come from the scene file and go back into it.
 TEST(DisplaySettings, ModelTakesAndSavesTheDisplayBlock) {
-    Scene scene = load_scene_file(scene_file(3)).scene;
+    Scene scene = load_scene_file(test::brief_scene_file(3)).scene;
     scene.display.tonemap = ToneMap::linear;
     scene.display.exposure = -1.5;
     ViewerModel m;

@@ -25,13 +25,9 @@ using namespace kr::viewer;
 
 namespace {
 
-fs::path scene_file(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
-}
-
 ViewerModel model_of(int n) {
     ViewerModel m;
-    m.load(scene_file(n));
+    m.load(test::brief_scene_file(n));
     return m;
 }
 
@@ -178,7 +174,7 @@ TEST(Navigation, PanMovesBothDollyKeepsDirection) {
 // ray grazes), the far wall (a radius-500 sphere whose near side is about the plane z = 5)
 // is about 20 away along the view axis.
 TEST(ClickToFocus, DistanceAlongViewAxis) {
-    const RenderScene scene = prepare_scene(load_scene_file(scene_file(3)).scene);
+    const RenderScene scene = prepare_scene(load_scene_file(test::brief_scene_file(3)).scene);
     const auto d = focus_distance(scene, 0.5, 0.6);
     ASSERT_TRUE(d.has_value());
     EXPECT_NEAR(*d, 20, 0.01);
@@ -247,7 +243,7 @@ TEST(RenderThread, PreviewScalesFitTheBudget) {
 // The worker's published frames are the deterministic estimate: at the target spp they
 // equal plain render passes, whatever the thread timing, edits and previews before.
 TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
-    Scene authored = load_scene_file(scene_file(8)).scene;
+    Scene authored = load_scene_file(test::brief_scene_file(8)).scene;
     authored.renderer.width = 40;
     authored.renderer.height = 30;
     auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
@@ -281,7 +277,7 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
 }
 
 TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
-    Scene authored = load_scene_file(scene_file(2)).scene;
+    Scene authored = load_scene_file(test::brief_scene_file(2)).scene;
     authored.renderer.width = authored.renderer.height = 16;
     auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
@@ -306,7 +302,7 @@ TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
 // estimated relative error is below the target (adaptively), and the time rule after its
 // seconds; both like render --noise / --time.
 TEST(RenderThread, NoiseAndTimeRulesStopTheEstimate) {
-    Scene authored = load_scene_file(scene_file(3)).scene;
+    Scene authored = load_scene_file(test::brief_scene_file(3)).scene;
     authored.renderer.width = authored.renderer.height = 24;
     auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
@@ -345,7 +341,7 @@ TEST(SceneWatch, BrokenFileKeepsTheLastGoodScene) {
     fs::create_directories(dir);
     const fs::path file = dir / "scene.json";
     std::stringstream original;
-    original << std::ifstream(scene_file(2)).rdbuf();
+    original << std::ifstream(test::brief_scene_file(2)).rdbuf();
     std::ofstream(file) << original.str();
 
     ViewerModel m;

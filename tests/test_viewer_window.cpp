@@ -55,7 +55,7 @@ protected:
         if (!dir.empty()) fs::remove_all(dir);
     }
     static std::string scene(int n) {
-        return (fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json")).string();
+        return kr::test::brief_scene_file(n).string();
     }
     ViewRun keithray(const std::string& args, bool window) {
         // A screen big enough for the 512x512 image at 1:1 beside the panels.
@@ -166,9 +166,7 @@ TEST_F(ViewerWindow, BrokenSceneFailsScriptedRunWithItsError) {
 // brief's reference, offered for its scene.
 namespace {
 
-fs::path reference(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "references" / ("assignment_0" + std::to_string(n) + ".ppm");
-}
+fs::path reference(int n) { return kr::test::brief_reference_file(n); }
 
 }  // namespace
 
@@ -277,7 +275,7 @@ std::map<std::string, std::string> drive(const fs::path& dir, const std::string&
     const std::string script = (fs::path(KEITHRAY_RES_DIR) / ".." / "tests" / "viewer_input.sh").string();
     const kr::test::CommandResult r = kr::test::run_command(
         "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' bash '" + script + "' " + scenario + " '" + KEITHRAY_EXE +
-            "' '" + (fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(scene_number) + ".json")).string() +
+            "' '" + kr::test::brief_scene_file(scene_number).string() +
             "' '" + dir.string() + "'",
         dir);
     std::map<std::string, std::string> out;

@@ -20,6 +20,7 @@
 #include "viewer/edit.h"
 #include "viewer/model.h"
 #include "viewer/render_worker.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -28,14 +29,10 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-fs::path scene_file(int n) {
-    return fs::path(KEITHRAY_RES_DIR) / "scenes" / ("assignment_0" + std::to_string(n) + ".json");
-}
-
 // A brief scene at a small size, so that passes are short even under a sanitizer but
 // still span many rows (the stop flag is checked per row).
 std::shared_ptr<const RenderScene> small_scene(int n, int width, int height) {
-    Scene authored = load_scene_file(scene_file(n)).scene;
+    Scene authored = load_scene_file(test::brief_scene_file(n)).scene;
     authored.renderer.width = width;
     authored.renderer.height = height;
     return std::make_shared<const RenderScene>(prepare_scene(authored));
@@ -180,7 +177,7 @@ TEST(WorkerStress, ConcurrentSubmitters) {
 // for the pass in flight; the final frame has the last scene's size.
 TEST(WorkerStress, SceneReloadWhileRendering) {
     ViewerModel model;
-    model.load(scene_file(3));
+    model.load(test::brief_scene_file(3));
     RenderWorker worker;
     auto submit = [&] {
         RenderSettings s = model.settings().render;
@@ -191,7 +188,7 @@ TEST(WorkerStress, SceneReloadWhileRendering) {
     int w = 0, h = 0;
     for (int round = 0; round < 3; ++round)
         for (int n : scenes) {
-            model.load(scene_file(n));
+            model.load(test::brief_scene_file(n));
             w = 24 + 4 * n + round, h = 16 + 2 * n;
             ASSERT_TRUE(model.edit(Edit::renderer, [&](Scene& sc, ViewerSettings& vs) {
                 sc.renderer.width = w;

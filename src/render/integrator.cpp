@@ -1,6 +1,6 @@
 // The two integrators: Whitted-style recursive ray tracing and iterative path tracing, one
 // sample at a time. Path tracing of eight (float) or four (double) samples at once is
-// packet.cpp; the steps both path tracers share are here (path.h) and in vertex.h.
+// packet.cpp; the steps both path tracers share are in path.cpp and vertex.h.
 #include <algorithm>
 
 #include "render/material.h"
@@ -11,95 +11,6 @@
 namespace kr {
 
 using vertex::OnePath;
-
-// A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
-// whole Ray just after its fields were stored stalls on store forwarding (measured: a
-// tenth of the path loop's time).
-void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax, int to_sphere) {
-    r.o = hit.p;
-    r.d = dir;
-    r.tmin = 0;
-    r.tmax = tmax;
-    r.from_sphere = hit.sphere;
-    r.into_from_sphere = dot(dir, hit.n) < 0;
-    r.to_sphere = to_sphere;
-}
-
-namespace {
-
-// Direct light from one point light at a surface with a smooth lobe (no selection pdf):
-// the shadow ray to cast and what it brings if nothing blocks it. False: nothing to bring.
-bool point_light_direct(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp,
-                        Ray& shadow, Color& direct) {
-    Vec3 wi = light.position - hit.p;
-    const double d2 = dot(wi, wi);
-    if (!(d2 > 0)) return false;
-    const double d = std::sqrt(d2);
-    wi = wi / d;
-    const Color f_cos = eval_smooth(m, sp, wi);
-    if (is_black(f_cos)) return false;
-    // Irradiance = I cos / d^2 (the power of a point light is its intensity).
-    respawn(shadow, hit, wi, d);
-    direct = f_cos * light.intensity / d2;
-    return true;
-}
-
-// Light sample towards one area light; `mis` weights it against BSDF sampling. The shadow
-// ray to cast and what it brings if nothing blocks it; false: nothing to bring.
-bool area_light_direct(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Material& m,
-                       const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
-                       Color& direct) {
-    if (light.sphere == hit.sphere) return false;  // a convex emitter cannot light itself
-    if (!has_smooth_lobe(m)) return false;          // eval_smooth is 0
-    LightSample ls;
-    const SphereGeom& geom = scene.spheres[light.sphere];
-    if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
-    const vertex::DirectLight<OnePath> d = vertex::direct_light<OnePath>(
-        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, m.rho, sp.ns(), light.radiance, select_prob, mis);
-    if (!d.lit) return false;
-    respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
-    direct = d.light;
-    return true;
-}
-
-}  // namespace
-
-double emission_weight(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Hit& hit,
-                       const Vec3& incoming, const PathHistory& history) {
-    if (history.full_emission || hit.sphere == history.last_sphere) return 1;
-    // The light sample at the last vertex counted all of this light, or could have found this
-    // point too: then the two strategies are weighed by the power heuristic.
-    if (!combines_with_bsdf(sampling)) return 0;
-    const SphereGeom& geom = scene.spheres[hit.sphere];
-    const double p_light = light.select_prob * sphere_light_pdf(geom, history.last_p, incoming, hit.t, hit.n, sampling);
-    const double p_bsdf = history.last_bsdf_pdf;
-    return light_emission_scale(geom, history.last_p, incoming, hit.n, sampling) * p_bsdf * p_bsdf /
-           (p_bsdf * p_bsdf + p_light * p_light);
-}
-
-bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
-                      const SurfacePoint& sp, double u, Vec2 u_point, Ray& shadow, Color& direct) {
-    const vertex::LightChoice<OnePath> choice =
-        vertex::choose_light<OnePath>(scene, settings.integrator == Integrator::pt_naive, u);
-    if (choice.point >= 0) {
-        const PointLight& light = scene.point_lights[size_t(choice.point)];
-        if (!point_light_direct(light, m, hit, sp, shadow, direct)) return false;
-        direct = direct / light.select_prob;
-        return true;
-    }
-    if (choice.area < 0) return false;
-    const AreaLight& light = scene.area_lights[size_t(choice.area)];
-    return light.select_prob > 0 && area_light_direct(scene, settings.light_sampling, light, m, hit, sp, true,
-                                                       light.select_prob, u_point, shadow, direct);
-}
-
-unsigned vertex_numbers_used(const RenderScene& scene, const Material& m, int bounce, int rr_depth) {
-    const bool next_event = has_smooth_lobe(m) && scene.light_count() > 0;
-    return (next_event && scene.light_count() > 1 ? Sampler::use_light_pick : 0u) |
-           (next_event && !scene.area_lights.empty() ? Sampler::use_light : 0u) |
-           (uses_lobe_choice(m) ? Sampler::use_lobe : 0u) | (uses_direction_sample(m) ? Sampler::use_bsdf : 0u) |
-           (bounce + 1 >= rr_depth ? Sampler::use_roulette : 0u);
-}
 
 namespace {
 
