@@ -142,7 +142,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 2;
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     auto wait_for = [&](auto done) {
         std::shared_ptr<const Snapshot> f = worker.latest();
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
@@ -152,7 +152,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     };
     const auto first = wait_for([](const Snapshot& s) { return s.finished; });
     ASSERT_TRUE(first && first->spp == 2);
-    worker.set_target_spp(4);
+    worker.set_stop_rule(StopRule{4});
     // Every frame after the raise is a full-resolution continuation: 3, then 4 passes.
     int last_spp = 2;
     std::shared_ptr<const Snapshot> f = first;
@@ -166,7 +166,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     }
     ASSERT_TRUE(f->finished);
     EXPECT_EQ(f->spp, 4);
-    EXPECT_EQ(f->target_spp, 4);
+    EXPECT_EQ(f->max_passes, 4);
     // The same image as four plain passes: the two first were kept, not re-rendered.
     RenderState plain(20, 16);
     for (int i = 0; i < 4; ++i) render_pass(*scene, settings, plain);
@@ -175,7 +175,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
         for (int k = 0; k < 3; ++k)
             ASSERT_NEAR(f->radiance.pixels[i][k], expected.pixels[i][k], 1e-12 * (1 + expected.pixels[i][k]));
     // A target below the count taken: nothing more is rendered.
-    worker.set_target_spp(3);
+    worker.set_stop_rule(StopRule{3});
     const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
     EXPECT_EQ(more->serial, f->serial);
 }
@@ -204,19 +204,19 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
     // Done at 64; a raised target (65) renders on; a lowered one (below 116 done) is done.
     f.spp = 64;
     f.finished = true;
-    f.stopped_by = "spp";
+    f.stopped_by = StopReason::passes;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
     s.render.target_spp = 65;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
     f.spp = 116;
     f.finished = false;
-    f.stopped_by = "";
+    f.stopped_by.reset();
     s.render.target_spp = 64;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
     s.unlimited = true;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
     // The noise rule: 4% now, 2% wanted: four times the passes, 1/4 of the way.
-    s.stop_noise = 0.02;
+    s.stop.noise = 0.02;
     st = run_status(&f, s, false);
     EXPECT_EQ(st.rule, "noise");
     EXPECT_DOUBLE_EQ(st.progress, 0.25);

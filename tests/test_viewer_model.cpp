@@ -251,11 +251,11 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
     settings.target_spp = 3;
 
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     RenderSettings other = settings;
     other.max_depth = 1;
-    worker.submit({2, scene, other});  // an edit at once: generation 1 may never show
-    worker.submit({3, scene, settings});
+    worker.submit({2, scene, other, StopRule{other.target_spp}});  // an edit at once: generation 1 may never show
+    worker.submit({3, scene, settings, StopRule{settings.target_spp}});
     std::shared_ptr<const Snapshot> f;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
     while (!(f && f->generation == 3 && f->finished) && std::chrono::steady_clock::now() < deadline)
@@ -283,11 +283,11 @@ TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 2;
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     std::shared_ptr<const Snapshot> f;
     while (!(f && f->finished)) f = worker.wait_newer(f ? f->serial : 0, std::chrono::seconds(10));
     worker.set_paused(true);
-    worker.set_unlimited(true);
+    worker.set_stop_rule(StopRule{kUnlimitedPasses});
     // Paused: nothing new (at most the pass that was running when pause came).
     const auto paused_frame = worker.wait_newer(f->serial, std::chrono::milliseconds(200));
     const auto still = worker.wait_newer(paused_frame->serial, std::chrono::milliseconds(300));
@@ -316,24 +316,20 @@ TEST(RenderThread, NoiseAndTimeRulesStopTheEstimate) {
     };
     {
         RenderWorker worker;
-        worker.set_unlimited(true);
-        worker.set_stop_rule(0, 0.05);
-        worker.submit({1, scene, settings});
+        worker.submit({1, scene, settings, StopRule{kUnlimitedPasses, 0, 0.05}});
         const auto f = run_until_finished(worker);
         ASSERT_TRUE(f && f->finished);
-        EXPECT_STREQ(f->stopped_by, "noise");
+        EXPECT_EQ(f->stopped_by, StopReason::noise);
         EXPECT_GT(f->spp, 16);  // past the (ignored) target: the rule decided
         // The whole image is within the target (every pixel within its share implies it).
         EXPECT_LE(f->relative_error, 0.05);
     }
     {
         RenderWorker worker;
-        worker.set_unlimited(true);
-        worker.set_stop_rule(0.3, 0);
-        worker.submit({1, scene, settings});
+        worker.submit({1, scene, settings, StopRule{kUnlimitedPasses, 0.3, 0}});
         const auto f = run_until_finished(worker);
         ASSERT_TRUE(f && f->finished);
-        EXPECT_STREQ(f->stopped_by, "time");
+        EXPECT_EQ(f->stopped_by, StopReason::time);
         EXPECT_GE(f->full_seconds, 0.3);
         const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
         EXPECT_EQ(more->serial, f->serial);  // and stays stopped
