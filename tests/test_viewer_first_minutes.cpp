@@ -25,12 +25,6 @@ using namespace kr::viewer;
 
 namespace {
 
-ViewerModel model_of(int n) {
-    ViewerModel m;
-    m.load(test::brief_scene_file(n));
-    return m;
-}
-
 void move_camera_x(ViewerModel& m, double x, const char* group = "") {
     ASSERT_TRUE(m.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].position.x = x; },
                        nullptr, "camera position", group));
@@ -46,7 +40,7 @@ double yaw_degrees(const Camera& c) {
 // Defect 1: a press and release with a pixel of jitter, or a pointer that jumps between
 // events, never orbits.
 TEST(DragGesture, JitterBelowTheThresholdIsAClick) {
-    Camera cam = model_of(3).camera();
+    Camera cam = test::brief_model(3).camera();
     DragGesture g;
     g.press(100, 100);
     double dx = 0, dy = 0;
@@ -59,7 +53,7 @@ TEST(DragGesture, JitterBelowTheThresholdIsAClick) {
 }
 
 TEST(DragGesture, OffsetIsFromWhereTheDragStartedNotThePreviousEvent) {
-    Camera cam = model_of(3).camera();
+    Camera cam = test::brief_model(3).camera();
     DragGesture g;
     g.press(100, 100);
     double dx = 1, dy = 1;
@@ -84,7 +78,7 @@ TEST(DragGesture, OffsetIsFromWhereTheDragStartedNotThePreviousEvent) {
 
 // Defect 10: held keys move at a rate per second, whatever the frame rate.
 TEST(KeyMotion, SameMotionAtAnyFrameRate) {
-    const Camera start = model_of(3).camera();
+    const Camera start = test::brief_model(3).camera();
     KeyMotion keys;
     keys.orbit_x = 1;
     auto held = [&](int frames, double seconds) {
@@ -104,10 +98,10 @@ TEST(KeyMotion, SameMotionAtAnyFrameRate) {
 // Defect 10: a camera orbited into a wall sphere is named.
 TEST(CameraInside, NamesTheSphereAroundTheCamera) {
     for (int n = 1; n <= 8; ++n) {
-        const ViewerModel m = model_of(n);
+        const ViewerModel m = test::brief_model(n);
         EXPECT_FALSE(sphere_containing(m.scene(), m.camera().position)) << "scene " << n;
     }
-    const ViewerModel m = model_of(3);
+    const ViewerModel m = test::brief_model(3);
     const Primitive& p = m.scene().primitives[0];
     const Shape& s = m.scene().shapes[size_t(p.shape)];
     const auto inside = sphere_containing(m.scene(), s.centre);
@@ -118,7 +112,7 @@ TEST(CameraInside, NamesTheSphereAroundTheCamera) {
 // Defect 2: a new target keeps the samples; only the stratified estimator, whose strata
 // depend on the target, restarts.
 TEST(TargetSpp, ChangingTheTargetKeepsTheImage) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     const auto prepared = m.prepared();
     ASSERT_TRUE(m.set_target_spp(65));
@@ -227,7 +221,7 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
 // Defect 4: a typed value is applied once, on Enter or focus loss; a refused one names the
 // field and keeps the previous value.
 TEST(TypedValue, AppliedOnceWhenTheFieldIsLeft) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     TypedFields typed;
     const uint64_t g = m.generation();
     for (double keystroke : {-2.0, -20.0}) typed.hold(7, &keystroke, 1);  // "-2", then "-20"
@@ -252,7 +246,7 @@ TEST(TypedValue, RefusedEditNamesTheFieldAndKeepsThePreviousValue) {
     const double ok[3] = {0, 1, 2};
     EXPECT_FALSE(check_typed_value("position", ok, 3, -10, 10));
 
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const Camera before = m.camera();
     std::string error;
     EXPECT_FALSE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) {
@@ -269,7 +263,7 @@ TEST(TypedValue, RefusedEditNamesTheFieldAndKeepsThePreviousValue) {
 
 // Defect 6: undo and redo of every scene and settings edit; one drag is one step.
 TEST(UndoRedo, EditsUndoAndRedoInOrder) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const double x0 = m.camera().position.x;
     const uint64_t g0 = m.generation();
     move_camera_x(m, 1);
@@ -304,7 +298,7 @@ TEST(UndoRedo, EditsUndoAndRedoInOrder) {
 }
 
 TEST(UndoRedo, OneDragIsOneStep) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const double x0 = m.camera().position.x;
     for (int i = 1; i <= 10; ++i) move_camera_x(m, i, "orbit");
     m.seal_undo_step();
@@ -317,7 +311,7 @@ TEST(UndoRedo, OneDragIsOneStep) {
 }
 
 TEST(UndoRedo, ResetViewReturnsToTheFilesCamera) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const Camera file = m.camera();
     ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { orbit(s.cameras[size_t(s.camera)], 20, 5); }));
     ASSERT_TRUE(m.edit(Edit::lens, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].alpha = 0.3; }));
@@ -332,7 +326,7 @@ TEST(UndoRedo, ResetViewReturnsToTheFilesCamera) {
 
 // Defect 5: a change of the file on disk reloads at once only without unsaved edits.
 TEST(ReloadChoice, AsksOnlyWithUnsavedEdits) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
     ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));
     EXPECT_EQ(m.on_file_changed(), WatchAction::reload);  // pausing is not an edit to keep

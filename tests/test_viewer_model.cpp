@@ -23,16 +23,6 @@ namespace fs = std::filesystem;
 using namespace kr;
 using namespace kr::viewer;
 
-namespace {
-
-ViewerModel model_of(int n) {
-    ViewerModel m;
-    m.load(test::brief_scene_file(n));
-    return m;
-}
-
-}  // namespace
-
 TEST(ResetRule, ImageEditsResetDisplayEditsDoNot) {
     for (Edit e : {Edit::camera, Edit::lens, Edit::light, Edit::material, Edit::renderer, Edit::scene})
         EXPECT_TRUE(edit_resets(e)) << int(e);
@@ -41,7 +31,7 @@ TEST(ResetRule, ImageEditsResetDisplayEditsDoNot) {
 }
 
 TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g0 = m.generation();
     auto scene_before = m.prepared();
 
@@ -118,7 +108,7 @@ TEST(ResetRule, EditsThatMoveNoSphereKeepTheBvh) {
 
 // Authored and prepared stay apart: an edit the renderer cannot take is undone whole.
 TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     const Camera before = m.camera();
     std::string error;
@@ -132,7 +122,7 @@ TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
 }
 
 TEST(ResetRule, SavedSceneCarriesRendererSettings) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) {
         s.render.integrator = Integrator::wrt;
         s.render.max_depth = 3;
@@ -190,7 +180,7 @@ TEST(ClickToFocus, DistanceAlongViewAxis) {
 }
 
 TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     ASSERT_TRUE(m.focus_at(0.5, 0.6));
     EXPECT_EQ(m.camera().type, CameraType::lens);
