@@ -257,7 +257,7 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     // The viewer's render thread, through the same driver.
     settings.target_spp = rule.max_passes;
     viewer::RenderWorker worker;
-    worker.submit({1, std::make_shared<const RenderScene>(scene), settings});
+    worker.submit({1, std::make_shared<const RenderScene>(scene), settings, rule});
     std::shared_ptr<const viewer::Snapshot> f;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
     while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)

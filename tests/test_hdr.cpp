@@ -489,6 +489,37 @@ TEST_F(HdrCli, CompareExitStatusVerdictAndDiffImage) {
     EXPECT_GT(read_hdr(dir / "b.exr").rgb.size(), 0u);
 }
 
+// A NaN or infinite radiance never passes as data: psnr and compare refuse the file (exit 1,
+// one line naming it and the first such pixel), whatever the thresholds; an image of NaNs
+// never "agrees" with a black one.
+TEST_F(HdrCli, NonFiniteRadianceIsRefusedNeverAgreement) {
+    HdrImage black;
+    black.width = 4;
+    black.height = 3;
+    black.rgb.assign(black.pixel_count() * 3, 0.0f);
+    HdrImage nan = black, inf = black;
+    std::fill(nan.rgb.begin(), nan.rgb.end(), std::numeric_limits<float>::quiet_NaN());
+    inf.rgb[3 * 5 + 1] = std::numeric_limits<float>::infinity();  // pixel (1, 1), green
+    write_bytes(dir / "black.pfm", encode_pfm_rgb(black));
+    write_bytes(dir / "nan.pfm", encode_pfm_rgb(nan));
+    write_bytes(dir / "inf.pfm", encode_pfm_rgb(inf));
+    const std::pair<std::string, std::string> cases[] = {
+        {"compare nan.pfm black.pfm --min-psnr 30", "nan.pfm"},
+        {"compare black.pfm nan.pfm --max-rmse 1e30", "nan.pfm"},
+        {"compare inf.pfm inf.pfm --max-relmse 1", "inf.pfm"},
+        {"psnr nan.pfm black.pfm", "nan.pfm"},
+    };
+    for (const auto& [args, file] : cases) {
+        const test::CommandResult r = run(args);
+        EXPECT_EQ(r.status, 1) << args << "\n" << r.out << r.err;
+        EXPECT_EQ(r.out.find("agree"), std::string::npos) << args << "\n" << r.out;
+        expect_one_line_naming(r.err, file);
+        EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
+    }
+    EXPECT_NE(run("psnr inf.pfm black.pfm").err.find("infinite at pixel (1, 1)"), std::string::npos);
+    EXPECT_EQ(run("compare black.pfm black.pfm --min-psnr 30").status, 0);
+}
+
 TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {
     write_scene("s.json");
     write_scene("wide.json", 20);

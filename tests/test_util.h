@@ -18,6 +18,7 @@
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "scene/scene.h"
+#include "viewer/model.h"
 
 // KR_TEST_SANITIZED: this build runs under a sanitizer, which reserves terabytes of address
 // space, so tests that run the program under `ulimit -v` skip.
@@ -108,6 +109,13 @@ inline std::string edit_once(std::string text, const std::string& from, const st
     EXPECT_EQ(text.find(from, at + 1), std::string::npos) << "ambiguous " << from;
     if (at != std::string::npos) text.replace(at, from.size(), to);
     return text;
+}
+
+// The viewer's model with the brief's scene `n` loaded.
+inline viewer::ViewerModel brief_model(int n) {
+    viewer::ViewerModel m;
+    m.load(brief_scene_file(n));
+    return m;
 }
 
 // Scene `n` of the brief at size x size pixels.

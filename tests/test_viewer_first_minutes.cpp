@@ -25,12 +25,6 @@ using namespace kr::viewer;
 
 namespace {
 
-ViewerModel model_of(int n) {
-    ViewerModel m;
-    m.load(test::brief_scene_file(n));
-    return m;
-}
-
 void move_camera_x(ViewerModel& m, double x, const char* group = "") {
     ASSERT_TRUE(m.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].position.x = x; },
                        nullptr, "camera position", group));
@@ -46,7 +40,7 @@ double yaw_degrees(const Camera& c) {
 // Defect 1: a press and release with a pixel of jitter, or a pointer that jumps between
 // events, never orbits.
 TEST(DragGesture, JitterBelowTheThresholdIsAClick) {
-    Camera cam = model_of(3).camera();
+    Camera cam = test::brief_model(3).camera();
     DragGesture g;
     g.press(100, 100);
     double dx = 0, dy = 0;
@@ -59,7 +53,7 @@ TEST(DragGesture, JitterBelowTheThresholdIsAClick) {
 }
 
 TEST(DragGesture, OffsetIsFromWhereTheDragStartedNotThePreviousEvent) {
-    Camera cam = model_of(3).camera();
+    Camera cam = test::brief_model(3).camera();
     DragGesture g;
     g.press(100, 100);
     double dx = 1, dy = 1;
@@ -84,7 +78,7 @@ TEST(DragGesture, OffsetIsFromWhereTheDragStartedNotThePreviousEvent) {
 
 // Defect 10: held keys move at a rate per second, whatever the frame rate.
 TEST(KeyMotion, SameMotionAtAnyFrameRate) {
-    const Camera start = model_of(3).camera();
+    const Camera start = test::brief_model(3).camera();
     KeyMotion keys;
     keys.orbit_x = 1;
     auto held = [&](int frames, double seconds) {
@@ -104,10 +98,10 @@ TEST(KeyMotion, SameMotionAtAnyFrameRate) {
 // Defect 10: a camera orbited into a wall sphere is named.
 TEST(CameraInside, NamesTheSphereAroundTheCamera) {
     for (int n = 1; n <= 8; ++n) {
-        const ViewerModel m = model_of(n);
+        const ViewerModel m = test::brief_model(n);
         EXPECT_FALSE(sphere_containing(m.scene(), m.camera().position)) << "scene " << n;
     }
-    const ViewerModel m = model_of(3);
+    const ViewerModel m = test::brief_model(3);
     const Primitive& p = m.scene().primitives[0];
     const Shape& s = m.scene().shapes[size_t(p.shape)];
     const auto inside = sphere_containing(m.scene(), s.centre);
@@ -118,7 +112,7 @@ TEST(CameraInside, NamesTheSphereAroundTheCamera) {
 // Defect 2: a new target keeps the samples; only the stratified estimator, whose strata
 // depend on the target, restarts.
 TEST(TargetSpp, ChangingTheTargetKeepsTheImage) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     const auto prepared = m.prepared();
     ASSERT_TRUE(m.set_target_spp(65));
@@ -142,7 +136,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 2;
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     auto wait_for = [&](auto done) {
         std::shared_ptr<const Snapshot> f = worker.latest();
         const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
@@ -152,7 +146,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     };
     const auto first = wait_for([](const Snapshot& s) { return s.finished; });
     ASSERT_TRUE(first && first->spp == 2);
-    worker.set_target_spp(4);
+    worker.set_stop_rule(StopRule{4});
     // Every frame after the raise is a full-resolution continuation: 3, then 4 passes.
     int last_spp = 2;
     std::shared_ptr<const Snapshot> f = first;
@@ -166,7 +160,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
     }
     ASSERT_TRUE(f->finished);
     EXPECT_EQ(f->spp, 4);
-    EXPECT_EQ(f->target_spp, 4);
+    EXPECT_EQ(f->max_passes, 4);
     // The same image as four plain passes: the two first were kept, not re-rendered.
     RenderState plain(20, 16);
     for (int i = 0; i < 4; ++i) render_pass(*scene, settings, plain);
@@ -175,7 +169,7 @@ TEST(TargetSpp, WorkerContinuesFromTheSamplesTaken) {
         for (int k = 0; k < 3; ++k)
             ASSERT_NEAR(f->radiance.pixels[i][k], expected.pixels[i][k], 1e-12 * (1 + expected.pixels[i][k]));
     // A target below the count taken: nothing more is rendered.
-    worker.set_target_spp(3);
+    worker.set_stop_rule(StopRule{3});
     const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
     EXPECT_EQ(more->serial, f->serial);
 }
@@ -204,19 +198,19 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
     // Done at 64; a raised target (65) renders on; a lowered one (below 116 done) is done.
     f.spp = 64;
     f.finished = true;
-    f.stopped_by = "spp";
+    f.stopped_by = StopReason::passes;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
     s.render.target_spp = 65;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
     f.spp = 116;
     f.finished = false;
-    f.stopped_by = "";
+    f.stopped_by.reset();
     s.render.target_spp = 64;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::done);
     s.unlimited = true;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::rendering);
     // The noise rule: 4% now, 2% wanted: four times the passes, 1/4 of the way.
-    s.stop_noise = 0.02;
+    s.stop.noise = 0.02;
     st = run_status(&f, s, false);
     EXPECT_EQ(st.rule, "noise");
     EXPECT_DOUBLE_EQ(st.progress, 0.25);
@@ -227,7 +221,7 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
 // Defect 4: a typed value is applied once, on Enter or focus loss; a refused one names the
 // field and keeps the previous value.
 TEST(TypedValue, AppliedOnceWhenTheFieldIsLeft) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     TypedFields typed;
     const uint64_t g = m.generation();
     for (double keystroke : {-2.0, -20.0}) typed.hold(7, &keystroke, 1);  // "-2", then "-20"
@@ -252,7 +246,7 @@ TEST(TypedValue, RefusedEditNamesTheFieldAndKeepsThePreviousValue) {
     const double ok[3] = {0, 1, 2};
     EXPECT_FALSE(check_typed_value("position", ok, 3, -10, 10));
 
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const Camera before = m.camera();
     std::string error;
     EXPECT_FALSE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) {
@@ -269,7 +263,7 @@ TEST(TypedValue, RefusedEditNamesTheFieldAndKeepsThePreviousValue) {
 
 // Defect 6: undo and redo of every scene and settings edit; one drag is one step.
 TEST(UndoRedo, EditsUndoAndRedoInOrder) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const double x0 = m.camera().position.x;
     const uint64_t g0 = m.generation();
     move_camera_x(m, 1);
@@ -304,7 +298,7 @@ TEST(UndoRedo, EditsUndoAndRedoInOrder) {
 }
 
 TEST(UndoRedo, OneDragIsOneStep) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const double x0 = m.camera().position.x;
     for (int i = 1; i <= 10; ++i) move_camera_x(m, i, "orbit");
     m.seal_undo_step();
@@ -317,7 +311,7 @@ TEST(UndoRedo, OneDragIsOneStep) {
 }
 
 TEST(UndoRedo, ResetViewReturnsToTheFilesCamera) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const Camera file = m.camera();
     ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { orbit(s.cameras[size_t(s.camera)], 20, 5); }));
     ASSERT_TRUE(m.edit(Edit::lens, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].alpha = 0.3; }));
@@ -332,7 +326,7 @@ TEST(UndoRedo, ResetViewReturnsToTheFilesCamera) {
 
 // Defect 5: a change of the file on disk reloads at once only without unsaved edits.
 TEST(ReloadChoice, AsksOnlyWithUnsavedEdits) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     EXPECT_EQ(m.on_file_changed(), WatchAction::reload);
     ASSERT_TRUE(m.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = true; }));
     EXPECT_EQ(m.on_file_changed(), WatchAction::reload);  // pausing is not an edit to keep

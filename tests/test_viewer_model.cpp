@@ -23,16 +23,6 @@ namespace fs = std::filesystem;
 using namespace kr;
 using namespace kr::viewer;
 
-namespace {
-
-ViewerModel model_of(int n) {
-    ViewerModel m;
-    m.load(test::brief_scene_file(n));
-    return m;
-}
-
-}  // namespace
-
 TEST(ResetRule, ImageEditsResetDisplayEditsDoNot) {
     for (Edit e : {Edit::camera, Edit::lens, Edit::light, Edit::material, Edit::renderer, Edit::scene})
         EXPECT_TRUE(edit_resets(e)) << int(e);
@@ -41,7 +31,7 @@ TEST(ResetRule, ImageEditsResetDisplayEditsDoNot) {
 }
 
 TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g0 = m.generation();
     auto scene_before = m.prepared();
 
@@ -118,7 +108,7 @@ TEST(ResetRule, EditsThatMoveNoSphereKeepTheBvh) {
 
 // Authored and prepared stay apart: an edit the renderer cannot take is undone whole.
 TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     const Camera before = m.camera();
     std::string error;
@@ -132,7 +122,7 @@ TEST(ResetRule, InvalidEditIsRejectedAndUndone) {
 }
 
 TEST(ResetRule, SavedSceneCarriesRendererSettings) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) {
         s.render.integrator = Integrator::wrt;
         s.render.max_depth = 3;
@@ -190,7 +180,7 @@ TEST(ClickToFocus, DistanceAlongViewAxis) {
 }
 
 TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
-    ViewerModel m = model_of(3);
+    ViewerModel m = test::brief_model(3);
     const uint64_t g = m.generation();
     ASSERT_TRUE(m.focus_at(0.5, 0.6));
     EXPECT_EQ(m.camera().type, CameraType::lens);
@@ -251,11 +241,11 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
     settings.target_spp = 3;
 
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     RenderSettings other = settings;
     other.max_depth = 1;
-    worker.submit({2, scene, other});  // an edit at once: generation 1 may never show
-    worker.submit({3, scene, settings});
+    worker.submit({2, scene, other, StopRule{other.target_spp}});  // an edit at once: generation 1 may never show
+    worker.submit({3, scene, settings, StopRule{settings.target_spp}});
     std::shared_ptr<const Snapshot> f;
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
     while (!(f && f->generation == 3 && f->finished) && std::chrono::steady_clock::now() < deadline)
@@ -283,11 +273,11 @@ TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 2;
     RenderWorker worker;
-    worker.submit({1, scene, settings});
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
     std::shared_ptr<const Snapshot> f;
     while (!(f && f->finished)) f = worker.wait_newer(f ? f->serial : 0, std::chrono::seconds(10));
     worker.set_paused(true);
-    worker.set_unlimited(true);
+    worker.set_stop_rule(StopRule{kUnlimitedPasses});
     // Paused: nothing new (at most the pass that was running when pause came).
     const auto paused_frame = worker.wait_newer(f->serial, std::chrono::milliseconds(200));
     const auto still = worker.wait_newer(paused_frame->serial, std::chrono::milliseconds(300));
@@ -316,24 +306,20 @@ TEST(RenderThread, NoiseAndTimeRulesStopTheEstimate) {
     };
     {
         RenderWorker worker;
-        worker.set_unlimited(true);
-        worker.set_stop_rule(0, 0.05);
-        worker.submit({1, scene, settings});
+        worker.submit({1, scene, settings, StopRule{kUnlimitedPasses, 0, 0.05}});
         const auto f = run_until_finished(worker);
         ASSERT_TRUE(f && f->finished);
-        EXPECT_STREQ(f->stopped_by, "noise");
+        EXPECT_EQ(f->stopped_by, StopReason::noise);
         EXPECT_GT(f->spp, 16);  // past the (ignored) target: the rule decided
         // The whole image is within the target (every pixel within its share implies it).
         EXPECT_LE(f->relative_error, 0.05);
     }
     {
         RenderWorker worker;
-        worker.set_unlimited(true);
-        worker.set_stop_rule(0.3, 0);
-        worker.submit({1, scene, settings});
+        worker.submit({1, scene, settings, StopRule{kUnlimitedPasses, 0.3, 0}});
         const auto f = run_until_finished(worker);
         ASSERT_TRUE(f && f->finished);
-        EXPECT_STREQ(f->stopped_by, "time");
+        EXPECT_EQ(f->stopped_by, StopReason::time);
         EXPECT_GE(f->full_seconds, 0.3);
         const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
         EXPECT_EQ(more->serial, f->serial);  // and stays stopped

@@ -46,7 +46,7 @@ std::shared_ptr<const Snapshot> wait_finished(const RenderWorker& worker, uint64
                                               std::chrono::seconds limit = std::chrono::seconds(300)) {
     auto wanted = [&](const std::shared_ptr<const Snapshot>& f) {
         return f && f->generation == generation && f->finished &&
-               (target_spp == 0 || f->target_spp == target_spp);
+               (target_spp == 0 || f->max_passes == target_spp);
     };
     const auto deadline = Clock::now() + limit;
     std::shared_ptr<const Snapshot> f = worker.latest();
@@ -129,19 +129,19 @@ TEST(WorkerStress, RapidEditsDuringRendering) {
         s.integrator = i % 3 == 0 ? Integrator::wrt : Integrator::pt;
         s.seed = uint64_t(i);
         s.target_spp = 1 + i % 3;
-        worker.submit({++generation, scene, s});
+        worker.submit({++generation, scene, s, StopRule{s.target_spp}});
         if (i % 7 == 0) worker.set_paused(i % 14 == 0);
-        if (i % 5 == 0) worker.set_unlimited(i % 10 == 0);
+        if (i % 5 == 0) worker.set_stop_rule(StopRule{i % 10 == 0 ? kUnlimitedPasses : s.target_spp});
         // Back to back, or long enough for a pass to be under way when the next edit stops it.
         if (i % 3 != 0) std::this_thread::sleep_for(std::chrono::microseconds(200 * (i % 11)));
     }
     poller.join();
     worker.set_paused(false);
-    worker.set_unlimited(false);
+    worker.set_stop_rule(StopRule{1});
     RenderSettings last = base;
     last.target_spp = 2;
     last.max_depth = 2;
-    worker.submit({++generation, scene, last});
+    worker.submit({++generation, scene, last, StopRule{last.target_spp}});
     const auto f = wait_finished(worker, generation);
     ASSERT_TRUE(f) << "no finished frame for the last edit";
     expect_valid_final(*f, generation, w, h, 2);
@@ -158,7 +158,7 @@ TEST(WorkerStress, ConcurrentSubmitters) {
     auto submitter = [&](std::shared_ptr<const RenderScene> scene) {
         RenderSettings s = RenderSettings::from_scene(scene->renderer);
         s.target_spp = 1;
-        for (int i = 0; i < 100; ++i) worker.submit({next.fetch_add(1), scene, s});
+        for (int i = 0; i < 100; ++i) worker.submit({next.fetch_add(1), scene, s, StopRule{s.target_spp}});
     };
     std::thread t1(submitter, a), t2(submitter, b);
     t1.join();
@@ -166,7 +166,7 @@ TEST(WorkerStress, ConcurrentSubmitters) {
     RenderSettings s = RenderSettings::from_scene(b->renderer);
     s.target_spp = 2;
     const uint64_t last = next.fetch_add(1);
-    worker.submit({last, b, s});
+    worker.submit({last, b, s, StopRule{s.target_spp}});
     const auto f = wait_finished(worker, last);
     ASSERT_TRUE(f);
     expect_valid_final(*f, last, 20, 10, 2);
@@ -182,7 +182,7 @@ TEST(WorkerStress, SceneReloadWhileRendering) {
     auto submit = [&] {
         RenderSettings s = model.settings().render;
         s.target_spp = 1;
-        worker.submit({model.generation(), model.prepared(), s});
+        worker.submit({model.generation(), model.prepared(), s, StopRule{s.target_spp}});
     };
     const int scenes[] = {3, 5, 2, 7, 8, 1, 4, 6};
     int w = 0, h = 0;
@@ -206,7 +206,7 @@ TEST(WorkerStress, SceneReloadWhileRendering) {
     // 1-spp job, so that job's finished frame may come first: wait for the 2-spp one.
     RenderSettings s = model.settings().render;
     s.target_spp = 2;
-    worker.submit({model.generation(), model.prepared(), s});
+    worker.submit({model.generation(), model.prepared(), s, StopRule{s.target_spp}});
     const auto f = wait_finished(worker, model.generation(), 2);
     ASSERT_TRUE(f);
     expect_valid_final(*f, model.generation(), w, h, 2);
@@ -221,8 +221,8 @@ TEST(WorkerStress, DestructionMidPass) {
     for (int i = 0; i < 24; ++i) {
         std::atomic<int> published{0};
         auto worker = std::make_unique<RenderWorker>([&] { published.fetch_add(1); });
-        if (i % 6 != 0) worker->submit({1, scene, s});
-        if (i % 4 == 1) worker->set_unlimited(true);
+        if (i % 6 != 0) worker->submit({1, scene, s, StopRule{s.target_spp}});
+        if (i % 4 == 1) worker->set_stop_rule(StopRule{kUnlimitedPasses});
         if (i % 8 == 3) worker->set_paused(true);
         if (i % 3 == 2) {
             // Until a frame is out: the next pass is a later preview or a full pass.
@@ -232,7 +232,7 @@ TEST(WorkerStress, DestructionMidPass) {
         } else {
             std::this_thread::sleep_for(std::chrono::microseconds(300 * i));
         }
-        if (i % 5 == 4) worker->submit({2, scene, s});  // an edit pending at destruction
+        if (i % 5 == 4) worker->submit({2, scene, s, StopRule{s.target_spp}});  // an edit pending at destruction
         const auto start = Clock::now();
         worker.reset();
         // One row of a 64-pixel-wide image, not a whole pass: generous for a sanitizer.

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <stdexcept>
 #include <string>
 
 #include "core/image_io.h"
+#include "core/text.h"
 
 namespace kr {
 
@@ -36,8 +39,22 @@ std::vector<std::filesystem::path> output_file_paths(const std::filesystem::path
 ImageFile read_image_file(const std::filesystem::path& path) {
     ImageFile file;
     file.hdr = is_hdr_file(path);
-    if (file.hdr) file.radiance = read_hdr(path);
-    else file.rgb8 = read_image(path);
+    if (file.hdr) {
+        file.radiance = read_hdr(path);
+        // A NaN or an infinity is no radiance: compared, it would pass as agreement with anything.
+        const std::vector<float>& rgb = file.radiance.rgb;
+        const auto bad = std::find_if(rgb.begin(), rgb.end(), [](float v) { return !std::isfinite(v); });
+        if (bad != rgb.end()) {
+            const size_t pixel = size_t(bad - rgb.begin()) / 3, w = size_t(file.radiance.width);
+            const size_t count = size_t(std::count_if(rgb.begin(), rgb.end(), [](float v) { return !std::isfinite(v); }));
+            throw std::runtime_error(show_user_text(path.string()) + ": " + std::to_string(count) +
+                                     " radiance values are not finite, the first " + (std::isnan(*bad) ? "NaN" : "infinite") +
+                                     " at pixel (" + std::to_string(pixel % w) + ", " + std::to_string(pixel / w) +
+                                     "); expected finite numbers");
+        }
+    } else {
+        file.rgb8 = read_image(path);
+    }
     return file;
 }
 

@@ -13,19 +13,6 @@ namespace kr {
 
 using vertex::OnePath;
 
-// A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
-// whole Ray just after its fields were stored stalls on store forwarding (measured: a
-// tenth of the path loop's time).
-void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax, int to_sphere) {
-    r.o = hit.p;
-    r.d = dir;
-    r.tmin = 0;
-    r.tmax = tmax;
-    r.from_sphere = hit.sphere;
-    r.into_from_sphere = dot(dir, hit.n) < 0;
-    r.to_sphere = to_sphere;
-}
-
 // Direct light from one point light at a surface with a smooth lobe (no selection pdf):
 // the shadow ray to cast and what it brings if nothing blocks it. False: nothing to bring.
 bool point_light_direct(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp,

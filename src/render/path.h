@@ -12,7 +12,16 @@ namespace kr {
 // A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
 // whole Ray just after its fields were stored stalls on store forwarding (measured: a
 // tenth of the path loop's time).
-void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1);
+// Inline: it runs once per ray, and both tracers call it from their own files.
+inline void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1) {
+    r.o = hit.p;
+    r.d = dir;
+    r.tmin = 0;
+    r.tmax = tmax;
+    r.from_sphere = hit.sphere;
+    r.into_from_sphere = dot(dir, hit.n) < 0;
+    r.to_sphere = to_sphere;
+}
 
 // What a path remembers of its last vertex, for weighing the light it hits next.
 struct PathHistory {

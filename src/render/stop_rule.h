@@ -27,6 +27,7 @@ struct StopRule {
 
     // Whether a time or noise rule can end the render before its passes.
     bool open_ended() const { return seconds > 0 || noise > 0; }
+    bool operator==(const StopRule&) const = default;
 };
 
 // The rule that ended a render; the names are the flags' (`--spp`, `--time`, `--noise`).

@@ -17,6 +17,7 @@
 #include "render/options.h"
 #include "render/settings.h"
 #include "render/render_scene.h"
+#include "render/stop_rule.h"
 #include "scene/scene.h"
 #include "viewer/edit.h"
 
@@ -25,10 +26,17 @@ namespace kr::viewer {
 struct ViewerSettings {
     RenderSettings render;    // integrator, estimator, light sampling, depth, target spp, seed
     bool unlimited = false;   // keep refining past target_spp
-    double stop_seconds = 0;  // stop after this much render time (0: no limit)
-    double stop_noise = 0;    // stop at this estimated relative error, adaptively (0: off)
+    StopRule stop;            // its time and noise rules (0: off); stop_rule() adds the pass limit
     bool paused = false;
     ToneSettings tone;
+
+    // When the estimate stops refining: after target_spp passes (none when unlimited), or
+    // by the time or noise rule.
+    StopRule stop_rule() const {
+        StopRule rule = stop;
+        rule.max_passes = unlimited ? kUnlimitedPasses : render.target_spp;
+        return rule;
+    }
 };
 
 // What to do when the watched scene file changes on disk.

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -56,7 +55,8 @@ RenderWorker::~RenderWorker() {
 void RenderWorker::submit(RenderJob job) {
     {
         std::lock_guard lock(mutex_);
-        target_spp_ = std::max(1, job.settings.target_spp);
+        rule_ = job.stop;
+        rule_.max_passes = std::max(1, rule_.max_passes);
         pending_ = std::move(job);
         stop_.store(true);  // the pass in flight ends at its next row
     }
@@ -71,27 +71,11 @@ void RenderWorker::set_paused(bool paused) {
     changed_.notify_all();
 }
 
-void RenderWorker::set_stop_rule(double seconds, double noise) {
+void RenderWorker::set_stop_rule(const StopRule& rule) {
     {
         std::lock_guard lock(mutex_);
-        stop_seconds_ = seconds;
-        stop_noise_ = noise;
-    }
-    changed_.notify_all();
-}
-
-void RenderWorker::set_target_spp(int target_spp) {
-    {
-        std::lock_guard lock(mutex_);
-        target_spp_ = std::max(1, target_spp);
-    }
-    changed_.notify_all();
-}
-
-void RenderWorker::set_unlimited(bool unlimited) {
-    {
-        std::lock_guard lock(mutex_);
-        unlimited_ = unlimited;
+        rule_ = rule;
+        rule_.max_passes = std::max(1, rule_.max_passes);
     }
     changed_.notify_all();
 }
@@ -133,18 +117,10 @@ void RenderWorker::run() {
 
     for (;;) {
         StopRule rule;
-        // The rules as the user has them now (called under the lock).
-        auto current_rule = [&] {
-            StopRule r;
-            r.max_passes = unlimited_ ? std::numeric_limits<int>::max() : target_spp_;
-            r.seconds = stop_seconds_;
-            r.noise = stop_noise_;
-            return r;
-        };
         // Which rule ends the refinement, if any (called under the lock).
         auto stop_reason = [&]() -> std::optional<StopReason> {
             if (!driver || next_preview < previews.size()) return std::nullopt;
-            return driver->stop_reason(current_rule());
+            return driver->stop_reason(rule_);
         };
         {
             std::unique_lock lock(mutex_);
@@ -156,13 +132,13 @@ void RenderWorker::run() {
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
                 state.reset(w, h);
-                driver.emplace(*job.scene, job.settings, state, current_rule());
+                driver.emplace(*job.scene, job.settings, state, rule_);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
                 seconds = 0;
                 if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
-            rule = current_rule();
+            rule = rule_;
         }
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
@@ -195,10 +171,9 @@ void RenderWorker::run() {
         if (frame->scale == 1) record_pixel_statistics(state, *frame);
         {
             std::lock_guard lock(mutex_);
-            frame->target_spp = target_spp_;
-            const std::optional<StopReason> reason = stop_reason();
-            frame->finished = reason.has_value();
-            frame->stopped_by = reason ? stop_reason_names.name(*reason).data() : "";
+            frame->max_passes = rule_.max_passes;
+            frame->stopped_by = stop_reason();
+            frame->finished = frame->stopped_by.has_value();
         }
         publish(std::move(frame));
     }

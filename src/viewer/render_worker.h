@@ -19,11 +19,14 @@
 
 namespace kr::viewer {
 
-// What to render: a prepared scene (shared, never modified once built) and the settings.
+// What to render: a prepared scene (shared, never modified once built), the settings, and
+// the rule that ends the refinement (RenderWorker::set_stop_rule changes it for the running
+// estimate).
 struct RenderJob {
     uint64_t generation = 0;  // the model's edit counter: frames carry it back
     std::shared_ptr<const RenderScene> scene;
     RenderSettings settings;
+    StopRule stop;
 };
 
 // One published snapshot of the estimate.
@@ -33,7 +36,7 @@ struct Snapshot {
     int scale = 1;           // > 1: a preview rendered at 1/scale resolution, shown upscaled
     Image radiance;          // per-pixel mean radiance
     int spp = 0;             // full-resolution passes accumulated (0 for a preview)
-    int target_spp = 1;
+    int max_passes = 1;      // the stop rule's pass limit (kUnlimitedPasses: none)
     double seconds = 0;      // render time of this generation so far (pauses excluded)
     double full_seconds = 0; // of which full-resolution passes
     uint64_t rays = 0;       // rays of the full-resolution passes
@@ -48,7 +51,7 @@ struct Snapshot {
     std::vector<float> variance;
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
-    const char* stopped_by = "";  // "spp", "time" or "noise" once finished
+    std::optional<StopReason> stopped_by;  // which, once finished
 };
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
@@ -72,15 +75,12 @@ public:
     // Neither resets the estimate. Pausing takes effect at the end of the running pass,
     // so the accumulated passes stay whole (and the image deterministic).
     void set_paused(bool paused);
-    void set_unlimited(bool unlimited);
-    // A new target spp for the running estimate: it keeps its samples and refines on to
-    // the new target, or stops (finished) if it already has as many.
-    void set_target_spp(int target_spp);
-    // The stop rules of `keithray render --time / --noise` (0 disables each): the estimate
-    // stops refining after `seconds` of full-resolution rendering, or once its estimated
-    // relative error is below `noise`, passes going only to pixels above their share of it.
-    // Like unlimited, they apply to the running estimate without resetting it.
-    void set_stop_rule(double seconds, double noise);
+    // A new stop rule for the running estimate: it keeps its samples and refines on to the
+    // new pass limit (kUnlimitedPasses: none), for the rule's seconds of full-resolution
+    // rendering, or until its estimated relative error is below the rule's noise (passes
+    // going only to pixels above their share of it); or it stops (finished) if the new rule
+    // is already met.
+    void set_stop_rule(const StopRule& rule);
 
     // The newest frame (null before the first).
     std::shared_ptr<const Snapshot> latest() const;
@@ -96,9 +96,8 @@ private:
     mutable std::condition_variable changed_;   // wakes the render thread
     mutable std::condition_variable published_; // wakes waiters on frames
     std::optional<RenderJob> pending_;
-    bool paused_ = false, unlimited_ = false, quit_ = false;
-    int target_spp_ = 1;  // the job's, until set_target_spp
-    double stop_seconds_ = 0, stop_noise_ = 0;
+    bool paused_ = false, quit_ = false;
+    StopRule rule_;  // the job's, until set_stop_rule
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};

@@ -1,5 +1,5 @@
 // The viewer's Save panel without its widgets: the paths it offers for a scene and what
-// each of its buttons writes. GL-free; ui_save.cpp draws the panel and asks before it
+// each of its buttons writes. GL-free; ui_panel_save.cpp draws the panel and asks before it
 // overwrites a file. An image is written as `keithray render -o` writes the same name
 // (render/outputs.h): the same bytes for the same render.
 #pragma once

@@ -21,18 +21,15 @@ RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool
     st.noise = frame->spp >= 2 && std::isfinite(frame->relative_error) ? frame->relative_error : -1;
 
     // Progress towards each stop rule that is on; the first to be met ends the render.
-    StopRule rule;
-    rule.max_passes = settings.unlimited ? kUnlimitedPasses : st.target;
-    rule.seconds = settings.stop_seconds;
-    rule.noise = settings.stop_noise;
-    const StopProgress progress = stop_progress(rule, frame->spp, frame->full_seconds, st.noise);
+    const StopProgress progress = stop_progress(settings.stop_rule(), frame->spp, frame->full_seconds, st.noise);
     st.progress = progress.fraction;
     st.eta = progress.eta;
     if (progress.nearest) st.rule = stop_reason_names.name(*progress.nearest);
 
     // Done: a stop rule ended it, unless a raised target or "unlimited" lets it go on; or
     // the target was lowered below the passes already taken.
-    const bool spp_rule_over = std::string_view(frame->stopped_by) == stop_reason_names.name(StopReason::passes) && (settings.unlimited || frame->spp < st.target);
+    const bool spp_rule_over =
+        frame->stopped_by == StopReason::passes && (settings.unlimited || frame->spp < st.target);
     const bool done = (frame->finished && !spp_rule_over) ||
                       (!settings.unlimited && !st.preview && frame->spp >= st.target);
     if (has_error) st.state = RunState::error;

@@ -1,0 +1,82 @@
+// PanelContext: the edit path, the frame on screen, the layout, and opening a scene.
+#include "viewer/ui_context.h"
+
+#include <algorithm>
+
+#include <imgui.h>
+
+#include "scene/load.h"
+#include "viewer/ui_compare.h"
+
+namespace kr::viewer {
+
+bool PanelContext::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string_view field,
+                        std::string_view group) {
+    std::string why;
+    if (!model.edit(kind, change, &why, field, group)) {
+        messages.show_error(why);
+        return false;
+    }
+    if (edit_resets(kind)) messages.error.clear();
+    return true;
+}
+
+const Snapshot* PanelContext::frame() const {
+    return ui.shown && ui.shown->generation == model.generation() ? ui.shown.get() : nullptr;
+}
+
+const Snapshot* PanelContext::full_frame() const {
+    const Snapshot* f = frame();
+    return f && f->scale == 1 ? f : nullptr;
+}
+
+double PanelContext::status_bar_height() const {
+    const ImGuiStyle& style = ImGui::GetStyle();
+    // Two lines: the render's figures, then the message line.
+    return (2 * ImGui::GetFrameHeightWithSpacing() + 2 * style.WindowPadding.y) * ImGui::GetIO().DisplayFramebufferScale.y;
+}
+
+PixelRect PanelContext::view_area() const {
+    const double panel = ui.panel_visible ? ui.panel_width * ImGui::GetIO().DisplayFramebufferScale.x : 0.0;
+    return {0, 0, std::max(1.0, ui.framebuffer_width - panel), std::max(1.0, ui.framebuffer_height - status_bar_height())};
+}
+
+PixelRect PanelContext::image_rect() const {
+    if (!model.has_scene()) return {};
+    // Fitted whole (whole screen pixels per image pixel when it fits), or zoomed and panned.
+    return ui.compare.view.placement(view_area(), model.scene().renderer.width, model.scene().renderer.height);
+}
+
+void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
+    if (ctx.model.dirty()) {
+        ctx.ui.files.pending_open = file;
+        ctx.ui.files.ask_discard = true;
+        return;
+    }
+    open_scene(ctx, file);
+}
+
+void open_scene(PanelContext& ctx, const std::filesystem::path& file) {
+    SceneFiles& files = ctx.ui.files;
+    try {
+        ctx.model.load(file);
+        ctx.messages.error.clear();
+        if (file != files.watch.file()) {
+            files.watch.watch(file);
+            ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene());
+            // The brief's reference follows the scene; one the user chose stays.
+            CompareTool& tool = ctx.ui.compare;
+            if (tool.reference_automatic || !tool.comparison.reference()) {
+                tool.comparison.clear_reference();
+                tool.reference_automatic = false;
+                tool.picture_key.clear();
+                if (const auto brief = brief_reference_for(file)) load_reference(ctx, *brief, true);
+            }
+        }
+    } catch (const SceneError& e) {
+        ctx.messages.show_error(e.what());  // the last good scene stays on screen
+        if (!ctx.model.has_scene()) files.watch.watch(file);
+    }
+}
+
+}  // namespace kr::viewer

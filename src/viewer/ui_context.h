@@ -1,0 +1,129 @@
+// What the window's panels (ui_panels.h), its input handling (ui_input.h) and its scripted
+// mode (ui_script.h) work on: the model and the one edit path into it, the message line,
+// and the window's state (the frame on screen, the layout, the scene files, the inspect and
+// compare tool). ViewerApp (ui_app.h) owns them and hands each frame a PanelContext.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "viewer/compare_view.h"
+#include "viewer/convergence_log.h"
+#include "viewer/files.h"
+#include "viewer/image_view.h"
+#include "viewer/inspect.h"
+#include "viewer/model.h"
+#include "viewer/render_worker.h"
+#include "viewer/save_dialog.h"
+#include "viewer/status.h"
+
+namespace kr::viewer {
+
+using UiClock = std::chrono::steady_clock;
+
+// The status bar's message line.
+struct Messages {
+    std::string error;                 // the last refused edit or failed load, red until the next success
+    UiClock::time_point error_time{};  // when it was set: flashed at the pointer for a moment
+    std::string status;                // the last save or keep message
+    void show_error(std::string message) {
+        error = std::move(message);
+        error_time = UiClock::now();
+    }
+    // The error is new enough to show at the pointer.
+    bool flashing(UiClock::time_point now) const {
+        return !error.empty() && std::chrono::duration<double>(now - error_time).count() < 3;
+    }
+};
+
+// The inspect and compare tool (ui_compare.cpp draws the image and the inspector,
+// ui_panel_compare.cpp its panel): zoom and pan, image B, the picture the view shows, the
+// figures of A against B, the locked probe and the convergence log.
+struct CompareTool {
+    ImageView view;
+    bool zoom_applied = false;  // --zoom waits for the first frame's layout
+    Comparison comparison;
+    bool reference_automatic = false;  // the brief's reference for this scene, not --reference
+    std::string reference_path;        // the panel's field
+    ConvergenceLog convergence;
+    std::optional<CompareFigures> figures;  // the shown frame (A) against image B
+    std::string figures_note;               // why there are no figures
+    bool picture_current = false;  // the texture's bytes are the current view's, for the shown frame
+    double picture_scale = 0;      // the false-colour map's top value
+    std::string picture_key;       // what the picture was made from (cleared: make it again)
+    double linear_scale = 0;       // tonemap_scale of the shown frame (the inspector)
+    std::optional<std::pair<int, int>> locked_probe;
+    bool open_panel = false;  // the command line asked for a view or a probe: the panel opens once
+};
+
+// The scene file shown and the others on offer.
+struct SceneFiles {
+    FileWatch watch;
+    std::vector<std::filesystem::path> folders;  // listed in `choices` (empty: list again)
+    std::vector<SceneChoice> choices;
+    std::optional<std::filesystem::path> pending_open;  // an open or reload awaiting the discard question
+    bool ask_discard = false;                           // open that question this frame
+};
+
+// The Save panel's paths (edited by the user) and the save awaiting the overwrite question.
+struct SaveTool {
+    SavePaths paths;
+    std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
+};
+
+// The window's state that the panels, the input handling and the scripted mode share.
+struct UiState {
+    TypedFields typed;                       // numbers being typed into panel fields
+    std::shared_ptr<const Snapshot> shown;   // the frame in the texture
+    uint64_t shown_serial = 0;
+    int framebuffer_width = 0, framebuffer_height = 0;  // this frame's
+    float panel_width = 400;                 // window points; the user can resize it
+    bool panel_visible = true, help_visible = false;
+    bool pick_focus = false;                 // the next click on the image focuses the lens
+    std::optional<std::string> inside_sphere;  // the camera is inside this sphere
+    double ui_fps = 0, ui_work = 0;          // UI frames per second, seconds of work each (smoothed)
+    SceneFiles files;
+    CompareTool compare;
+    SaveTool save;
+};
+
+// What a panel is drawn over: the model, the edit path, the messages and the window's state.
+struct PanelContext {
+    ViewerModel& model;
+    Messages& messages;
+    UiState& ui;
+
+    // Applies `change` through ViewerModel::edit (its reset rule); a refusal becomes the
+    // error message. `field` names the value in messages; edits of one `group` (a drag, a
+    // held key, one field) make one undo step.
+    bool edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string_view field = {},
+              std::string_view group = {});
+    // The frame on screen when it shows the model's current image, else null.
+    const Snapshot* frame() const;
+    // ... and only when it is at full resolution.
+    const Snapshot* full_frame() const;
+    double status_bar_height() const;  // framebuffer pixels
+    PixelRect view_area() const;       // the free area left of the panel, above the status bar
+    PixelRect image_rect() const;      // where the image is drawn in it (zoom and pan)
+};
+
+// Opens `file` now (a reload when it is the current one); on failure the last good scene stays.
+void open_scene(PanelContext& ctx, const std::filesystem::path& file);
+// The same, asking first when there are unsaved edits.
+void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file);
+
+// Writes `kind` to `path` (viewer/save_dialog.h), asking first when a file would be
+// replaced; the outcome is the status message (ui_panel_save.cpp).
+void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path& path);
+// The overwrite question, drawn every frame where request_save may have opened it.
+void overwrite_popup(PanelContext& ctx);
+
+}  // namespace kr::viewer

@@ -1,0 +1,245 @@
+#include "viewer/ui_input.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/trace.h"
+#include "viewer/ui_compare.h"
+
+#include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
+#include <imgui.h>
+
+namespace kr::viewer {
+
+void InputState::note_key(int key, int action) {
+    if (action == GLFW_PRESS && key_presses.size() < 64) key_presses.push_back(key);
+}
+
+int InputState::pressed_bits() const {
+    return int(drags[0].pressed) | 2 * int(drags[1].pressed) | 4 * int(drags[2].pressed) | 8 * int(divider_drag);
+}
+
+bool InputState::moving() const {
+    const ImGuiIO& io = ImGui::GetIO();
+    return io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || motion_keys_held;
+}
+
+namespace {
+
+void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
+    ViewerModel& model = ctx.model;
+    CompareTool& tool = ctx.ui.compare;
+    ImGuiIO& io = ImGui::GetIO();
+    const double to_fb = io.DisplayFramebufferScale.x;  // window points to framebuffer pixels
+    const int w = model.scene().renderer.width, h = model.scene().renderer.height;
+    const double image_scale = rect.width / w;
+    const double mx = io.MousePos.x * to_fb, my = io.MousePos.y * to_fb;
+    const PixelRect area = ctx.view_area();
+    auto inside = [&](const PixelRect& r) { return mx >= r.x && my >= r.y && mx < r.x + r.width && my < r.y + r.height; };
+    const bool over_image = inside(area) && inside(rect);
+    for (int b = 0; b < 3; ++b)
+        if (!io.MouseDown[b]) in.drags[b].release();
+    if (!io.MouseDown[0]) in.divider_drag = false;
+    // Mouse: only when ImGui does not want it, so a click on a panel never moves the camera.
+    if (io.WantCaptureMouse || !over_image) {
+        for (int b = 0; b < 3; ++b)
+            if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
+        if (!io.WantCaptureMouse && inside(area) && io.KeyCtrl && io.MouseWheel != 0)
+            tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+    } else {
+        for (int b = 0; b < 3; ++b)
+            if (ImGui::IsMouseClicked(b))
+                in.drags[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
+        const bool left_click = ImGui::IsMouseClicked(ImGuiMouseButton_Left);
+        const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
+        if (left_click && io.KeyShift) {
+            in.drags[0].release();  // Shift+click locks the inspector on a pixel, or frees it
+            const std::pair<int, int> pixel{int(std::floor((mx - rect.x) / image_scale)),
+                                            int(std::floor((my - rect.y) / image_scale))};
+            if (tool.locked_probe == pixel) tool.locked_probe.reset();
+            else tool.locked_probe = pixel;
+        } else if (left_click && tool.comparison.settings.mode == ViewMode::split && std::abs(mx - divider_x) <= 6 * to_fb) {
+            in.drags[0].release();  // the split view's divider, never an orbit
+            in.divider_drag = true;
+        } else if (left_click && (io.KeyCtrl || ctx.ui.pick_focus)) {
+            in.drags[0].release();  // a focus click, never an orbit
+            const Vec2 film = raster_to_camera((mx - rect.x) / rect.width * w, (my - rect.y) / rect.height * h, w, h);
+            if (!model.focus_at(film.x, film.y)) ctx.messages.show_error("click-to-focus: nothing there to focus on");
+            ctx.ui.pick_focus = false;
+        }
+        if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
+            // The middle button pans a zoomed image; on a fitted one it dollies the camera.
+            in.middle_pans = !tool.view.fitted();
+            in.pan_last_x = in.pan_last_y = 0;
+        }
+        if (io.MouseWheel != 0) {
+            if (io.KeyCtrl) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            else
+                ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+                    dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
+                }, "dolly", "wheel");
+        }
+    }
+    if (in.divider_drag) tool.comparison.settings.split = std::clamp((mx - rect.x) / rect.width, 0.0, 1.0);
+    // Drags started on the image go on wherever the pointer goes. Each applies its whole
+    // offset from where it started (screen pixels, in image pixels here) to the camera as it was then.
+    double dx = 0, dy = 0;
+    const int active = model.scene().camera;
+    auto drag = [&](DragGesture& g) {
+        if (!g.move(mx, my, model.camera(), dx, dy)) return false;
+        dx /= image_scale;
+        dy /= image_scale;
+        return true;
+    };
+    if (drag(in.drags[0]))
+        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = in.drags[0].start_camera;
+            orbit_drag(cam, dx, dy);
+            s.cameras[size_t(active)] = cam;
+        }, "orbit", "orbit");
+    if (drag(in.drags[1]))
+        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = in.drags[1].start_camera;
+            pan_drag(cam, dx, dy, h);
+            s.cameras[size_t(active)] = cam;
+        }, "pan", "pan");
+    if (in.middle_pans) {
+        // The image follows the pointer from where the button went down: this frame's part of
+        // the drag, in screen pixels, once past the click threshold.
+        if (drag(in.drags[2])) {
+            const double tx = mx - in.drags[2].press_x, ty = my - in.drags[2].press_y;
+            tool.view.pan(area, w, h, tx - in.pan_last_x, ty - in.pan_last_y);
+            in.pan_last_x = tx;
+            in.pan_last_y = ty;
+        }
+    } else if (drag(in.drags[2])) {
+        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            Camera cam = in.drags[2].start_camera;
+            dolly(cam, std::exp(dy * 0.005));
+            s.cameras[size_t(active)] = cam;
+        }, "dolly", "dolly");
+    }
+}
+
+// The zoom and compare keys; true when one acted.
+bool zoom_keys(PanelContext& ctx, InputState& in) {
+    const ViewerModel& model = ctx.model;
+    CompareTool& tool = ctx.ui.compare;
+    const int w = model.scene().renderer.width, h = model.scene().renderer.height;
+    const PixelRect area = ctx.view_area();
+    const ImGuiIO& io = ImGui::GetIO();
+    // About the pointer when it is over the view, else about the view's centre.
+    const double to_fb = io.DisplayFramebufferScale.x;
+    double px = io.MousePos.x * to_fb, py = io.MousePos.y * to_fb;
+    if (!(px >= area.x && py >= area.y && px < area.x + area.width && py < area.y + area.height)) {
+        px = area.x + area.width / 2;
+        py = area.y + area.height / 2;
+    }
+    bool acted = false;
+    for (const int key : in.key_presses) {
+        acted = true;
+        if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
+        else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
+        else if (key == GLFW_KEY_0 || key == GLFW_KEY_KP_0) tool.view.fit();
+        else if (key == GLFW_KEY_1 || key == GLFW_KEY_KP_1) tool.view.one_to_one(area, w, h);
+        else if (key == GLFW_KEY_V) {
+            auto& mode = tool.comparison.settings.mode;
+            mode = ViewMode((int(mode) + 1) % int(view_mode_names.names.size()));
+        } else if (key == GLFW_KEY_K && ctx.ui.shown && ctx.ui.shown->scale == 1) {
+            keep_image_b(ctx, *ctx.ui.shown);
+        } else acted = false;
+    }
+    return acted;
+}
+
+void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
+    ViewerModel& model = ctx.model;
+    UiState& ui = ctx.ui;
+    ImGuiIO& io = ImGui::GetIO();
+    const auto now = UiClock::now();
+    // A press this frame, whether ImGui saw the key down or it was released before the frame.
+    auto pressed = [&](int key) {
+        return ImGui::IsKeyPressed(key, false) ||
+               std::find(in.key_presses.begin(), in.key_presses.end(), key) != in.key_presses.end();
+    };
+    // The window keys, in the order they were pressed: taps that reach one frame together
+    // (a busy machine) act as they would one frame each (F1 then Esc shows and closes the
+    // help; Esc then F1 asks to quit, then shows the help). F1 and F11 work even while a
+    // field has the keyboard.
+    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
+    for (const int key : in.key_presses) {
+        if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
+        else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
+        else if (typing) continue;
+        else if (key == GLFW_KEY_ESCAPE) {
+            if (ui.help_visible) ui.help_visible = false;
+            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
+        } else if (key == GLFW_KEY_TAB) {
+            ui.panel_visible = !ui.panel_visible;
+        }
+    }
+    if (typing) {
+        in.motion_keys_held = false;
+        return;
+    }
+    bool question = false;
+    for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
+    if (question) ui.help_visible = !ui.help_visible;
+    if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
+        const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
+        if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
+        return;
+    }
+    if (pressed(GLFW_KEY_HOME) || pressed(GLFW_KEY_R)) {
+        model.seal_undo_step();
+        model.reset_view();
+    }
+    if (pressed(GLFW_KEY_RIGHT_BRACKET) || pressed(GLFW_KEY_LEFT_BRACKET)) {
+        const int spp = model.settings().render.target_spp;
+        model.seal_undo_step();
+        model.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
+    }
+    if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
+    if (!io.KeyCtrl) zoom_keys(ctx, in);
+    if (pressed(GLFW_KEY_SPACE))
+        ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
+    if (io.KeyCtrl) {
+        in.motion_keys_held = false;
+        return;
+    }
+    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
+    KeyMotion keys;
+    keys.orbit_x = int(ImGui::IsKeyDown(GLFW_KEY_RIGHT)) - int(ImGui::IsKeyDown(GLFW_KEY_LEFT));
+    keys.orbit_y = int(ImGui::IsKeyDown(GLFW_KEY_DOWN)) - int(ImGui::IsKeyDown(GLFW_KEY_UP));
+    keys.pan_x = int(ImGui::IsKeyDown(GLFW_KEY_A)) - int(ImGui::IsKeyDown(GLFW_KEY_D));
+    keys.pan_y = int(ImGui::IsKeyDown(GLFW_KEY_E)) - int(ImGui::IsKeyDown(GLFW_KEY_Q));
+    keys.dolly = int(ImGui::IsKeyDown(GLFW_KEY_S)) - int(ImGui::IsKeyDown(GLFW_KEY_W));
+    if (keys.any()) {
+        // The time since the previous frame with keys held; a first frame moves one 60 Hz step.
+        const double dt = in.motion_keys_held ? std::clamp(std::chrono::duration<double>(now - in.last_motion).count(), 0.0, 0.1) : 1.0 / 60;
+        const int h = model.scene().renderer.height;
+        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+            apply_key_motion(s.cameras[size_t(s.camera)], keys, dt, h);
+        }, "camera keys", "keys");
+    }
+    in.motion_keys_held = keys.any();
+    in.last_motion = now;
+}
+
+}  // namespace
+
+WindowRequests handle_input(PanelContext& ctx, InputState& in) {
+    WindowRequests requests;
+    if (!ctx.model.has_scene()) {
+        in.key_presses.clear();
+        return requests;
+    }
+    handle_mouse(ctx, in, ctx.image_rect());
+    handle_keys(ctx, in, requests);
+    in.key_presses.clear();
+    // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
+    if (!in.moving() && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
+    return requests;
+}
+
+}  // namespace kr::viewer

@@ -1,0 +1,40 @@
+// The mouse and the keys on the image, once per frame (the panels take them while the
+// pointer is over them): orbit, pan and dolly drags, the wheel, focus and probe clicks, the
+// split view's divider, zoom, the camera keys, undo, the window's own keys.
+#pragma once
+
+#include <vector>
+
+#include "viewer/navigation.h"
+#include "viewer/ui_context.h"
+
+namespace kr::viewer {
+
+struct InputState {
+    DragGesture drags[3];        // left: orbit, right: pan, middle: dolly (or pan a zoomed image)
+    bool divider_drag = false;   // the left button holds the split view's divider
+    bool middle_pans = false;    // the middle drag pans a zoomed image, not the camera
+    double pan_last_x = 0, pan_last_y = 0;  // the middle pan so far, framebuffer pixels
+    bool motion_keys_held = false;
+    UiClock::time_point last_motion{};  // previous frame with motion keys held
+    // Keys pressed since the last frame, as GLFW reported them. ImGui 1.86 (Debian 12) keeps
+    // only whether a key is down at each frame, so a press and release between two frames
+    // (a short tap on a busy machine) never shows in ImGui::IsKeyPressed.
+    std::vector<int> key_presses;
+
+    void note_key(int key, int action);
+    // The buttons held on the image for --status-file: 1 left, 2 right, 4 middle, 8 the divider.
+    int pressed_bits() const;
+    // A held button or camera key: the window redraws at its frame rate.
+    bool moving() const;
+};
+
+// What the keys ask of the window itself.
+struct WindowRequests {
+    bool toggle_fullscreen = false;  // F11 (pressed an odd number of times)
+    bool quit = false;               // Esc
+};
+
+WindowRequests handle_input(PanelContext& ctx, InputState& input);
+
+}  // namespace kr::viewer

@@ -1,0 +1,199 @@
+// The window around the panel column: the status bar, the help window, a refused edit
+// flashed at the pointer, and the quit and discard questions.
+#include "viewer/ui_overlays.h"
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+
+namespace kr::viewer {
+
+namespace {
+
+// The keys and mouse controls, for the help window (F1 or ?).
+constexpr const char* kHelpRows[][2] = {
+    {"left drag", "orbit about the target"},
+    {"right drag", "pan"},
+    {"wheel, middle drag", "dolly (middle drag pans a zoomed image)"},
+    {"Ctrl+wheel, + / -", "zoom the image about the pointer (up to 16x)"},
+    {"0 / 1", "fit the image to the window / show it 1:1"},
+    {"hover / Shift+click", "read a pixel / lock the probe on it"},
+    {"V", "next view: render, reference, split, error, noise, samples"},
+    {"K", "keep the image as a snapshot (image B)"},
+    {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
+    {"arrows", "orbit"},
+    {"W / S", "dolly in / out"},
+    {"A / D / Q / E", "pan left / right / down / up"},
+    {"Home or R", "reset the view to the file's camera"},
+    {"[ / ]", "halve / double the target spp (keeps the samples taken)"},
+    {"Space", "pause / resume"},
+    {"Ctrl+Z", "undo"},
+    {"Ctrl+Shift+Z, Ctrl+Y", "redo"},
+    {"Tab", "hide / show the panel"},
+    {"F11", "fullscreen"},
+    {"F1 or ?", "this help"},
+    {"Esc", "close this help; quit (asks first with unsaved edits)"},
+    {"typed numbers", "apply on Enter or when the field is left"},
+};
+
+std::string format_duration(double s) {
+    char buf[32];
+    if (s < 60) std::snprintf(buf, sizeof buf, "%.1f s", s);
+    else std::snprintf(buf, sizeof buf, "%dm%02ds", int(s) / 60, int(s) % 60);
+    return buf;
+}
+
+}  // namespace
+
+void draw_status_bar(PanelContext& ctx) {
+    Messages& messages = ctx.messages;
+    const ImGuiIO& io = ImGui::GetIO();
+    const float bar_h = float(ctx.status_bar_height() / std::max(1.0f, io.DisplayFramebufferScale.y));
+    ImGui::SetNextWindowPos(ImVec2(0, io.DisplaySize.y - bar_h));
+    ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, bar_h));
+    ImGui::Begin("##status", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoBringToFrontOnFocus);
+    const Snapshot* current = ctx.frame();
+    const RunStatus st = run_status(current, ctx.model.settings(), !ctx.model.has_scene());
+    // Line 1: state, spp, progress with ETA, elapsed, Mrays/s, noise. Fixed-width fields, so
+    // nothing moves as the figures change.
+    static const ImVec4 kStateColours[] = {{0.8f, 0.8f, 0.8f, 1}, {0.5f, 0.8f, 1, 1}, {1, 0.8f, 0.3f, 1},
+                                           {0.4f, 0.9f, 0.4f, 1}, {1, 0.4f, 0.4f, 1}};
+    ImGui::AlignTextToFramePadding();
+    ImGui::TextColored(kStateColours[size_t(st.state)], "%-9s", std::string(run_state_names.name(st.state)).c_str());
+    ImGui::SameLine(90);
+    if (st.unlimited) ImGui::Text("%d spp (unlimited)", st.spp);
+    else ImGui::Text("%d / %d spp", st.spp, st.target);
+    ImGui::SameLine(240);
+    char overlay[64] = "";
+    if (st.progress >= 0) {
+        if (st.state == RunState::done) std::snprintf(overlay, sizeof overlay, "done (%s)", st.rule.c_str());
+        else if (st.eta >= 0) std::snprintf(overlay, sizeof overlay, "ETA %s (%s)", format_duration(st.eta).c_str(), st.rule.c_str());
+        else std::snprintf(overlay, sizeof overlay, "%s", st.rule.c_str());
+    } else {
+        std::snprintf(overlay, sizeof overlay, "no stop rule");
+    }
+    ImGui::ProgressBar(st.progress >= 0 ? float(st.progress) : 0.0f, ImVec2(220, 0), overlay);
+    ImGui::SameLine(480);
+    ImGui::Text("%s", st.preview ? "preview" : format_duration(st.elapsed).c_str());
+    ImGui::SameLine(560);
+    ImGui::Text("%.2f Mrays/s", st.mrays_per_second);
+    ImGui::SameLine(680);
+    if (st.noise >= 0) ImGui::Text("noise %.3g%%", 100 * st.noise);
+    else ImGui::TextDisabled("noise: needs 2 spp");
+    const std::optional<CompareFigures>& figures = ctx.ui.compare.figures;
+    if (figures && current) {
+        // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
+        ImGui::SameLine(790);
+        ImGui::Text("vs B %.2f dB", figures->psnr);
+    }
+    // Line 2: one message, the most important first; full text on hover.
+    const std::string* message = nullptr;
+    ImVec4 colour(0.85f, 0.85f, 0.85f, 1);
+    std::string inside;
+    if (!messages.error.empty()) {
+        message = &messages.error;
+        colour = ImVec4(1, 0.4f, 0.4f, 1);
+    } else if (ctx.ui.inside_sphere) {
+        inside = "camera is inside sphere " + *ctx.ui.inside_sphere + ": the image shows its inside (Home resets the view)";
+        message = &inside;
+        colour = ImVec4(1, 0.8f, 0.3f, 1);
+    } else if (!messages.status.empty()) {
+        message = &messages.status;
+    }
+    ImGui::AlignTextToFramePadding();
+    if (message) {
+        ImGui::PushStyleColor(ImGuiCol_Text, colour);
+        ImGui::TextUnformatted(message->c_str());  // one line: the window clips it
+        ImGui::PopStyleColor();
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", message->c_str());
+        if (message == &messages.error) {
+            ImGui::SameLine();
+            if (ImGui::SmallButton("dismiss")) messages.error.clear();
+        }
+    } else {
+        ImGui::TextDisabled("F1 or ?: keys and mouse   Tab: panel   F11: fullscreen");
+    }
+    ImGui::End();
+}
+
+void draw_error_flash(const Messages& messages) {
+    // A refused edit also shows where the user is looking: beside the pointer, briefly.
+    if (!messages.flashing(UiClock::now())) return;
+    ImGui::BeginTooltip();
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.4f, 0.4f, 1));
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30);
+    ImGui::TextUnformatted(messages.error.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::PopStyleColor();
+    ImGui::EndTooltip();
+}
+
+void draw_help(UiState& ui) {
+    if (!ui.help_visible) return;
+    const ImGuiIO& io = ImGui::GetIO();
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x * 0.5f, io.DisplaySize.y * 0.45f), ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+    ImGui::Begin("Keys and mouse (F1, ? or Esc closes)", &ui.help_visible,
+                 ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings);
+    if (ImGui::BeginTable("keys", 2)) {
+        for (const auto& row : kHelpRows) {
+            ImGui::TableNextRow();
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(row[0]);
+            ImGui::TableNextColumn();
+            ImGui::TextUnformatted(row[1]);
+        }
+        ImGui::EndTable();
+    }
+    ImGui::TextDisabled("mouse and keys act on the image; the panel takes them while the pointer is over it");
+    ImGui::End();
+}
+
+bool quit_popup(bool& asked) {
+    if (asked) {
+        ImGui::OpenPopup("Quit?");
+        asked = false;
+    }
+    if (!ImGui::BeginPopupModal("Quit?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return false;
+    ImGui::Text("The scene has unsaved edits. Quit and lose them?");
+    bool quit = false;
+    if (ImGui::Button("Quit without saving")) {
+        quit = true;
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+    return quit;
+}
+
+void discard_popup(PanelContext& ctx) {
+    SceneFiles& files = ctx.ui.files;
+    if (files.ask_discard) {
+        ImGui::OpenPopup("Unsaved edits");
+        files.ask_discard = false;
+    }
+    if (!ImGui::BeginPopupModal("Unsaved edits", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    const bool same = files.pending_open && *files.pending_open == files.watch.file();
+    if (same) ImGui::Text("%s changed on disk, and the scene here has unsaved edits.", files.watch.file().filename().string().c_str());
+    else ImGui::Text("The scene has unsaved edits. Open %s and lose them?",
+                     files.pending_open ? files.pending_open->filename().string().c_str() : "");
+    if (ImGui::Button(same ? "Reload (lose my edits)" : "Open (lose my edits)")) {
+        if (files.pending_open) open_scene(ctx, *files.pending_open);
+        files.pending_open.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Keep my edits") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) {
+        if (same) ctx.messages.status = "kept your edits; the file on disk differs (Save scene JSON to keep them)";
+        files.pending_open.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+}
+
+}  // namespace kr::viewer

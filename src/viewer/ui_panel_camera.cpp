@@ -1,0 +1,36 @@
+// The Camera panel: the active camera, its position, target, field of view and aspect.
+#include <algorithm>
+#include <string>
+
+#include <imgui.h>
+
+#include "viewer/ui_panels.h"
+#include "viewer/ui_widgets.h"
+
+namespace kr::viewer {
+
+void panel_camera(PanelContext& ctx) {
+    if (!ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    const Scene& scene = ctx.model.scene();
+    if (scene.cameras.size() > 1) {
+        int active = scene.camera;
+        if (ImGui::BeginCombo("active", scene.cameras[size_t(active)].id.c_str())) {
+            for (size_t i = 0; i < scene.cameras.size(); ++i)
+                if (ImGui::Selectable((scene.cameras[i].id + "##cam" + std::to_string(i)).c_str(), int(i) == active))
+                    active = int(i);
+            ImGui::EndCombo();
+        }
+        if (active != scene.camera) ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.camera = active; }, "active camera");
+    }
+    Camera cam = ctx.model.camera();
+    const double span = std::max(1.0, length(cam.target - cam.position));
+    auto apply = [&](const char* name) {
+        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)] = cam; }, name, name);
+    };
+    if (field(ctx, "position", &cam.position.x, 3, float(0.005 * span), -kHuge, kHuge)) apply("camera position");
+    if (field(ctx, "target", &cam.target.x, 3, float(0.005 * span), -kHuge, kHuge)) apply("camera target");
+    if (field(ctx, "fov (deg)", &cam.fov, 1, 0.1f, 0.5, 179.5)) apply("fov");
+    if (field(ctx, "aspect", &cam.aspect, 1, 0.005f, 0.05, 20)) apply("aspect");
+}
+
+}  // namespace kr::viewer

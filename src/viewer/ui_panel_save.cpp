@@ -1,0 +1,87 @@
+// The Save panel and its overwrite question; what it writes: viewer/save_dialog.h.
+#include <filesystem>
+#include <string>
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include "viewer/save_dialog.h"
+#include "viewer/ui_panels.h"
+
+namespace kr::viewer {
+
+namespace fs = std::filesystem;
+
+void panel_save(PanelContext& ctx) {
+    if (!ImGui::CollapsingHeader("Save", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    SavePaths& paths = ctx.ui.save.paths;
+    const bool full = ctx.full_frame() != nullptr;
+    ImGui::InputText("image", &paths.image);
+    ImGui::BeginDisabled(!full);
+    // Each image as `render -o` writes it, the path's extension set to match.
+    if (ImGui::Button("Save PPM")) request_save(ctx, SaveKind::ppm, image_save_path(SaveKind::ppm, paths.image));
+    ImGui::EndDisabled();
+    ImGui::InputText("png", &paths.png);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save PNG")) request_save(ctx, SaveKind::png, image_save_path(SaveKind::png, paths.png));
+    ImGui::EndDisabled();
+    // The radiance as floats: OpenEXR (with every layer) or PFM (and the depth beside it).
+    ImGui::InputText("hdr", &paths.hdr);
+    ImGui::BeginDisabled(!full);
+    if (ImGui::Button("Save EXR")) request_save(ctx, SaveKind::exr, image_save_path(SaveKind::exr, paths.hdr));
+    ImGui::SameLine();
+    if (ImGui::Button("Save PFM")) request_save(ctx, SaveKind::pfm, image_save_path(SaveKind::pfm, paths.hdr));
+    ImGui::EndDisabled();
+    ImGui::InputText("scene", &paths.scene);
+    if (ImGui::Button("Save scene JSON")) request_save(ctx, SaveKind::scene, paths.scene);
+    ImGui::TextDisabled("messages appear in the status bar");
+}
+
+namespace {
+
+void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
+    std::string& status = ctx.messages.status;
+    try {
+        status = save_output(kind, path, ctx.model, ctx.ui.shown.get(), ctx.ui.compare.convergence.csv());
+        // Saving over the watched file should not read like an outside change.
+        std::error_code ec;
+        FileWatch& watch = ctx.ui.files.watch;
+        if (kind == SaveKind::scene && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
+    } catch (const std::exception& e) {
+        status = std::string("save failed: ") + e.what();
+    }
+}
+
+}  // namespace
+
+void request_save(PanelContext& ctx, SaveKind kind, const fs::path& path) {
+    // Never overwrite silently (an image's depth file included): the popup asks.
+    for (const fs::path& target : save_targets(kind, path)) {
+        std::error_code ec;
+        if (!fs::exists(target, ec)) continue;
+        ctx.ui.save.pending = std::make_pair(kind, path);
+        ImGui::OpenPopup("Overwrite?");
+        return;
+    }
+    save_now(ctx, kind, path);
+}
+
+void overwrite_popup(PanelContext& ctx) {
+    auto& pending = ctx.ui.save.pending;
+    if (!ImGui::BeginPopupModal("Overwrite?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    ImGui::Text("%s already exists. Overwrite it?", pending ? pending->second.string().c_str() : "");
+    if (ImGui::Button("Overwrite")) {
+        if (pending) save_now(ctx, pending->first, pending->second);
+        pending.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel")) {
+        pending.reset();
+        ctx.messages.status = "not saved";
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+}
+
+}  // namespace kr::viewer

@@ -1,0 +1,68 @@
+#include "viewer/ui_widgets.h"
+
+#include <algorithm>
+#include <vector>
+
+#include <imgui_internal.h>  // TempInputIsActive: a drag field in its typed-text mode
+
+namespace kr::viewer {
+
+namespace {
+
+// A field's name in messages: its label without the ImGui id suffix.
+std::string field_name(const char* label) {
+    const std::string s(label);
+    return s.substr(0, s.find("##"));
+}
+
+}  // namespace
+
+bool field(PanelContext& ctx, const char* label, double* v, int count, float speed, double lo, double hi,
+           const char* format) {
+    const ImGuiID id = ImGui::GetID(label);
+    std::vector<double> value(v, v + count);
+    // No AlwaysClamp: a drag stays within [lo, hi]; a typed value is checked below instead.
+    bool changed = count == 1 ? ImGui::DragScalar(label, ImGuiDataType_Double, value.data(), speed, &lo, &hi, format)
+                              : ImGui::DragScalarN(label, ImGuiDataType_Double, value.data(), count, speed, &lo, &hi, format);
+    const ImGuiContext& g = *ImGui::GetCurrentContext();
+    const bool typing = g.TempInputId != 0 && g.ActiveId == g.TempInputId;
+    if (changed && typing) {
+        // Keystrokes are held: typing -20 must not apply -2 on the way.
+        ctx.ui.typed.hold(id, value.data(), count);
+        changed = false;
+    }
+    if (ImGui::IsItemDeactivated()) {
+        if (auto held = ctx.ui.typed.take(id)) {
+            value = *held;
+            changed = true;
+        }
+    }
+    if (!changed || std::equal(value.begin(), value.end(), v)) return false;
+    if (auto why = check_typed_value(field_name(label), value.data(), count, lo, hi)) {
+        ctx.messages.show_error(*why);
+        return false;
+    }
+    std::copy(value.begin(), value.end(), v);
+    return true;
+}
+
+bool field_int(PanelContext& ctx, const char* label, int& v, int lo, int hi) {
+    const ImGuiID id = ImGui::GetID(label);
+    int value = v;
+    // A text field: every keystroke is held until Enter or focus loss.
+    if (ImGui::InputInt(label, &value, 0, 0)) {
+        const double d = value;
+        ctx.ui.typed.hold(id, &d, 1);
+    }
+    if (!ImGui::IsItemDeactivated()) return false;
+    const auto held = ctx.ui.typed.take(id);
+    if (!held || (*held)[0] == v) return false;
+    if (auto why = check_typed_value(field_name(label), held->data(), 1, lo, hi)) {
+        ctx.messages.show_error(*why);
+        return false;
+    }
+    v = int((*held)[0]);
+    return true;
+}
+
+}  // namespace kr::viewer

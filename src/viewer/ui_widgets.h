@@ -1,0 +1,44 @@
+// The panels' widgets: number fields that apply a drag live and a typed value on Enter or
+// focus loss (after check_typed_value), and combos over an enum's name table.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include <imgui.h>
+
+#include "core/enum_names.h"
+#include "viewer/ui_context.h"
+
+namespace kr::viewer {
+
+// The range of a field with no natural bound (positions, powers).
+inline constexpr double kHuge = 1e9;
+
+// True when `v` (`count` components) was changed and should be applied; a typed value
+// outside [lo, hi] is refused with a message instead.
+bool field(PanelContext& ctx, const char* label, double* v, int count, float speed, double lo, double hi,
+           const char* format = "%.4g");
+// A typed integer in [lo, hi].
+bool field_int(PanelContext& ctx, const char* label, int& v, int lo, int hi);
+
+template <typename Enum, size_t N>
+bool combo(const char* label, Enum& value, const EnumNames<Enum, N>& names) {
+    bool changed = false;
+    const std::string current(names.name(value));
+    if (ImGui::BeginCombo(label, current.c_str())) {
+        for (size_t i = 0; i < N; ++i) {
+            const std::string name(names.names[i]);
+            const bool selected = static_cast<size_t>(value) == i;
+            if (ImGui::Selectable(name.c_str(), selected)) {
+                changed = !selected;
+                value = static_cast<Enum>(i);
+            }
+            if (selected) ImGui::SetItemDefaultFocus();
+        }
+        ImGui::EndCombo();
+    }
+    return changed;
+}
+
+}  // namespace kr::viewer
