@@ -147,3 +147,25 @@ TEST(ToneMap, ExposureActsOnEveryOperatorAndSrgbFollowsTheCurve) {
     EXPECT_NEAR(srgb_encode(0.0031308), 0.04045, 1e-5);           // the curve's two pieces meet
     EXPECT_NEAR(1.055 * std::pow(0.0031308, 1 / 2.4) - 0.055, 0.04045, 1e-5);
 }
+
+// quantize_unit rounds v * 255 as lround does (halves away from zero), also within a few ulps
+// of every half-way point, where a rounding of its own could tip the other way.
+TEST(ToneMap, QuantizeIsLroundOfTheScaledValue) {
+    const auto reference = [](double v) {
+        return v > 0 ? (v >= 1 ? 255 : int(std::lround(v * 255.0))) : 0;
+    };
+    int checked = 0;
+    for (int k = 0; k < 256; ++k) {
+        for (const double edge : {(k + 0.5) / 255.0, double(k) / 255.0}) {
+            double down = edge, up = edge;
+            for (int step = 0; step < 64; ++step, ++checked) {
+                ASSERT_EQ(int(quantize_unit(down)), reference(down)) << down;
+                ASSERT_EQ(int(quantize_unit(up)), reference(up)) << up;
+                down = std::nextafter(down, 0.0);
+                up = std::nextafter(up, 2.0);
+            }
+        }
+    }
+    for (int i = 0; i <= 100000; ++i, ++checked) EXPECT_EQ(int(quantize_unit(i / 1e5)), reference(i / 1e5));
+    EXPECT_GT(checked, 100000);
+}

@@ -14,7 +14,11 @@ namespace kr {
 uint8_t quantize_unit(double v) {
     if (!(v > 0)) return 0;  // also maps NaN to 0
     if (v >= 1) return 255;
-    return static_cast<uint8_t>(std::lround(v * 255.0));
+    // lround of x in (0, 255) without the library call: x - trunc(x) is exact, so this is
+    // its rounding of halves away from zero.
+    const double x = v * 255.0;
+    const int whole = int(x);
+    return static_cast<uint8_t>(whole + (x - whole >= 0.5));
 }
 
 std::array<uint8_t, 3> tonemap_color(const Color& radiance, ToneMap op, double scale) {

@@ -132,8 +132,10 @@ public:
     Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target);
     // The Sobol estimator's sampler from its pixel's key (pixel_key), which render_pass keeps
     // per pixel: the same sampler as the constructor above gives.
-    Sampler(uint32_t sobol_key, uint32_t index)
-        : estimator_(Estimator::sobol), sobol_key_(sobol_key), index_(index), index_reversed_(reverse_bits(index)) {}
+    Sampler(uint32_t sobol_key, uint32_t index) : Sampler(sobol_key, index, reverse_bits(index)) {}
+    // The same with reverse_bits(index) given (render_pass reuses it across pixels).
+    Sampler(uint32_t sobol_key, uint32_t index, uint32_t index_reversed)
+        : estimator_(Estimator::sobol), sobol_key_(sobol_key), index_(index), index_reversed_(index_reversed) {}
     // The Sobol numbers' key of a pixel for a seed: two SplitMix64 hashes.
     static uint32_t pixel_key(uint64_t seed, uint64_t pixel) {
         return uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)));
