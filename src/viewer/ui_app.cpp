@@ -114,13 +114,16 @@ void ViewerApp::poll_watch() {
     SceneFiles& files = ui_.files;
     if (!files.watch.changed()) return;
     input_seen_ = true;  // something to show either way
-    // Never drop the user's edits silently: with unsaved edits, ask.
-    if (model_.has_scene() && model_.on_file_changed() == WatchAction::ask) {
+    // Never drop the user's edits silently: with unsaved edits, ask. A changed view alone
+    // is kept over the file's changes without asking.
+    const WatchAction action = model_.has_scene() ? model_.on_file_changed() : WatchAction::reload;
+    if (action == WatchAction::ask) {
         files.pending_open = files.watch.file();
         files.ask_discard = true;
         return;
     }
-    open_scene(ctx_, files.watch.file());
+    open_scene(ctx_, files.watch.file(), action == WatchAction::reload_keep_view);
+    if (action == WatchAction::reload_keep_view) messages_.show_status("reloaded the file's changes; kept your view");
 }
 
 void ViewerApp::sync_worker() {
@@ -259,19 +262,34 @@ void ViewerApp::draw_panels() {
     }
     const ImGuiIO& io = ImGui::GetIO();
     const float bar_h = float(ctx_.status_bar_height() / std::max(1.0f, io.DisplayFramebufferScale.y));
-    // The panel keeps the right edge above the status bar; its left edge can be dragged.
-    const float max_w = std::max(200.0f, io.DisplaySize.x * 0.5f);
-    float& width = ui_.panel_width;
-    width = std::clamp(width, 200.0f, max_w);
+    // The panel keeps the right edge above the status bar. The width the user chose stays
+    // what it is: a small window only shows it narrower, and it comes back when the window grows.
+    const float width = shown_panel_width(ui_.panel_width, float(io.DisplaySize.x));
+    const float height = io.DisplaySize.y - bar_h;
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width, 0));
-    ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - bar_h));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(200, io.DisplaySize.y - bar_h), ImVec2(max_w, io.DisplaySize.y - bar_h));
-    ImGui::Begin("keithray", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoTitleBar);
-    // The width the user dragged it to, for the next frame's layout.
-    if (ImGui::IsWindowFocused() && io.MouseDown[0]) width = ImGui::GetWindowWidth();
+    ImGui::SetNextWindowSize(ImVec2(width, height));
+    ImGui::Begin("keithray", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoResize);
+    // Labels keep their room: the fields narrow instead.
+    ImGui::PushItemWidth(-kPanelLabelWidth);
     draw_panel_list(ctx_);
+    ImGui::PopItemWidth();
     overwrite_popup(ctx_);
     ImGui::End();
+    // The panel's left edge: a grip kPanelGripWidth wide that drags the width.
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - kPanelGripWidth / 2, 0));
+    ImGui::SetNextWindowSize(ImVec2(kPanelGripWidth, height));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1, 1));
+    ImGui::Begin("##panel edge", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoMove);
+    ImGui::InvisibleButton("##grip", ImVec2(kPanelGripWidth, height));
+    if (ImGui::IsItemHovered() || ImGui::IsItemActive()) ImGui::SetMouseCursor(ImGuiMouseCursor_ResizeEW);
+    if (ImGui::IsItemActive())
+        ui_.panel_width = shown_panel_width(io.DisplaySize.x - io.MousePos.x, io.DisplaySize.x);
+    ImGui::End();
+    ImGui::PopStyleVar(2);
 }
 
 bool ViewerApp::draw_frame() {
@@ -332,6 +350,9 @@ int ViewerApp::run() {
                 input_seen_ = true;  // draw the new state once
             }))
             break;
+        // A message that expired goes from the status bar at once.
+        messages_.error_sticks = !model_.has_scene();
+        if (messages_.expire(UiClock::now())) input_seen_ = true;
         const auto latest = worker_->latest();
         const bool new_snapshot = latest && latest->serial != ui_.shown_serial;
         // Redraw only on input, a new snapshot, or something moving; else sleep until one of

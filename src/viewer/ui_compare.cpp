@@ -32,8 +32,8 @@ void keep_image_b(PanelContext& ctx, const Snapshot& frame) {
     CompareTool& tool = ctx.ui.compare;
     tool.comparison.settings.b = tool.comparison.keep(frame.radiance, frame.spp);
     tool.picture_key.clear();
-    ctx.messages.status =
-        "kept the image as " + tool.comparison.slots()[size_t(tool.comparison.settings.b)]->name + " (image B)";
+    ctx.messages.show_status("kept the image as " + tool.comparison.slots()[size_t(tool.comparison.settings.b)]->name +
+                             " (image B)");
 }
 
 std::optional<PixelProbe> probe(const PanelContext& ctx, int x, int y) {
@@ -138,6 +138,7 @@ void draw_image(const PanelContext& ctx, Display& display, const PixelRect& rect
     const PixelRect area = ctx.view_area();
     const ToneSettings& tone = model.settings().tone;
     const ViewMode mode = tool.comparison.settings.mode;
+    display.set_smooth(tool.smooth);
     if (mode == ViewMode::render || !tool.picture_current) {
         display.draw(rect, area, fb_w, fb_h, tone);  // the render, also while B or a map is missing
         return;

@@ -37,7 +37,8 @@ double PanelContext::status_bar_height() const {
 }
 
 PixelRect PanelContext::view_area() const {
-    const double panel = ui.panel_visible ? ui.panel_width * ImGui::GetIO().DisplayFramebufferScale.x : 0.0;
+    const ImGuiIO& io = ImGui::GetIO();
+    const double panel = ui.panel_visible ? shown_panel_width(ui.panel_width, io.DisplaySize.x) * io.DisplayFramebufferScale.x : 0.0;
     return {0, 0, std::max(1.0, ui.framebuffer_width - panel), std::max(1.0, ui.framebuffer_height - status_bar_height())};
 }
 
@@ -56,11 +57,13 @@ void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
     open_scene(ctx, file);
 }
 
-void open_scene(PanelContext& ctx, const std::filesystem::path& file) {
+void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_view) {
     SceneFiles& files = ctx.ui.files;
     try {
-        ctx.model.load(file);
-        ctx.messages.error.clear();
+        if (keep_view) ctx.model.load_keeping_view(file);
+        else ctx.model.load(file);
+        // The messages of the scene shown before belong to it.
+        ctx.messages.clear();
         if (file != files.watch.file()) {
             files.watch.watch(file);
             ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene());

@@ -8,6 +8,7 @@
 
 #include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
 #include <imgui.h>
+#include <imgui_internal.h>  // ClosePopupToLevel: Esc closes an open drop-down
 
 namespace kr::viewer {
 
@@ -44,13 +45,21 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     if (io.WantCaptureMouse || !over_image) {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
-        if (!io.WantCaptureMouse && inside(area) && io.KeyCtrl && io.MouseWheel != 0)
+        if (!io.WantCaptureMouse && inside(area) && !io.KeyShift && io.MouseWheel != 0)
             tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
     } else {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b))
                 in.drags[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
         const bool left_click = ImGui::IsMouseClicked(ImGuiMouseButton_Left);
+        if (left_click) {
+            // The orbit's pivot: the surface under the press, else the target.
+            in.pivot = model.camera().target;
+            const double px = io.MouseClickedPos[0].x * to_fb, py = io.MouseClickedPos[0].y * to_fb;
+            if (ctx.ui.nav.orbit_picked && model.prepared())
+                if (const auto p = surface_point(*model.prepared(), (px - rect.x) / rect.width, (py - rect.y) / rect.height))
+                    in.pivot = *p;
+        }
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
         if (left_click && io.KeyShift) {
             in.drags[0].release();  // Shift+click locks the inspector on a pixel, or frees it
@@ -68,15 +77,19 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             ctx.ui.pick_focus = false;
         }
         if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
-            // The middle button pans a zoomed image; on a fitted one it dollies the camera.
-            in.middle_pans = !tool.view.fitted();
+            // The middle button pans the image, as the wheel zooms it; Shift+middle dollies.
+            in.middle_pans = !io.KeyShift;
             in.pan_last_x = in.pan_last_y = 0;
         }
         if (io.MouseWheel != 0) {
-            if (io.KeyCtrl) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            // The wheel zooms the image about the pointer (samples kept); Shift+wheel dollies.
+            if (!io.KeyShift) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
             else
                 ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-                    dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
+                    Camera& cam = s.cameras[size_t(s.camera)];
+                    const Camera before = cam;
+                    dolly(cam, std::pow(0.9, double(io.MouseWheel) * ctx.ui.nav.speed));
+                    if (ctx.ui.nav.stop_at_surfaces) keep_outside(s, before, cam);
                 }, "dolly", "wheel");
         }
     }
@@ -91,17 +104,24 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         dy /= image_scale;
         return true;
     };
+    const NavigationSettings& nav = ctx.ui.nav;
     if (drag(in.drags[0]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[0].start_camera;
-            orbit_drag(cam, dx, dy);
-            s.cameras[size_t(active)] = cam;
+            Camera& cam = s.cameras[size_t(active)];
+            if (nav.fly) {
+                cam = in.drags[0].start_camera;
+                look_drag(cam, dx, dy);
+            } else {
+                cam = orbit_step(s, in.drags[0].start_camera, cam, in.pivot, dx, dy, nav.stop_at_surfaces);
+            }
         }, "orbit", "orbit");
     if (drag(in.drags[1]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[1].start_camera;
+            Camera& cam = s.cameras[size_t(active)];
+            const Camera before = cam;
+            cam = in.drags[1].start_camera;
             pan_drag(cam, dx, dy, h);
-            s.cameras[size_t(active)] = cam;
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
         }, "pan", "pan");
     if (in.middle_pans) {
         // The image follows the pointer from where the button went down: this frame's part of
@@ -114,9 +134,11 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         }
     } else if (drag(in.drags[2])) {
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[2].start_camera;
-            dolly(cam, std::exp(dy * 0.005));
-            s.cameras[size_t(active)] = cam;
+            Camera& cam = s.cameras[size_t(active)];
+            const Camera before = cam;
+            cam = in.drags[2].start_camera;
+            dolly(cam, std::exp(dy * 0.005 * nav.speed));
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
         }, "dolly", "dolly");
     }
 }
@@ -152,6 +174,30 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
     return acted;
 }
 
+// The window's own keys, with or without a scene (a broken starting scene must not freeze
+// them), in the order they were pressed: taps that reach one frame together (a busy
+// machine) act as they would one frame each (F1 then Esc shows and closes the help; Esc
+// then F1 asks to quit, then shows the help). F1 and F11 work even while a field has the keyboard.
+void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
+    UiState& ui = ctx.ui;
+    const ImGuiIO& io = ImGui::GetIO();
+    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
+    for (const int key : in.key_presses) {
+        if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
+        else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
+        else if (typing) continue;
+        else if (key == GLFW_KEY_ESCAPE) {
+            // Esc closes what is open first: the help, a drop-down or a question; then quits.
+            if (ui.help_visible) ui.help_visible = false;
+            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
+            else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
+            // (a question closes itself on Esc: its Cancel)
+        } else if (key == GLFW_KEY_TAB) {
+            ui.panel_visible = !ui.panel_visible;
+        }
+    }
+}
+
 void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     ViewerModel& model = ctx.model;
     UiState& ui = ctx.ui;
@@ -166,25 +212,18 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     // (a busy machine) act as they would one frame each (F1 then Esc shows and closes the
     // help; Esc then F1 asks to quit, then shows the help). F1 and F11 work even while a
     // field has the keyboard.
-    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
-    for (const int key : in.key_presses) {
-        if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
-        else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
-        else if (typing) continue;
-        else if (key == GLFW_KEY_ESCAPE) {
-            if (ui.help_visible) ui.help_visible = false;
-            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
-        } else if (key == GLFW_KEY_TAB) {
-            ui.panel_visible = !ui.panel_visible;
-        }
-    }
-    if (typing) {
+    window_keys(ctx, in, requests);
+    if (io.WantTextInput || ImGui::IsAnyItemActive()) {
         in.motion_keys_held = false;
         return;
     }
     bool question = false;
     for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
     if (question) ui.help_visible = !ui.help_visible;
+    if (io.KeyCtrl && pressed(GLFW_KEY_S)) {
+        save_scene_in_place(ctx);
+        return;
+    }
     if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
         const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
@@ -200,6 +239,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         model.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
     }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
+    if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
     if (!io.KeyCtrl) zoom_keys(ctx, in);
     if (pressed(GLFW_KEY_SPACE))
         ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
@@ -218,8 +258,14 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         // The time since the previous frame with keys held; a first frame moves one 60 Hz step.
         const double dt = in.motion_keys_held ? std::clamp(std::chrono::duration<double>(now - in.last_motion).count(), 0.0, 0.1) : 1.0 / 60;
         const int h = model.scene().renderer.height;
+        const NavigationSettings& nav = ui.nav;
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            apply_key_motion(s.cameras[size_t(s.camera)], keys, dt, h);
+            Camera& cam = s.cameras[size_t(s.camera)];
+            const Camera before = cam;
+            apply_key_motion(cam, keys, dt, h, nav);
+            // Arrow keys orbit about the target: stopped at a wall, they slide along it.
+            const bool orbiting = !nav.fly && (keys.orbit_x || keys.orbit_y);
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam, orbiting ? &before.target : nullptr);
         }, "camera keys", "keys");
     }
     in.motion_keys_held = keys.any();
@@ -231,6 +277,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
 WindowRequests handle_input(PanelContext& ctx, InputState& in) {
     WindowRequests requests;
     if (!ctx.model.has_scene()) {
+        window_keys(ctx, in, requests);
         in.key_presses.clear();
         return requests;
     }

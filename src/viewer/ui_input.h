@@ -11,9 +11,10 @@
 namespace kr::viewer {
 
 struct InputState {
-    DragGesture drags[3];        // left: orbit, right: pan, middle: dolly (or pan a zoomed image)
+    DragGesture drags[3];        // left: orbit (fly: look), right: pan, middle: pan the image (Shift: dolly)
+    Vec3 pivot;                  // what the left drag orbits about: the surface under the press, or the target
     bool divider_drag = false;   // the left button holds the split view's divider
-    bool middle_pans = false;    // the middle drag pans a zoomed image, not the camera
+    bool middle_pans = false;    // the middle drag pans the image (not Shift+middle: that dollies)
     double pan_last_x = 0, pan_last_y = 0;  // the middle pan so far, framebuffer pixels
     bool motion_keys_held = false;
     UiClock::time_point last_motion{};  // previous frame with motion keys held

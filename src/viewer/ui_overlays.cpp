@@ -188,8 +188,14 @@ void discard_popup(PanelContext& ctx) {
         ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
+    if (same && ImGui::Button("Take the file's changes, keep my view")) {
+        open_scene(ctx, *files.pending_open, true);
+        files.pending_open.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    if (same) ImGui::SameLine();
     if (ImGui::Button("Keep my edits") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) {
-        if (same) ctx.messages.status = "kept your edits; the file on disk differs (Save scene JSON to keep them)";
+        if (same) ctx.messages.show_status("kept your edits; the file on disk differs (Save scene JSON to keep them)");
         files.pending_open.reset();
         ImGui::CloseCurrentPopup();
     }
