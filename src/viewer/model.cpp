@@ -207,6 +207,14 @@ bool ViewerModel::set_resolution(int width, int height, bool fit_camera) {
     }, nullptr, "resolution");
 }
 
+bool ViewerModel::view_as_loaded() const {
+    if (!has_scene() || scene_.camera != file_camera_ || size_t(scene_.camera) >= file_cameras_.size()) return false;
+    const Camera& a = camera();
+    const Camera& f = file_cameras_[size_t(scene_.camera)];
+    return a.position == f.position && a.target == f.target && a.fov == f.fov && a.aspect == f.aspect &&
+           std::make_pair(scene_.renderer.width, scene_.renderer.height) == file_resolution_;
+}
+
 bool ViewerModel::reset_view() {
     if (!has_scene() || file_camera_ < 0) return false;
     return edit(Edit::camera, [&](Scene& s, ViewerSettings&) {

@@ -93,6 +93,9 @@ public:
     // The render resolution (a renderer edit: the image restarts). With `fit_camera`, the
     // active camera's aspect becomes width / height, so the picture is not stretched.
     bool set_resolution(int width, int height, bool fit_camera);
+    // The active camera's view and the resolution are the file's (what a reference image
+    // of the file shows).
+    bool view_as_loaded() const;
     // The resolution the file gives.
     std::pair<int, int> file_resolution() const { return file_resolution_; }
 

@@ -11,6 +11,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "core/file_write.h"
+#include "core/text.h"
 #include "scene/load.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
@@ -34,7 +35,7 @@ void install_input_callbacks(GLFWwindow* w) {
     glfwSetCursorPosCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
     glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int, int, int) { app_of(win)->note_input(); });
     glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
-    glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int) { app_of(win)->note_key(key, action); });
+    glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
     glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
     glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
@@ -169,9 +170,9 @@ Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
     return out;
 }
 
-void ViewerApp::note_key(int key, int action) {
+void ViewerApp::note_key(int key, int action, int mods) {
     input_seen_ = true;
-    input_.note_key(key, action);
+    input_.note_key(key, action, mods);
 }
 
 void ViewerApp::request_quit() {
@@ -234,16 +235,19 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (tool.locked_probe) std::snprintf(probe, sizeof probe, "%d,%d", tool.locked_probe->first, tool.locked_probe->second);
     if (tool.comparison.b())
         std::snprintf(b, sizeof b, tool.comparison.settings.b < 0 ? "reference" : "slot%d", tool.comparison.settings.b + 1);
-    char line[420];
+    // inside: the sphere the camera is in ("none"); fly: the navigation mode.
+    const std::string inside = ui_.inside_sphere ? show_user_text(*ui_.inside_sphere) : "none";
+    char line[640];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
-                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b);
+                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
+                  inside.c_str());
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);

@@ -85,7 +85,12 @@ void update_pictures(PanelContext& ctx, Display& display) {
     Rgb8Image b_bytes = b ? b->display(tone) : Rgb8Image{};
     tool.figures.reset();
     tool.figures_note.clear();
-    if (b && full) {
+    const bool reference_off_view =
+        b && tool.comparison.reference() && b == &*tool.comparison.reference() && !model.view_as_loaded();
+    if (reference_off_view) {
+        // The reference is the file's view: another view's figures against it mean nothing.
+        tool.figures_note = "the camera left the reference's view";
+    } else if (b && full) {
         tool.figures = compare_figures(a, b_bytes);
         if (!tool.figures)
             tool.figures_note = "B is " + std::to_string(b->width()) + "x" + std::to_string(b->height()) + ", the image " +
@@ -95,7 +100,7 @@ void update_pictures(PanelContext& ctx, Display& display) {
     }
     if (shown->generation == model.generation()) {
         std::optional<CompareFigures> truth;
-        if (full && tool.comparison.reference())
+        if (full && tool.comparison.reference() && model.view_as_loaded())
             truth = b == &*tool.comparison.reference() ? tool.figures : compare_figures(a, tool.comparison.reference()->display(tone));
         tool.convergence.record(*shown, truth);
     }
@@ -157,8 +162,8 @@ void draw_image(const PanelContext& ctx, Display& display, const PixelRect& rect
     display.draw_bytes(rect, clip(divider, rect.x + rect.width), fb_w, fb_h);
 }
 
-void draw_inspector(const PanelContext& ctx, const PixelRect& rect) {
-    const CompareTool& tool = ctx.ui.compare;
+void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
+    CompareTool& tool = ctx.ui.compare;
     const ViewerModel& model = ctx.model;
     ImGuiIO& io = ImGui::GetIO();
     const float to_points = 1.0f / std::max(1.0f, io.DisplayFramebufferScale.x);
@@ -177,15 +182,38 @@ void draw_inspector(const PanelContext& ctx, const PixelRect& rect) {
         draw->AddRect(ImVec2(cx - size / 2 - 1, cy - size / 2 - 1), ImVec2(cx + size / 2 + 1, cy + size / 2 + 1),
                       IM_COL32(255, 80, 80, 255));
     }
+    // Which view the image shows, on the image (the render needs no label).
+    const ViewMode mode = tool.comparison.settings.mode;
+    if (mode != ViewMode::render) {
+        const CompareImage* b = tool.comparison.b();
+        std::string label = std::string(view_mode_names.name(mode));
+        if (mode == ViewMode::split) label = "split: render | " + (b ? b->name : std::string("no image B"));
+        else if ((mode == ViewMode::reference || mode == ViewMode::error) && b) label += ": " + b->name;
+        if (!tool.picture_current) label += " (not available: showing the render)";
+        const PixelRect view = ctx.view_area();
+        const ImVec2 at(float(std::max(rect.x, view.x) + 6) * to_points, float(std::max(rect.y, view.y) + 6) * to_points);
+        const ImVec2 size = ImGui::CalcTextSize(label.c_str());
+        draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 160));
+        draw->AddText(at, IM_COL32(255, 255, 255, 230), label.c_str());
+    }
     // Hovering the image with no button down shows its pixel.
     const PixelRect area = ctx.view_area();
     const double mx = io.MousePos.x / to_points, my = io.MousePos.y / to_points;
     const bool over = mx >= std::max(rect.x, area.x) && my >= std::max(rect.y, area.y) &&
                       mx < std::min(rect.x + rect.width, area.x + area.width) &&
                       my < std::min(rect.y + rect.height, area.y + area.height);
+    tool.hover_text.clear();
     if (!over || io.WantCaptureMouse || io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || !ctx.ui.shown) return;
     const auto p = probe(ctx, int(std::floor((mx - rect.x) / scale)), int(std::floor((my - rect.y) / scale)));
     if (!p) return;
+    // One line for the status bar; the box at the pointer only when asked for (I).
+    char line[256];
+    const int n = std::snprintf(line, sizeof line, "pixel %d, %d   radiance %.4g %.4g %.4g   shown %d %d %d", p->x, p->y,
+                                p->mean.x, p->mean.y, p->mean.z, p->displayed[0], p->displayed[1], p->displayed[2]);
+    if (n > 0 && size_t(n) < sizeof line && !p->preview && std::isfinite(p->standard_error))
+        std::snprintf(line + n, sizeof line - size_t(n), "   %u samples, std. error %.3g", p->samples, p->standard_error);
+    tool.hover_text = line;
+    if (!tool.probe_box) return;
     ImGui::BeginTooltip();
     ImGui::Text("pixel %d, %d", p->x, p->y);
     ImGui::Text("radiance %.4g %.4g %.4g", p->mean.x, p->mean.y, p->mean.z);

@@ -84,6 +84,8 @@ struct CompareTool {
     std::string picture_key;       // what the picture was made from (cleared: make it again)
     double linear_scale = 0;       // tonemap_scale of the shown frame (the inspector)
     std::optional<std::pair<int, int>> locked_probe;
+    std::string hover_text;   // the inspector's numbers for the pixel under the pointer (status bar)
+    bool probe_box = false;   // ... also in a box at the pointer (I)
     bool open_panel = false;  // the command line asked for a view or a probe: the panel opens once
 };
 

@@ -12,8 +12,17 @@
 
 namespace kr::viewer {
 
-void InputState::note_key(int key, int action) {
-    if (action == GLFW_PRESS && key_presses.size() < 64) key_presses.push_back(key);
+void InputState::note_key(int key, int action, int mods) {
+    if (action == GLFW_PRESS && key_presses.size() < 64) {
+        key_presses.push_back(key);
+        key_mods.push_back(mods);
+    }
+}
+
+bool InputState::pressed_with_ctrl(int key) const {
+    for (size_t i = 0; i < key_presses.size(); ++i)
+        if (key_presses[i] == key && (key_mods[i] & GLFW_MOD_CONTROL)) return true;
+    return false;
 }
 
 int InputState::pressed_bits() const {
@@ -158,7 +167,9 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         py = area.y + area.height / 2;
     }
     bool acted = false;
-    for (const int key : in.key_presses) {
+    for (size_t i = 0; i < in.key_presses.size(); ++i) {
+        const int key = in.key_presses[i];
+        if (in.key_mods[i] & GLFW_MOD_CONTROL) continue;  // a Ctrl chord, not a zoom key
         acted = true;
         if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
         else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
@@ -167,6 +178,8 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         else if (key == GLFW_KEY_V) {
             auto& mode = tool.comparison.settings.mode;
             mode = ViewMode((int(mode) + 1) % int(view_mode_names.names.size()));
+        } else if (key == GLFW_KEY_I) {
+            tool.probe_box = !tool.probe_box;
         } else if (key == GLFW_KEY_K && ctx.ui.shown && ctx.ui.shown->scale == 1) {
             keep_image_b(ctx, *ctx.ui.shown);
         } else acted = false;
@@ -220,12 +233,19 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     bool question = false;
     for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
     if (question) ui.help_visible = !ui.help_visible;
-    if (io.KeyCtrl && pressed(GLFW_KEY_S)) {
+    // Ctrl chords by the modifiers each key event had: a fast chord can start and end between frames.
+    auto ctrl_pressed = [&](int key) { return in.pressed_with_ctrl(key) || (io.KeyCtrl && ImGui::IsKeyPressed(key, false)); };
+    auto shift_with = [&](int key) {
+        for (size_t i = 0; i < in.key_presses.size(); ++i)
+            if (in.key_presses[i] == key && (in.key_mods[i] & GLFW_MOD_SHIFT)) return true;
+        return io.KeyShift;
+    };
+    if (ctrl_pressed(GLFW_KEY_S)) {
         save_scene_in_place(ctx);
         return;
     }
-    if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
-        const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
+    if (ctrl_pressed(GLFW_KEY_Z) || ctrl_pressed(GLFW_KEY_Y)) {
+        const bool redo = ctrl_pressed(GLFW_KEY_Y) || shift_with(GLFW_KEY_Z);
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
         return;
     }
@@ -240,7 +260,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
     if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
-    if (!io.KeyCtrl) zoom_keys(ctx, in);
+    if (!io.KeyCtrl) zoom_keys(ctx, in);  // (zoom_keys skips presses made with Ctrl)
     if (pressed(GLFW_KEY_SPACE))
         ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
     if (io.KeyCtrl) {
@@ -279,11 +299,13 @@ WindowRequests handle_input(PanelContext& ctx, InputState& in) {
     if (!ctx.model.has_scene()) {
         window_keys(ctx, in, requests);
         in.key_presses.clear();
+        in.key_mods.clear();
         return requests;
     }
     handle_mouse(ctx, in, ctx.image_rect());
     handle_keys(ctx, in, requests);
     in.key_presses.clear();
+    in.key_mods.clear();
     // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
     if (!in.moving() && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
     return requests;

@@ -22,8 +22,11 @@ struct InputState {
     // only whether a key is down at each frame, so a press and release between two frames
     // (a short tap on a busy machine) never shows in ImGui::IsKeyPressed.
     std::vector<int> key_presses;
+    std::vector<int> key_mods;  // each press's modifiers (GLFW_MOD_*), as the event had them
 
-    void note_key(int key, int action);
+    void note_key(int key, int action, int mods = 0);
+    // `key` was pressed since the last frame with Ctrl held (by its event, not the frame's state).
+    bool pressed_with_ctrl(int key) const;
     // The buttons held on the image for --status-file: 1 left, 2 right, 4 middle, 8 the divider.
     int pressed_bits() const;
     // A held button or camera key: the window redraws at its frame rate.

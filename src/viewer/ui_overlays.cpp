@@ -20,7 +20,8 @@ constexpr const char* kHelpRows[][2] = {
     {"wheel, middle drag", "dolly (middle drag pans a zoomed image)"},
     {"Ctrl+wheel, + / -", "zoom the image about the pointer (up to 16x)"},
     {"0 / 1", "fit the image to the window / show it 1:1"},
-    {"hover / Shift+click", "read a pixel / lock the probe on it"},
+    {"hover / Shift+click", "read a pixel in the status bar / lock the probe on it"},
+    {"I", "the pixel's numbers also in a box at the pointer"},
     {"V", "next view: render, reference, split, error, noise, samples"},
     {"K", "keep the image as a snapshot (image B)"},
     {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
@@ -74,8 +75,10 @@ void draw_status_bar(PanelContext& ctx) {
         if (st.state == RunState::done) std::snprintf(overlay, sizeof overlay, "done (%s)", st.rule.c_str());
         else if (st.eta >= 0) std::snprintf(overlay, sizeof overlay, "ETA %s (%s)", format_duration(st.eta).c_str(), st.rule.c_str());
         else std::snprintf(overlay, sizeof overlay, "%s", st.rule.c_str());
+    } else if (!st.unlimited) {
+        std::snprintf(overlay, sizeof overlay, "starting (spp)");  // no frame yet: towards the target
     } else {
-        std::snprintf(overlay, sizeof overlay, "no stop rule");
+        std::snprintf(overlay, sizeof overlay, "unlimited: no stop rule");
     }
     ImGui::ProgressBar(st.progress >= 0 ? float(st.progress) : 0.0f, ImVec2(220, 0), overlay);
     ImGui::SameLine(480);
@@ -83,12 +86,13 @@ void draw_status_bar(PanelContext& ctx) {
     ImGui::SameLine(560);
     ImGui::Text("%.2f Mrays/s", st.mrays_per_second);
     ImGui::SameLine(680);
-    if (st.noise >= 0) ImGui::Text("noise %.3g%%", 100 * st.noise);
+    // A fixed width, so the figure after it never runs into it.
+    if (st.noise >= 0) ImGui::Text("noise %s", format_noise(st.noise).c_str());
     else ImGui::TextDisabled("noise: needs 2 spp");
     const std::optional<CompareFigures>& figures = ctx.ui.compare.figures;
     if (figures && current) {
         // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
-        ImGui::SameLine(790);
+        ImGui::SameLine(800);
         ImGui::Text("vs B %.2f dB", figures->psnr);
     }
     // Line 2: one message, the most important first; full text on hover.
@@ -115,8 +119,11 @@ void draw_status_bar(PanelContext& ctx) {
             ImGui::SameLine();
             if (ImGui::SmallButton("dismiss")) messages.error.clear();
         }
+    } else if (!ctx.ui.compare.hover_text.empty()) {
+        // The inspector's numbers for the pixel under the pointer: here, not over the image.
+        ImGui::TextUnformatted(ctx.ui.compare.hover_text.c_str());
     } else {
-        ImGui::TextDisabled("F1 or ?: keys and mouse   Tab: panel   F11: fullscreen");
+        ImGui::TextDisabled("F1 or ?: keys and mouse   Tab: panel   F11: fullscreen   I: pixel box at the pointer");
     }
     ImGui::End();
 }
