@@ -14,6 +14,7 @@
 #include "render/camera.h"
 #include "scene/load.h"
 #include "scene/save.h"
+#include "scene/scene_list.h"
 #include "viewer/files.h"
 #include "viewer/model.h"
 #include "viewer/navigation.h"
@@ -609,4 +610,40 @@ TEST(SceneEdit, LightsOnAndOff) {
         ViewerModel each = test::brief_model(3);
         EXPECT_TRUE(each.edit(Edit::light, [&](Scene& sc, ViewerSettings&) { set_light_on(sc, i, false); })) << i;
     }
+}
+
+// Missing item 5: the example scenes ship in res/scenes/examples, which the Open list shows;
+// each loads and prepares; many_spheres is scene 3 with a second area light, a purple
+// Fresnel sphere and the lens camera active; furnace is a diffuse sphere inside a spherical
+// area light that holds the camera.
+TEST(ExampleScenes, ShippedListedAndWhatTheBriefSays) {
+    std::vector<std::string> names;
+    for (const fs::path& p : example_scenes()) {
+        names.push_back(p.stem().string());
+        ViewerModel m;
+        ASSERT_NO_THROW(m.load(p)) << p;
+        EXPECT_TRUE(m.has_scene()) << p;
+    }
+    for (const char* want : {"many_spheres", "furnace", "gallery_100"})
+        EXPECT_NE(std::find(names.begin(), names.end(), want), names.end()) << want;
+    const fs::path dir = example_scenes().front().parent_path();
+    const Scene many = load_scene_file(dir / "many_spheres.json").scene;
+    const Scene three = load_scene_file(test::brief_scene_file(3)).scene;
+    EXPECT_EQ(many.cameras[size_t(many.camera)].type, CameraType::lens);
+    EXPECT_EQ(many.active_lights.size(), three.active_lights.size() + 1);
+    EXPECT_EQ(many.primitives.size(), three.primitives.size() + 2);
+    bool purple_fresnel = false;
+    for (const Primitive& p : many.primitives) {
+        const Material& mat = many.materials[size_t(p.material)];
+        purple_fresnel |= mat.type == MaterialType::dielectric && mat.rho_t.z > mat.rho_t.y && mat.rho_t.x > mat.rho_t.y;
+    }
+    EXPECT_TRUE(purple_fresnel);
+    const Scene furnace = load_scene_file(dir / "furnace.json").scene;
+    ASSERT_EQ(furnace.active_lights.size(), 1u);
+    const Light& sky = furnace.lights[size_t(furnace.active_lights[0])];
+    ASSERT_EQ(sky.type, LightType::area);
+    const Shape& shell = furnace.shapes[size_t(sky.shape)];
+    const auto inside = sphere_containing(furnace, furnace.cameras[size_t(furnace.camera)].position);
+    ASSERT_TRUE(inside);
+    EXPECT_EQ(*inside, shell.id);
 }
