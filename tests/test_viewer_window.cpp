@@ -409,3 +409,23 @@ TEST_F(ViewerWindow, BrokenStartingSceneKeepsTheKeys) {
     EXPECT_EQ(r["title"].find("(edited)"), std::string::npos) << r["title"];
     EXPECT_EQ(r["exit_status"], "0");
 }
+
+// Missing item 1, with real input: a click selects the sphere under the pointer, Delete
+// removes it, Ctrl+Z brings it back, Ctrl+D duplicates it, a drag from the selection moves it
+// (not the camera), Esc clears the selection.
+TEST_F(ViewerWindow, ClickSelectsDeleteUndoDuplicateAndMove) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "select_edit", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    const kr::Scene scene = kr::load_scene_file(kr::test::brief_scene_file(3)).scene;
+    int sphere01 = -1;
+    for (size_t i = 0; i < scene.primitives.size(); ++i)
+        if (scene.primitives[i].id == "sphere 01") sphere01 = int(i);
+    EXPECT_EQ(r["selected"], std::to_string(sphere01));
+    const int n = std::stoi(r["primitives_before"]);
+    EXPECT_EQ(r["primitives_deleted"], std::to_string(n - 1));
+    EXPECT_EQ(r["primitives_duplicated"], std::to_string(n + 1));
+    EXPECT_EQ(r["selected_copy"], std::to_string(n));  // the copy, last in the list
+    EXPECT_EQ(r["selected_after_move"], r["selected_again"]);
+    EXPECT_NE(r["generation_after"], r["generation_before_move"]);  // the move changed the image
+}

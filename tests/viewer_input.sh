@@ -176,6 +176,50 @@ wheel_zooms)
     xdotool keyup shift
     wait_for 'dirty=1' || exit 1
     ;;
+select_edit)
+    # Click sphere 01 of scene 3 (image point 344, 410 of the 512x512 image): selected; Delete
+    # removes it, Ctrl+Z brings it back, Ctrl+D duplicates it (the copy selected), a drag of
+    # the selection moves it (the camera stays), Esc clears the selection.
+    img=$(field image)
+    left=${img%%,*} rest=${img#*,}
+    top=${rest%%,*}
+    x=$((${left%.*} + 344)) y=$((${top%.*} + 410))
+    n=$(field primitives)
+    echo "primitives_before=$n"
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    sel0=$(field selected)
+    echo "selected=$sel0"
+    xdotool key Delete
+    wait_for 'selected=none' || exit 1
+    echo "primitives_deleted=$(field primitives)"
+    xdotool key ctrl+z
+    wait_for "primitives=$n\b" || exit 1
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    xdotool key ctrl+d
+    wait_for "primitives=$((n + 1))\b" || exit 1
+    echo "selected_copy=$(field selected)"
+    echo "primitives_duplicated=$(field primitives)"
+    # The copy sits beside the original: a click selects the original again, then drag it.
+    xdotool click 1
+    wait_for "selected=$sel0 " || exit 1
+    echo "selected_again=$(field selected)"
+    echo "generation_before_move=$(field generation)"
+    xdotool mousedown 1
+    wait_for "press=1 pointer=$x,$y" || exit 1
+    xdotool mousemove --window "$wid" $((x + 30)) $y
+    wait_for "pointer=$((x + 30)),$y" || exit 1
+    xdotool mouseup 1
+    wait_for 'press=0' || exit 1
+    echo "selected_after_move=$(field selected)"
+    xdotool key Escape
+    wait_for 'selected=none' || exit 1
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    ;;
 esc)
     xdotool key Escape
     ;;

@@ -11,7 +11,6 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "core/file_write.h"
-#include "core/text.h"
 #include "scene/load.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
@@ -236,18 +235,22 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (tool.comparison.b())
         std::snprintf(b, sizeof b, tool.comparison.settings.b < 0 ? "reference" : "slot%d", tool.comparison.settings.b + 1);
     // inside: the sphere the camera is in ("none"); fly: the navigation mode.
-    const std::string inside = ui_.inside_sphere ? show_user_text(*ui_.inside_sphere) : "none";
+    std::string inside = ui_.inside_sphere ? *ui_.inside_sphere : "none";
+    std::replace(inside.begin(), inside.end(), ' ', '_');
+    // selected: the selected primitive's index in the scene block's list ("none").
+    const auto sel = ctx_.selection();
+    const std::string selected = sel ? std::to_string(*sel) : "none";
     char line[640];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
-                  inside.c_str());
+                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0));
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);

@@ -10,6 +10,7 @@
 
 #include "core/image_compare.h"
 #include "core/text.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 namespace kr::viewer {
@@ -181,6 +182,22 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
         const float cy = float(rect.y + (tool.locked_probe->second + 0.5) * scale) * to_points;
         draw->AddRect(ImVec2(cx - size / 2 - 1, cy - size / 2 - 1), ImVec2(cx + size / 2 + 1, cy + size / 2 + 1),
                       IM_COL32(255, 80, 80, 255));
+    }
+    // The selected sphere's outline, as the camera sees it.
+    if (const auto sel = ctx.selection(); sel && model.prepared()) {
+        const Scene& s = model.scene();
+        const Shape& shape = s.shapes[size_t(s.primitives[size_t(*sel)].shape)];
+        const auto outline = sphere_outline(model.prepared()->camera, shape.centre, shape.radius, 64);
+        std::vector<ImVec2> points;
+        for (const auto& [fx, fy] : outline)
+            points.emplace_back(float(rect.x + fx * rect.width) * to_points, float(rect.y + fy * rect.height) * to_points);
+        if (!points.empty()) {
+            draw->PushClipRect(ImVec2(float(ctx.view_area().x) * to_points, float(ctx.view_area().y) * to_points),
+                               ImVec2(float(ctx.view_area().x + ctx.view_area().width) * to_points,
+                                      float(ctx.view_area().y + ctx.view_area().height) * to_points));
+            draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);
+            draw->PopClipRect();
+        }
     }
     // Which view the image shows, on the image (the render needs no label).
     const ViewMode mode = tool.comparison.settings.mode;

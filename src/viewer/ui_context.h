@@ -122,6 +122,8 @@ struct UiState {
     bool panel_visible = true, help_visible = false;
     bool pick_focus = false;                 // the next click on the image focuses the lens
     NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
+    std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
+    int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
     std::optional<std::string> inside_sphere;  // the camera is inside this sphere
     double ui_fps = 0, ui_work = 0;          // UI frames per second, seconds of work each (smoothed)
     SceneFiles files;
@@ -147,7 +149,14 @@ struct PanelContext {
     double status_bar_height() const;  // framebuffer pixels
     PixelRect view_area() const;       // the free area left of the panel, above the status bar
     PixelRect image_rect() const;      // where the image is drawn in it (zoom and pan)
+    // The selection when it names a primitive of the current scene (an undo may remove it).
+    std::optional<int> selection() const;
 };
+
+// The selection's edits, each one undoable step (viewer/scene_edit.h).
+void duplicate_selection(PanelContext& ctx);  // Ctrl+D: the copy beside it, selected
+void delete_selection(PanelContext& ctx);     // Delete
+void add_sphere_at_target(PanelContext& ctx); // a sphere at the camera's target, selected
 
 // Opens `file` now (a reload when it is the current one); on failure the last good scene stays.
 // `keep_view`: a reload that puts the current view back over the file's cameras.

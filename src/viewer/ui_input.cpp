@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "render/trace.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 #include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
@@ -47,6 +48,12 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     const PixelRect area = ctx.view_area();
     auto inside = [&](const PixelRect& r) { return mx >= r.x && my >= r.y && mx < r.x + r.width && my < r.y + r.height; };
     const bool over_image = inside(area) && inside(rect);
+    // A left press and release that never became a drag is a click: it selects the sphere
+    // under it, or clears the selection.
+    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && in.drags[0].pressed && !in.drags[0].dragging) {
+        ctx.ui.selected = in.press_pick;
+        ctx.ui.axis_lock = -1;
+    }
     for (int b = 0; b < 3; ++b)
         if (!io.MouseDown[b]) in.drags[b].release();
     if (!io.MouseDown[0]) in.divider_drag = false;
@@ -65,9 +72,16 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             // The orbit's pivot: the surface under the press, else the target.
             in.pivot = model.camera().target;
             const double px = io.MouseClickedPos[0].x * to_fb, py = io.MouseClickedPos[0].y * to_fb;
+            const double fx = (px - rect.x) / rect.width, fy = (py - rect.y) / rect.height;
             if (ctx.ui.nav.orbit_picked && model.prepared())
-                if (const auto p = surface_point(*model.prepared(), (px - rect.x) / rect.width, (py - rect.y) / rect.height))
-                    in.pivot = *p;
+                if (const auto p = surface_point(*model.prepared(), fx, fy)) in.pivot = *p;
+            // The sphere under it: a click selects it; a drag from the selection moves it.
+            in.press_pick = model.prepared() ? pick_primitive(model.scene(), model.prepared()->camera, fx, fy) : std::nullopt;
+            in.moves_selection = in.press_pick && in.press_pick == ctx.selection() && !ctx.ui.nav.fly;
+            if (in.moves_selection) {
+                const Scene& s = model.scene();
+                in.move_start = s.shapes[size_t(s.primitives[size_t(*in.press_pick)].shape)].centre;
+            }
         }
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
         if (left_click && io.KeyShift) {
@@ -114,7 +128,17 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         return true;
     };
     const NavigationSettings& nav = ctx.ui.nav;
-    if (drag(in.drags[0]))
+    const auto selected = ctx.selection();
+    if (in.moves_selection && selected && drag(in.drags[0])) {
+        // The selection follows the pointer in the view plane, or along the locked axis
+        // (X, Y or Z held, or the Selection panel's lock).
+        int axis = ctx.ui.axis_lock;
+        if (ImGui::IsKeyDown(GLFW_KEY_X)) axis = 0;
+        if (ImGui::IsKeyDown(GLFW_KEY_Y)) axis = 1;
+        if (ImGui::IsKeyDown(GLFW_KEY_Z)) axis = 2;
+        const Vec3 to = in.move_start + drag_offset(model.prepared()->camera, in.move_start, dx, dy, h, axis);
+        ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) { own_shape(s, *selected).centre = to; }, "move", "move");
+    } else if (!in.moves_selection && drag(in.drags[0]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             Camera& cam = s.cameras[size_t(active)];
             if (nav.fly) {
@@ -202,6 +226,7 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         else if (key == GLFW_KEY_ESCAPE) {
             // Esc closes what is open first: the help, a drop-down or a question; then quits.
             if (ui.help_visible) ui.help_visible = false;
+            else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && ui.selected) ui.selected.reset();
             else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
             else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
             // (a question closes itself on Esc: its Cancel)
@@ -244,6 +269,11 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         save_scene_in_place(ctx);
         return;
     }
+    if (ctrl_pressed(GLFW_KEY_D)) {
+        duplicate_selection(ctx);
+        return;
+    }
+    if (pressed(GLFW_KEY_DELETE)) delete_selection(ctx);
     if (ctrl_pressed(GLFW_KEY_Z) || ctrl_pressed(GLFW_KEY_Y)) {
         const bool redo = ctrl_pressed(GLFW_KEY_Y) || shift_with(GLFW_KEY_Z);
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();

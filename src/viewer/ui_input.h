@@ -3,6 +3,7 @@
 // split view's divider, zoom, the camera keys, undo, the window's own keys.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "viewer/navigation.h"
@@ -13,6 +14,9 @@ namespace kr::viewer {
 struct InputState {
     DragGesture drags[3];        // left: orbit (fly: look), right: pan, middle: pan the image (Shift: dolly)
     Vec3 pivot;                  // what the left drag orbits about: the surface under the press, or the target
+    std::optional<int> press_pick;   // the primitive under the left press (a click selects it)
+    bool moves_selection = false;    // the left drag started on the selection: it moves it
+    Vec3 move_start;                 // the selection's centre when that drag started
     bool divider_drag = false;   // the left button holds the split view's divider
     bool middle_pans = false;    // the middle drag pans the image (not Shift+middle: that dollies)
     double pan_last_x = 0, pan_last_y = 0;  // the middle pan so far, framebuffer pixels
