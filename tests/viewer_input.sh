@@ -180,10 +180,8 @@ select_edit)
     # Click sphere 01 of scene 3 (image point 344, 410 of the 512x512 image): selected; Delete
     # removes it, Ctrl+Z brings it back, Ctrl+D duplicates it (the copy selected), a drag of
     # the selection moves it (the camera stays), Esc clears the selection.
-    img=$(field image)
-    left=${img%%,*} rest=${img#*,}
-    top=${rest%%,*}
-    x=$((${left%.*} + 344)) y=$((${top%.*} + 410))
+    img=$(field image)  # left,top,[fit]scale
+    read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 344.5 * s, $2 + 410.5 * s}')
     n=$(field primitives)
     echo "primitives_before=$n"
     xdotool mousemove --window "$wid" $x $y
