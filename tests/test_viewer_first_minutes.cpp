@@ -727,3 +727,26 @@ TEST(SceneEdit, DuplicateDeleteAddMaterialEmissiveUndoAndSave) {
     EXPECT_EQ(scene_to_json(m.scene()), scene_to_json(before));
     EXPECT_FALSE(m.dirty());
 }
+
+// Issue 34, defect 2: the render resolution is set in the viewer (a scale of the file's, or
+// the window's size with the camera's aspect following), an undoable edit that restarts the
+// image; the reference's figures apply only to the file's view and resolution.
+TEST(Resolution, ScaleOfTheFilesOrTheWindowsSize) {
+    ViewerModel m = test::brief_model(3);
+    EXPECT_TRUE(m.view_as_loaded());
+    const auto [w, h] = m.file_resolution();
+    const uint64_t g = m.generation();
+    ASSERT_TRUE(m.set_resolution(w / 2, h / 2, false));
+    EXPECT_EQ(m.scene().renderer.width, w / 2);
+    EXPECT_EQ(m.prepared()->renderer.width, w / 2);  // what the render thread renders
+    EXPECT_EQ(m.generation(), g + 1);
+    EXPECT_FALSE(m.view_as_loaded());
+    ASSERT_TRUE(m.set_resolution(880, 650, true));
+    EXPECT_DOUBLE_EQ(m.camera().aspect, 880.0 / 650);
+    ASSERT_TRUE(m.undo());
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.scene().renderer.width, w);
+    EXPECT_TRUE(m.view_as_loaded());
+    move_camera_x(m, 1);
+    EXPECT_FALSE(m.view_as_loaded());
+}
