@@ -126,8 +126,16 @@ TEST(NoiseView, MapsAreFalseColourOfTheStatistics) {
 TEST(ImageView, FitPlacesTheImageAsBeforeAndZoomKeepsThePointUnderThePointer) {
     const PixelRect area{0, 0, 880, 650};
     ImageView view;
-    // Fit: whole screen pixels when it fits, centred on whole pixels.
+    // Fit: the free area by any factor (issue 34, defect 2), centred on whole pixels.
     PixelRect r = view.placement(area, 512, 512);
+    EXPECT_DOUBLE_EQ(r.height, 650);
+    EXPECT_DOUBLE_EQ(r.width, 650);
+    EXPECT_EQ(r.x, 115);
+    EXPECT_EQ(r.y, 0);
+    EXPECT_DOUBLE_EQ(view.placement(area, 200, 100).width, 880);
+    // The whole-pixel fit: whole screen pixels when it fits.
+    view.whole_pixels = true;
+    r = view.placement(area, 512, 512);
     EXPECT_EQ(r.width, 512);
     EXPECT_EQ(r.x, 184);
     EXPECT_EQ(r.y, 69);

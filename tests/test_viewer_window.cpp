@@ -23,6 +23,7 @@
 #include "core/image_io.h"
 #include "viewer/compare_view.h"
 #include "viewer/inspect.h"
+#include "viewer/navigation.h"
 #include "scene/load.h"
 #include "test_util.h"
 
@@ -271,12 +272,13 @@ TEST_F(ViewerWindow, ZoomShowsBlocksOfTheImagesPixels) {
 // waits on the viewer's --status-file for each condition (bounded, never a fixed time).
 namespace {
 
-std::map<std::string, std::string> drive(const fs::path& dir, const std::string& scenario, int scene_number) {
+std::map<std::string, std::string> drive(const fs::path& dir, const std::string& scenario, int scene_number,
+                                         const fs::path& scene_file = {}) {
     const std::string script = (fs::path(KEITHRAY_RES_DIR) / ".." / "tests" / "viewer_input.sh").string();
+    const fs::path file = scene_file.empty() ? kr::test::brief_scene_file(scene_number) : scene_file;
     const kr::test::CommandResult r = kr::test::run_command(
         "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' bash '" + script + "' " + scenario + " '" + KEITHRAY_EXE +
-            "' '" + kr::test::brief_scene_file(scene_number).string() +
-            "' '" + dir.string() + "'",
+            "' '" + file.string() + "' '" + dir.string() + "'",
         dir);
     std::map<std::string, std::string> out;
     std::istringstream lines(r.out);
@@ -352,4 +354,78 @@ TEST_F(ViewerWindow, ZoomKeysProbeClickAndMiddleDragPan) {
     EXPECT_EQ(scale2, 2);
     ASSERT_EQ(std::sscanf(r["wheel_zoomed"].c_str(), "%lf,%lf,%lf", &x, &y, &scale), 3) << r["wheel_zoomed"];
     EXPECT_EQ(scale, 2);
+}
+
+// Issue 34, defect 1, with real input: the first orbit (a 120-pixel left drag) in the
+// default scene leaves the camera in no sphere; so does flying forward for 3 s (G, then W held).
+TEST_F(ViewerWindow, FirstOrbitAndFlyStayOutOfTheWalls) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "first_orbit", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_NE(r["generation_after"], r["generation_before"]);
+    EXPECT_EQ(r["inside"], "none");
+    EXPECT_EQ(r["inside_after_fly"], "none");
+}
+
+// The first orbit's picture, scripted through the same orbit as the drag: the screenshot is
+// the headless render of the saved scene, and it shows the room, not a black inside.
+TEST_F(ViewerWindow, FirstOrbitScreenshotShowsTheRoom) {
+    const fs::path shot = dir / "orbit.ppm", saved = dir / "orbit.json", headless = dir / "headless.ppm";
+    const ViewRun v = keithray("view '" + scene(3) + "' --spp 2 --frames 2 --orbit 120,0 --screenshot '" + shot.string() +
+                                   "' --save-scene '" + saved.string() + "' --timeout 300",
+                               true);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    const kr::Scene edited = kr::load_scene_file(saved).scene;
+    EXPECT_FALSE(kr::viewer::sphere_containing(edited, edited.cameras[size_t(edited.camera)].position));
+    const ViewRun r = keithray("render '" + saved.string() + "' --spp 2 -q -o '" + headless.string() + "'", false);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const kr::Rgb8Image a = kr::read_ppm(shot), b = kr::read_ppm(headless);
+    ASSERT_EQ(a.width, b.width);
+    EXPECT_LE(max_channel_difference(a, b), 1);
+    double mean = 0;
+    for (const uint8_t v8 : a.bytes) mean += v8;
+    mean /= double(a.bytes.size());
+    EXPECT_GT(mean, 40);  // the lit room (the camera inside a wall sees black)
+}
+
+// Issue 34, defect 10: the wheel zooms the image and keeps the samples; Shift+wheel dollies.
+TEST_F(ViewerWindow, WheelZoomsTheImageShiftWheelDollies) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "wheel_zooms", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["generation_zoomed"], r["generation_before"]);
+    EXPECT_NE(r["generation_after"], r["generation_before"]);
+}
+
+// Issue 34, defect 9: a broken starting scene leaves the keys working and nothing edited.
+TEST_F(ViewerWindow, BrokenStartingSceneKeepsTheKeys) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path broken = dir / "broken.json";
+    std::ofstream(broken) << "{ \"cameras\": [ }";
+    auto r = drive(dir, "broken_start", 0, broken);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["help"], "1");
+    EXPECT_EQ(r["dirty"], "0");
+    EXPECT_EQ(r["title"].find("(edited)"), std::string::npos) << r["title"];
+    EXPECT_EQ(r["exit_status"], "0");
+}
+
+// Missing item 1, with real input: a click selects the sphere under the pointer, Delete
+// removes it, Ctrl+Z brings it back, Ctrl+D duplicates it, a drag from the selection moves it
+// (not the camera), Esc clears the selection.
+TEST_F(ViewerWindow, ClickSelectsDeleteUndoDuplicateAndMove) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "select_edit", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    const kr::Scene scene = kr::load_scene_file(kr::test::brief_scene_file(3)).scene;
+    int sphere01 = -1;
+    for (size_t i = 0; i < scene.primitives.size(); ++i)
+        if (scene.primitives[i].id == "sphere 01") sphere01 = int(i);
+    EXPECT_EQ(r["selected"], std::to_string(sphere01));
+    const int n = std::stoi(r["primitives_before"]);
+    EXPECT_EQ(r["primitives_deleted"], std::to_string(n - 1));
+    EXPECT_EQ(r["primitives_duplicated"], std::to_string(n + 1));
+    EXPECT_EQ(r["selected_copy"], std::to_string(n));  // the copy, last in the list
+    EXPECT_EQ(r["selected_after_move"], r["selected_again"]);
+    EXPECT_NE(r["generation_after"], r["generation_before_move"]);  // the move changed the image
 }

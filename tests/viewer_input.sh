@@ -28,6 +28,25 @@ field() { sed -E "s/.*\b$1=([^ ]*).*/\1/" "$status"; }
 
 wid=$(xdotool search --sync --name '^keithray' | head -1)
 [[ -n $wid ]] || { echo "error=no window"; exit 1; }
+if [[ $scenario == broken_start ]]; then
+    # A broken starting scene: the window's keys still work (F1 shows the help, Esc quits).
+    wait_for 'state=error' || exit 1
+    echo "title=$(xdotool getwindowname "$wid")"
+    echo "dirty=$(field dirty)"
+    xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    echo "help=1"
+    xdotool key Escape  # closes the help
+    wait_for 'help=0' || exit 1
+    xdotool key Escape  # quits: nothing was edited
+    end=$((SECONDS + limit))
+    while kill -0 $pid 2>/dev/null && ((SECONDS < end)); do sleep 0.1; done
+    kill -0 $pid 2>/dev/null && { echo "error=still running after Esc"; exit 1; }
+    wait $pid
+    echo "exit_status=$?"
+    exit 0
+fi
 wait_for 'state=done' || exit 1
 xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
 # Over the image (left part of the window, clear of the panel and the status bar).
@@ -118,6 +137,86 @@ zoom_probe)
     wait_for 'b=reference' || exit 1
     xdotool key k
     wait_for 'b=slot1' || exit 1
+    ;;
+first_orbit)
+    # The first orbit a user makes: a 120-pixel left drag to the right, in steps as a hand
+    # moves; then the render finishes and the camera is in no sphere.
+    xdotool mousedown 1
+    wait_for 'press=1 pointer=250,330' || exit 1
+    for x in 270 290 310 330 350 370; do
+        xdotool mousemove --window "$wid" $x 330
+        wait_for "pointer=$x,330" || exit 1
+    done
+    wait_for 'dirty=1' || exit 1
+    xdotool mouseup 1
+    wait_for 'press=0' || exit 1
+    wait_for 'state=done' || exit 1
+    echo "inside=$(field inside)"
+    # Fly mode (G): W flies forward for a while, and stops before any surface.
+    xdotool key g
+    wait_for 'fly=1' || exit 1
+    xdotool keydown w
+    sleep 3  # held: the motion is per second, so how long it is held only changes how far
+    xdotool keyup w
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    wait_for 'state=done' || exit 1
+    echo "inside_after_fly=$(field inside)"
+    ;;
+wheel_zooms)
+    # The wheel zooms the image (no camera edit); Shift+wheel dollies.
+    xdotool click 4
+    wait_for 'image=[-0-9.]+,[-0-9.]+,[0-9.]+ ' || exit 1
+    echo "zoomed=$(field image)"
+    echo "generation_zoomed=$(field generation)"
+    xdotool key 0
+    wait_for 'image=[-0-9.]+,[-0-9.]+,fit' || exit 1
+    xdotool keydown shift
+    xdotool click 4
+    xdotool keyup shift
+    wait_for 'dirty=1' || exit 1
+    ;;
+select_edit)
+    # Click sphere 01 of scene 3 (image point 344, 410 of the 512x512 image): selected; Delete
+    # removes it, Ctrl+Z brings it back, Ctrl+D duplicates it (the copy selected), a drag of
+    # the selection moves it (the camera stays), Esc clears the selection.
+    img=$(field image)  # left,top,[fit]scale
+    read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 344.5 * s, $2 + 410.5 * s}')
+    n=$(field primitives)
+    echo "primitives_before=$n"
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    sel0=$(field selected)
+    echo "selected=$sel0"
+    xdotool key Delete
+    wait_for 'selected=none' || exit 1
+    echo "primitives_deleted=$(field primitives)"
+    xdotool key ctrl+z
+    wait_for "primitives=$n\b" || exit 1
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    xdotool key ctrl+d
+    wait_for "primitives=$((n + 1))\b" || exit 1
+    echo "selected_copy=$(field selected)"
+    echo "primitives_duplicated=$(field primitives)"
+    # The copy sits beside the original: a click selects the original again, then drag it.
+    xdotool click 1
+    wait_for "selected=$sel0 " || exit 1
+    echo "selected_again=$(field selected)"
+    echo "generation_before_move=$(field generation)"
+    xdotool mousedown 1
+    wait_for "press=1 pointer=$x,$y" || exit 1
+    xdotool mousemove --window "$wid" $((x + 30)) $y
+    wait_for "pointer=$((x + 30)),$y" || exit 1
+    xdotool mouseup 1
+    wait_for 'press=0' || exit 1
+    echo "selected_after_move=$(field selected)"
+    xdotool key Escape
+    wait_for 'selected=none' || exit 1
+    xdotool key F1
+    wait_for 'help=1' || exit 1
     ;;
 esc)
     xdotool key Escape

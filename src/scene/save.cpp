@@ -106,8 +106,13 @@ std::string scene_to_json(const Scene& scene) {
 }
 
 void save_scene_json(const Scene& scene, const std::filesystem::path& file) {
+    write_file_atomic(file, scene_to_json(scene_moved_to(scene, file)));
+}
+
+Scene scene_moved_to(const Scene& scene, const std::filesystem::path& file) {
     namespace fs = std::filesystem;
     Scene moved = scene;
+    moved.source_file = file;
     const fs::path dir = file.parent_path();
     if (!scene.renderer.output.empty()) {
         // Same target file seen from the new folder; absolute when no relative path exists.
@@ -117,7 +122,7 @@ void save_scene_json(const Scene& scene, const std::filesystem::path& file) {
         fs::path relative = absolute_target.lexically_relative(base);
         moved.renderer.output = (relative.empty() ? absolute_target : relative).generic_string();
     }
-    write_file_atomic(file, scene_to_json(moved));
+    return moved;
 }
 
 }  // namespace kr

@@ -19,4 +19,8 @@ std::string scene_to_json(const Scene& scene);
 // Throws std::runtime_error on failure.
 void save_scene_json(const Scene& scene, const std::filesystem::path& file);
 
+// `scene` as the file `file` holds it once saved there: its source file `file`, its output
+// rewritten relative to the new folder so it names the same file.
+Scene scene_moved_to(const Scene& scene, const std::filesystem::path& file);
+
 }  // namespace kr

@@ -22,4 +22,12 @@ std::vector<std::filesystem::path> default_scenes() {
     return found;
 }
 
+std::vector<std::filesystem::path> example_scenes() {
+    std::vector<std::filesystem::path> found = list_scenes("res/scenes/examples");
+#ifdef KEITHRAY_SCENES_DIR
+    if (found.empty()) found = list_scenes(std::filesystem::path(KEITHRAY_SCENES_DIR) / "examples");
+#endif
+    return found;
+}
+
 }  // namespace kr

@@ -17,6 +17,7 @@ enum class Edit {
     lens,       // camera type, focal distance, aperture
     light,      // active lights' position, power, area radius
     material,   // rho, roughness, eta, type
+    object,     // a primitive: selected and moved, resized, given a material, made emissive, added, removed
     renderer,   // integrator, depth, estimator, light sampling, seed
     scene,      // another file, a reload, a watched file that changed
     tone_map,   // operator, exposure: re-display only
@@ -30,6 +31,7 @@ constexpr bool edit_resets(Edit e) {
         case Edit::lens:
         case Edit::light:
         case Edit::material:
+        case Edit::object:
         case Edit::renderer:
         case Edit::scene: return true;
         case Edit::tone_map:

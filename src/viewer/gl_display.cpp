@@ -133,6 +133,9 @@ void Display::draw_quad(const PixelRect& where, const PixelRect& clip, int frame
     gl_.Uniform1i(sampler_loc_, 0);
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, texture);
+    const GLint filter = smooth_ ? GL_LINEAR : GL_NEAREST;
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, filter);
+    gl_.TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, filter);
     gl_.BindVertexArray(vertex_array_);
     gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     gl_.BindVertexArray(0);

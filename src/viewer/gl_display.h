@@ -36,6 +36,10 @@ public:
     void draw_bytes(const PixelRect& where, const PixelRect& clip, int framebuffer_width,
                     int framebuffer_height) const;
 
+    // Linear filtering where the image is scaled (a fit by any factor); else nearest, so
+    // pixels show as blocks and at 1:1 every fragment reads exactly its pixel.
+    void set_smooth(bool smooth) { smooth_ = smooth; }
+
 private:
     void draw_quad(const PixelRect& where, const PixelRect& clip, int framebuffer_width, int framebuffer_height,
                    int op, float exposure, float inv_max, GLuint texture) const;
@@ -45,6 +49,7 @@ private:
     GLint rect_loc_ = -1, op_loc_ = -1, exposure_loc_ = -1, inv_max_loc_ = -1, sampler_loc_ = -1;
     int tex_width_ = 0, tex_height_ = 0;
     double inv_max_ = 0;
+    bool smooth_ = false;
 };
 
 }  // namespace kr::viewer

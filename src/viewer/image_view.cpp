@@ -10,12 +10,12 @@ namespace {
 
 constexpr double kLevels[] = {0.125, 0.25, 0.5, 0.75, 1, 2, 3, 4, 6, 8, 12, 16};
 
-double fit_scale(const PixelRect& area, int width, int height) {
-    double s = std::min(std::max(1.0, area.width) / width, std::max(1.0, area.height) / height);
-    return s >= 1 ? std::floor(s) : s;  // whole pixels when it fits
-}
-
 }  // namespace
+
+double ImageView::fit_scale(const PixelRect& area, int width, int height) const {
+    const double s = std::min(std::max(1.0, area.width) / width, std::max(1.0, area.height) / height);
+    return whole_pixels && s >= 1 ? std::floor(s) : s;
+}
 
 double ImageView::scale(const PixelRect& area, int width, int height) const {
     return zoom_ > 0 ? zoom_ : fit_scale(area, width, height);

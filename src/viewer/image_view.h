@@ -1,5 +1,5 @@
-// Where the image sits in the window: fit to the free area, or zoomed (up to 16x, whole
-// screen pixels per image pixel from 1:1 up, so pixels show as blocks) and panned. GL-free:
+// Where the image sits in the window: fit to the free area (any factor, or whole pixels),
+// or zoomed (up to 16x; the zoom levels from 1:1 up are whole, so pixels show as blocks) and panned. GL-free:
 // the window and the tests place the image with the same functions.
 #pragma once
 
@@ -14,8 +14,10 @@ inline constexpr double kMaxZoom = 16;
 
 class ImageView {
 public:
-    // Screen pixels per image pixel: the fit scale (whole pixels when the image fits at 1:1
-    // or more), or the zoom.
+    // Fit fills the free area by any factor; with whole_pixels, by a whole number of screen
+    // pixels per image pixel when the image fits at 1:1 or more (blocks, no resampling).
+    bool whole_pixels = false;
+    // Screen pixels per image pixel: the fit scale, or the zoom.
     double scale(const PixelRect& area, int width, int height) const;
     bool fitted() const { return zoom_ == 0; }
     // The image's rectangle in the framebuffer (it may reach past `area`: the caller clips).
@@ -38,6 +40,7 @@ public:
 
 private:
     void clamp_centre(int width, int height);
+    double fit_scale(const PixelRect& area, int width, int height) const;
     double zoom_ = 0;                     // 0: fit
     double centre_x_ = 0, centre_y_ = 0;  // image point at the area's centre when zoomed
 };

@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/limits.h"
 #include "scene/load.h"
+#include "scene/save.h"
 #include "viewer/navigation.h"
 
 namespace kr::viewer {
@@ -24,7 +26,57 @@ std::shared_ptr<const RenderScene> prepare(const Scene& scene, std::vector<std::
     }
 }
 
+// The scene as saved, with every camera's view (position, target, fov, aspect) and the
+// active camera blanked: what is left is what an edit other than the view changes.
+std::string without_view(Scene scene) {
+    for (Camera& c : scene.cameras) {
+        c.position = Vec3(0, 0, 0);
+        c.target = Vec3(0, 0, 1);
+        c.fov = 45;
+        c.aspect = 1;
+    }
+    scene.camera = 0;
+    return scene_to_json(scene);
+}
+
+void copy_view(const Camera& from, Camera& to) {
+    to.position = from.position;
+    to.target = from.target;
+    to.fov = from.fov;
+    to.aspect = from.aspect;
+}
+
 }  // namespace
+
+void ViewerModel::mark_saved() {
+    saved_id_ = state_id_;
+    saved_json_ = without_view(scene_for_saving());
+}
+
+void ViewerModel::save_scene_to(const std::filesystem::path& file, bool adopt) {
+    save_scene_json(scene_for_saving(), file);
+    if (!adopt) return;
+    auto move = [&](Scene& s) { s = scene_moved_to(s, file); };
+    move(scene_);
+    for (State& st : undo_) move(st.scene);
+    for (State& st : redo_) move(st.scene);
+    mark_saved();
+}
+
+bool ViewerModel::only_view_changed() const {
+    return dirty() && without_view(scene_for_saving()) == saved_json_;
+}
+
+void ViewerModel::load_keeping_view(const std::filesystem::path& file) {
+    const std::vector<Camera> cameras = scene_.cameras;
+    const int active = scene_.camera;
+    load(file);
+    if (cameras.size() != scene_.cameras.size()) return;
+    edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
+        for (size_t i = 0; i < cameras.size(); ++i) copy_view(cameras[i], s.cameras[i]);
+        s.camera = active;
+    }, nullptr, "keep the view");
+}
 
 void ViewerModel::load(const std::filesystem::path& file) {
     LoadedScene loaded = load_scene_file(file);
@@ -38,6 +90,7 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     settings.render = apply_render_options(overrides_, scene);
     settings.tone = scene.display;
     file_cameras_ = scene.cameras;
+    file_resolution_ = {scene.renderer.width, scene.renderer.height};
     file_camera_ = scene.camera;
     scene_ = std::move(scene);
     prepared_ = std::move(prepared);
@@ -48,6 +101,7 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     redo_.clear();
     open_group_.clear();
     saved_id_ = state_id_ = next_state_id_++;
+    saved_json_ = without_view(scene_for_saving());
 }
 
 bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSettings&)>& change, std::string* error,
@@ -68,6 +122,13 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
                                 "; the previous value is kept";
             return false;
         }
+    }
+    if (!prepared_) {
+        // No scene yet (the command line's settings before the first load, or a broken
+        // starting scene): nothing the user edited, nothing to undo or to save.
+        scene_ = std::move(scene);
+        settings_ = settings;
+        return true;
     }
     // Pausing is run control the user toggles, not a change to undo.
     const bool only_pause = !resets && kind == Edit::run_control && settings.paused != settings_.paused;
@@ -136,11 +197,29 @@ bool ViewerModel::set_target_spp(int spp) {
     }, nullptr, "target spp");
 }
 
+bool ViewerModel::set_resolution(int width, int height, bool fit_camera) {
+    width = std::clamp(width, 1, kMaxDimension);
+    height = std::clamp(height, 1, kMaxDimension);
+    return edit(Edit::renderer, [&](Scene& s, ViewerSettings&) {
+        s.renderer.width = width;
+        s.renderer.height = height;
+        if (fit_camera) s.cameras[size_t(s.camera)].aspect = double(width) / height;
+    }, nullptr, "resolution");
+}
+
+bool ViewerModel::view_as_loaded() const {
+    if (!has_scene() || scene_.camera != file_camera_ || size_t(scene_.camera) >= file_cameras_.size()) return false;
+    const Camera& a = camera();
+    const Camera& f = file_cameras_[size_t(scene_.camera)];
+    return a.position == f.position && a.target == f.target && a.fov == f.fov && a.aspect == f.aspect &&
+           std::make_pair(scene_.renderer.width, scene_.renderer.height) == file_resolution_;
+}
+
 bool ViewerModel::reset_view() {
     if (!has_scene() || file_camera_ < 0) return false;
     return edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-        s.cameras = file_cameras_;
-        s.camera = file_camera_;
+        // The view only: the lens the user set up (type, focus, aperture) is not the view.
+        for (size_t i = 0; i < s.cameras.size() && i < file_cameras_.size(); ++i) copy_view(file_cameras_[i], s.cameras[i]);
     }, nullptr, "reset view");
 }
 

@@ -12,6 +12,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "render/options.h"
@@ -41,8 +42,10 @@ struct ViewerSettings {
 
 // What to do when the watched scene file changes on disk.
 enum class WatchAction {
-    reload,  // no unsaved edits: load it
-    ask      // unsaved edits: ask whether to reload (losing them) or keep the edits
+    reload,            // no unsaved edits: load it
+    reload_keep_view,  // only the view changed (orbit, pan, ...): load it and keep the view
+    ask                // unsaved edits: ask whether to reload (losing them), take the file's
+                       // changes and keep the view, or keep the edits
 };
 
 class ViewerModel {
@@ -87,14 +90,36 @@ public:
     // strata divide each pixel for the target: there the image restarts.
     bool set_target_spp(int spp);
 
-    // Puts the active camera back as the file has it (an undoable camera edit).
+    // The render resolution (a renderer edit: the image restarts). With `fit_camera`, the
+    // active camera's aspect becomes width / height, so the picture is not stretched.
+    bool set_resolution(int width, int height, bool fit_camera);
+    // The active camera's view and the resolution are the file's (what a reference image
+    // of the file shows).
+    bool view_as_loaded() const;
+    // The resolution the file gives.
+    std::pair<int, int> file_resolution() const { return file_resolution_; }
+
+    // Puts the active camera's view (position, target, fov, aspect) back as the file has it
+    // (an undoable camera edit); its lens (type, focal distance, aperture) stays.
     bool reset_view();
 
     // Edits not yet saved: the state differs from the one loaded or last saved.
     bool dirty() const { return state_id_ != saved_id_; }
     // After the scene was written to its own file: the current state counts as saved.
-    void mark_saved() { saved_id_ = state_id_; }
-    WatchAction on_file_changed() const { return dirty() ? WatchAction::ask : WatchAction::reload; }
+    void mark_saved();
+    // Writes scene_for_saving() to `file`. `adopt` (Save As): `file` becomes the scene's
+    // file (its output rewritten to name the same image from there, in the undo history
+    // too) and the state counts as saved; else (a copy) nothing changes here.
+    void save_scene_to(const std::filesystem::path& file, bool adopt);
+    // The unsaved edits are only of the view: the cameras' position, target, fov and aspect,
+    // and which camera is active. The view is not what an editor of the file changes.
+    bool only_view_changed() const;
+    WatchAction on_file_changed() const {
+        return !dirty() ? WatchAction::reload : only_view_changed() ? WatchAction::reload_keep_view : WatchAction::ask;
+    }
+    // Loads `file` (a reload: the file changed) and puts the current view back over its
+    // cameras when it has as many: the file's changes, the user's view (an undoable step).
+    void load_keeping_view(const std::filesystem::path& file);
 
     // The active camera (the scene must have one).
     const Camera& camera() const { return scene_.cameras[size_t(scene_.camera)]; }
@@ -134,8 +159,10 @@ private:
     std::vector<State> undo_, redo_;
     std::string open_group_;  // the group the newest undo step may still absorb
     uint64_t next_state_id_ = 1, state_id_ = 0, saved_id_ = 0;
+    std::string saved_json_;             // scene_for_saving() as loaded or last saved, without the view
     std::vector<Camera> file_cameras_;  // as loaded, for reset_view
     int file_camera_ = -1;
+    std::pair<int, int> file_resolution_{0, 0};
 };
 
 }  // namespace kr::viewer

@@ -28,6 +28,133 @@ void orbit(Camera& camera, double yaw_degrees, double pitch_degrees) {
                                                 cp * std::cos(yaw * kDegrees));
 }
 
+namespace {
+
+// `v` turned by `degrees` about the unit `axis` (Rodrigues).
+Vec3 rotate(const Vec3& v, const Vec3& axis, double degrees) {
+    const double a = degrees * kDegrees, c = std::cos(a), s = std::sin(a);
+    return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1 - c));
+}
+
+double elevation_degrees(const Vec3& v) {
+    const double r = length(v);
+    return r > 0 ? std::asin(std::clamp(v.y / r, -1.0, 1.0)) / kDegrees : 0.0;
+}
+
+// The pitch that turns `view` by `pitch_degrees` downwards (camera rising about a pivot),
+// kept kMaxPitch short of the poles; with the axis it turns about.
+bool pitch_axis(const Vec3& view, double& pitch_degrees, Vec3& axis) {
+    const Vec3 h = cross(view, Vec3(0, 1, 0));
+    if (!(length(h) > 1e-12)) return false;
+    axis = h / length(h);
+    const double e = elevation_degrees(view);
+    const double wanted = std::clamp(e - pitch_degrees, -kMaxPitch, kMaxPitch);
+    // Turning about `axis` by +1 degree raises or lowers the view: pick the sign that lowers.
+    const double sign = elevation_degrees(rotate(view, axis, 1)) > e ? -1 : 1;
+    pitch_degrees = sign * (e - wanted);
+    return true;
+}
+
+}  // namespace
+
+void orbit_about(Camera& camera, const Vec3& pivot, double yaw_degrees, double pitch_degrees) {
+    const Vec3 up(0, 1, 0);
+    Vec3 offset = rotate(camera.position - pivot, up, yaw_degrees);
+    Vec3 view = rotate(camera.target - camera.position, up, yaw_degrees);
+    Vec3 axis;
+    if (pitch_axis(view, pitch_degrees, axis)) {
+        offset = rotate(offset, axis, pitch_degrees);
+        view = rotate(view, axis, pitch_degrees);
+    }
+    camera.position = pivot + offset;
+    camera.target = camera.position + view;
+}
+
+void look_drag(Camera& camera, double dx_pixels, double dy_pixels) {
+    // The scene moves against the drag as in a first-person game: right drag turns right.
+    orbit_about(camera, camera.position, dx_pixels * kOrbitDegreesPerPixel, dy_pixels * kOrbitDegreesPerPixel);
+}
+
+void fly(Camera& camera, int forward, int right, int up, double distance) {
+    const CameraModel m = CameraModel::from(camera);
+    const Vec3 shift = (m.forward * double(forward) + m.right * double(right) + Vec3(0, 1, 0) * double(up)) * distance;
+    camera.position += shift;
+    camera.target += shift;
+}
+
+std::optional<double> first_crossing(const Scene& scene, const Vec3& from, const Vec3& to) {
+    const Vec3 d = to - from;
+    const double len2 = dot(d, d);
+    if (!(len2 > 0)) return std::nullopt;
+    std::optional<double> first;
+    for (const Primitive& p : scene.primitives) {
+        if (p.shape < 0) continue;
+        const Shape& s = scene.shapes[size_t(p.shape)];
+        // |from + f d - c|^2 = r^2 for f in (0, 1].
+        const Vec3 oc = from - s.centre;
+        const double b = dot(oc, d), c = dot(oc, oc) - s.radius * s.radius;
+        const double disc = b * b - len2 * c;
+        if (disc < 0) continue;
+        const double root = std::sqrt(disc);
+        for (const double f : {(-b - root) / len2, (-b + root) / len2})
+            if (f > 1e-9 && f <= 1 && (!first || f < *first)) first = f;
+    }
+    return first;
+}
+
+bool keep_outside(const Scene& scene, const Camera& before, Camera& moved, const Vec3* pivot) {
+    const Vec3 from = before.position;
+    const auto crossing = first_crossing(scene, from, moved.position);
+    if (!crossing) return false;
+    const Vec3 view = moved.target - moved.position;
+    auto stop_short = [&](const Vec3& a, const Vec3& b, double f) {
+        // Just short of the surface: a gap of 1e-4 of the way, at least 1e-6.
+        const double len = length(b - a);
+        const double keep = std::max(0.0, f * len - std::max(1e-4 * len, 1e-6));
+        return len > 0 ? a + (b - a) * (keep / len) : a;
+    };
+    if (pivot) {
+        // Drawn towards the pivot, to where the line from it first meets a surface.
+        const Vec3 p = *pivot;
+        const auto hit = first_crossing(scene, p, moved.position);
+        const Vec3 drawn = hit ? stop_short(p, moved.position, *hit) : moved.position;
+        if (length(drawn - p) > 1e-3 * length(moved.position - p) && !first_crossing(scene, from, drawn) &&
+            dot(moved.target - drawn, view) > 0) {
+            moved.position = drawn;
+            // Orbiting about the target keeps looking at it; else the view direction is kept.
+            if (length(moved.target - p) > 1e-9 * (1 + length(p))) moved.target = drawn + view;
+            return true;
+        }
+    }
+    moved.position = stop_short(from, moved.position, *crossing);
+    moved.target = moved.position + view;
+    return true;
+}
+
+std::optional<Vec3> surface_point(const RenderScene& scene, double fx, double fy) {
+    CameraModel pinhole = scene.camera;
+    pinhole.lens_radius = 0;  // the ray through the lens centre
+    const CameraRay cr = pinhole.generate(fx, fy, 0.5, 0.5);
+    Ray ray;
+    ray.o = cr.origin;
+    ray.d = cr.direction;
+    Hit hit;
+    if (!scene.intersects(ray, hit)) return std::nullopt;
+    return ray.o + ray.d * hit.t;
+}
+
+void orbit_drag(Camera& camera, double dx_pixels, double dy_pixels, const Vec3& pivot) {
+    orbit_about(camera, pivot, -dx_pixels * kOrbitDegreesPerPixel, dy_pixels * kOrbitDegreesPerPixel);
+}
+
+Camera orbit_step(const Scene& scene, const Camera& start, const Camera& current, const Vec3& pivot, double dx_pixels,
+                  double dy_pixels, bool stop_at_surfaces) {
+    Camera cam = start;
+    orbit_drag(cam, dx_pixels, dy_pixels, pivot);
+    if (stop_at_surfaces) keep_outside(scene, current, cam, &pivot);
+    return cam;
+}
+
 void orbit_drag(Camera& camera, double dx_pixels, double dy_pixels) {
     // Dragging moves the scene with the cursor: right drag swings the camera left.
     orbit(camera, -dx_pixels * kOrbitDegreesPerPixel, dy_pixels * kOrbitDegreesPerPixel);
@@ -72,8 +199,18 @@ bool DragGesture::move(double x, double y, const Camera& camera, double& dx, dou
     return true;
 }
 
-void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height) {
+void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height,
+                      const NavigationSettings& nav) {
+    seconds *= nav.speed;
     const double orbit_pixels = kKeyOrbitDegreesPerSecond / kOrbitDegreesPerPixel * seconds;
+    if (nav.fly) {
+        // The arrows look (not faster with the speed), W/S A/D Q/E fly.
+        const double look = orbit_pixels / nav.speed;
+        if (keys.orbit_x || keys.orbit_y) look_drag(camera, keys.orbit_x * look, keys.orbit_y * look);
+        const double step = kFlyFractionPerSecond * length(camera.target - camera.position) * seconds;
+        if (keys.pan_x || keys.pan_y || keys.dolly) fly(camera, -keys.dolly, -keys.pan_x, keys.pan_y, step);
+        return;
+    }
     if (keys.orbit_x || keys.orbit_y) orbit_drag(camera, keys.orbit_x * orbit_pixels, keys.orbit_y * orbit_pixels);
     const double pan_pixels = kKeyPanPixelsPerSecond * seconds;
     if (keys.pan_x || keys.pan_y) pan_drag(camera, keys.pan_x * pan_pixels, keys.pan_y * pan_pixels, image_height);
@@ -90,15 +227,9 @@ std::optional<std::string> sphere_containing(const Scene& scene, const Vec3& poi
 }
 
 std::optional<double> focus_distance(const RenderScene& scene, double fx, double fy) {
-    CameraModel pinhole = scene.camera;
-    pinhole.lens_radius = 0;  // the ray through the lens centre
-    const CameraRay cr = pinhole.generate(fx, fy, 0.5, 0.5);
-    Ray ray;
-    ray.o = cr.origin;
-    ray.d = cr.direction;
-    Hit hit;
-    if (!scene.intersects(ray, hit)) return std::nullopt;
-    return hit.t * dot(cr.direction, pinhole.forward);
+    const std::optional<Vec3> p = surface_point(scene, fx, fy);
+    if (!p) return std::nullopt;
+    return dot(*p - scene.camera.position, scene.camera.forward);
 }
 
 }  // namespace kr::viewer

@@ -12,11 +12,54 @@ namespace kr::viewer {
 // Mouse-drag scales shared by the window and the scripted --orbit option.
 inline constexpr double kOrbitDegreesPerPixel = 0.25;
 
+// How the mouse and keys move the camera (the Navigation panel; not saved with the scene).
+struct NavigationSettings {
+    bool fly = false;              // left drag looks around, W/A/S/D/Q/E fly; else orbit, pan, dolly
+    double speed = 1;              // factor on every drag, key and wheel motion (0.05 .. 20)
+    bool stop_at_surfaces = true;  // a move that would cross a sphere's surface stops before it
+    bool orbit_picked = true;      // a left drag orbits about the surface under the pointer
+};
+inline constexpr double kMinSpeed = 0.05, kMaxSpeed = 20;
+// Fly mode: the distance per second at speed 1 is this fraction of the camera's distance
+// to its target (the scene's scale as the file frames it).
+inline constexpr double kFlyFractionPerSecond = 0.5;
+
 // Turntable orbit about the target: yaw about +y, pitch towards the poles (kept 1 degree
 // short of them so the camera frame never degenerates). The distance is kept.
 void orbit(Camera& camera, double yaw_degrees, double pitch_degrees);
 // A drag of (dx, dy) pixels: right turns the view to the right, down tilts it down.
 void orbit_drag(Camera& camera, double dx_pixels, double dy_pixels);
+// The same about `pivot` (orbit_about).
+void orbit_drag(Camera& camera, double dx_pixels, double dy_pixels, const Vec3& pivot);
+
+// Turntable orbit about `pivot`: yaw about +y, then pitch about the camera's right axis
+// (the view kept 1 degree short of the poles). Position and view direction turn together,
+// so the pivot stays where it is in the image; orbiting about the target keeps the target.
+void orbit_about(Camera& camera, const Vec3& pivot, double yaw_degrees, double pitch_degrees);
+// Turns the view about the camera's position (fly mode's mouse look): a drag of (dx, dy)
+// pixels turns it right / down.
+void look_drag(Camera& camera, double dx_pixels, double dy_pixels);
+// Fly mode's keys: forward (+1 W, -1 S), right (D/A), up (E/Q), `distance` each; the
+// target moves along, so the view direction is kept.
+void fly(Camera& camera, int forward, int right, int up, double distance);
+
+// The first crossing of a sphere's surface (entering or leaving) on the segment from `from`
+// to `to`, as a fraction of it in (0, 1]; none when the segment crosses no surface.
+std::optional<double> first_crossing(const Scene& scene, const Vec3& from, const Vec3& to);
+// Stop at surfaces: `moved` is `before` after a navigation step. If its position's way from
+// before's crosses a surface, the position stops just short of it; with a `pivot` (an
+// orbit) the camera is first drawn towards the pivot, so an orbit slides along a wall
+// instead of stopping. The view direction is kept. True when the move was changed.
+bool keep_outside(const Scene& scene, const Camera& before, Camera& moved, const Vec3* pivot = nullptr);
+
+// One frame of an orbit drag: `start` (the camera when the drag started) orbited by the
+// drag's whole offset about `pivot`, stopped at surfaces on its way from `current` (the
+// camera on screen). The window and the tests go through this.
+Camera orbit_step(const Scene& scene, const Camera& start, const Camera& current, const Vec3& pivot, double dx_pixels,
+                  double dy_pixels, bool stop_at_surfaces);
+
+// The surface point seen through image point (fx, fy) by the pinhole ray, if any.
+std::optional<Vec3> surface_point(const RenderScene& scene, double fx, double fy);
 
 // A mouse button held on the image. A press and release with small jitter, or a pointer
 // that jumps between events, is a click, not a drag: the drag starts only once the pointer
@@ -47,7 +90,9 @@ struct KeyMotion {
 inline constexpr double kKeyOrbitDegreesPerSecond = 60;
 inline constexpr double kKeyPanPixelsPerSecond = 240;
 inline constexpr double kKeyDollyPerSecond = 0.8;  // the distance shrinks by e^-0.8 per second
-void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height);
+// In fly mode the same keys fly (W/S forward, A/D strafe, Q/E down/up) and the arrows look.
+void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height,
+                      const NavigationSettings& nav = {});
 
 // The id of an authored sphere (one the scene block renders) that contains `point`, if any:
 // a camera there sees only the sphere's inside.

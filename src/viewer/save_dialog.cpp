@@ -15,7 +15,9 @@ namespace {
 
 constexpr SaveKind kImageKinds[] = {SaveKind::ppm, SaveKind::png, SaveKind::exr, SaveKind::pfm};
 
-bool is_image(SaveKind kind) { return kind != SaveKind::scene && kind != SaveKind::convergence; }
+bool is_image(SaveKind kind) {
+    return kind != SaveKind::scene && kind != SaveKind::scene_copy && kind != SaveKind::convergence;
+}
 
 ImageFormat image_format(SaveKind kind) {
     switch (kind) {
@@ -82,9 +84,9 @@ std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model,
                         const std::string& convergence_csv) {
     if (kind == SaveKind::convergence) {
         write_file_atomic(path, convergence_csv);
-    } else if (kind == SaveKind::scene) {
-        save_scene_json(model.scene_for_saving(), path);
-        model.mark_saved();  // the edits are in a file now
+    } else if (kind == SaveKind::scene || kind == SaveKind::scene_copy) {
+        model.save_scene_to(path, kind == SaveKind::scene);
+        if (kind == SaveKind::scene_copy) return "saved a copy as " + show_user_text(path.string());
     } else {
         save_image(kind, path, model, shown);
     }

@@ -15,7 +15,8 @@
 
 namespace kr::viewer {
 
-enum class SaveKind { ppm, png, exr, pfm, scene, convergence };
+// scene: Save As (the file becomes the scene's); scene_copy: a copy, the scene's file stays.
+enum class SaveKind { ppm, png, exr, pfm, scene, scene_copy, convergence };
 
 // The panel's path fields, edited by the user.
 struct SavePaths {

@@ -25,7 +25,9 @@ bool apply_script_edits(const ViewOptions& options, ViewerModel& model, const Ed
         });
     if (options.orbit)
         edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            orbit_drag(s.cameras[size_t(s.camera)], options.orbit->first, options.orbit->second);
+            // The window's drag about the target, stopped at surfaces as it is there.
+            Camera& cam = s.cameras[size_t(s.camera)];
+            cam = orbit_step(s, cam, cam, cam.target, options.orbit->first, options.orbit->second, true);
         });
     if (options.click_focus) {
         // The centre of the pixel, as a click on it gives.

@@ -40,6 +40,14 @@ RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool
     return st;
 }
 
+std::string format_noise(double noise) {
+    char buf[32];
+    const double percent = 100 * noise;
+    if (percent >= 0.001) std::snprintf(buf, sizeof buf, "%.3g%%", std::min(percent, 999.0));
+    else std::snprintf(buf, sizeof buf, "< 0.001%%");
+    return buf;
+}
+
 std::string window_title(std::string_view scene_name, const RunStatus& status, bool dirty) {
     char spp[64];
     if (status.unlimited) std::snprintf(spp, sizeof spp, "%d spp (unlimited)", status.spp);

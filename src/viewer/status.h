@@ -34,6 +34,9 @@ struct RunStatus {
 // `has_error`: a load or edit failure is being shown (the last good image stays).
 RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error);
 
+// The noise estimate in the status bar, at most 9 characters: "5.61%", "0.0123%", "< 0.001%".
+std::string format_noise(double noise);
+
 // "assignment_03.json - 12/64 spp - rendering", with " (edited)" after the name when the
 // scene has unsaved edits.
 std::string window_title(std::string_view scene_name, const RunStatus& status, bool dirty);

@@ -34,7 +34,7 @@ void install_input_callbacks(GLFWwindow* w) {
     glfwSetCursorPosCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
     glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int, int, int) { app_of(win)->note_input(); });
     glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
-    glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int) { app_of(win)->note_key(key, action); });
+    glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
     glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
     glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
@@ -114,13 +114,16 @@ void ViewerApp::poll_watch() {
     SceneFiles& files = ui_.files;
     if (!files.watch.changed()) return;
     input_seen_ = true;  // something to show either way
-    // Never drop the user's edits silently: with unsaved edits, ask.
-    if (model_.has_scene() && model_.on_file_changed() == WatchAction::ask) {
+    // Never drop the user's edits silently: with unsaved edits, ask. A changed view alone
+    // is kept over the file's changes without asking.
+    const WatchAction action = model_.has_scene() ? model_.on_file_changed() : WatchAction::reload;
+    if (action == WatchAction::ask) {
         files.pending_open = files.watch.file();
         files.ask_discard = true;
         return;
     }
-    open_scene(ctx_, files.watch.file());
+    open_scene(ctx_, files.watch.file(), action == WatchAction::reload_keep_view);
+    if (action == WatchAction::reload_keep_view) messages_.show_status("reloaded the file's changes; kept your view");
 }
 
 void ViewerApp::sync_worker() {
@@ -166,9 +169,9 @@ Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
     return out;
 }
 
-void ViewerApp::note_key(int key, int action) {
+void ViewerApp::note_key(int key, int action, int mods) {
     input_seen_ = true;
-    input_.note_key(key, action);
+    input_.note_key(key, action, mods);
 }
 
 void ViewerApp::request_quit() {
@@ -231,16 +234,23 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (tool.locked_probe) std::snprintf(probe, sizeof probe, "%d,%d", tool.locked_probe->first, tool.locked_probe->second);
     if (tool.comparison.b())
         std::snprintf(b, sizeof b, tool.comparison.settings.b < 0 ? "reference" : "slot%d", tool.comparison.settings.b + 1);
-    char line[420];
+    // inside: the sphere the camera is in ("none"); fly: the navigation mode.
+    std::string inside = ui_.inside_sphere ? *ui_.inside_sphere : "none";
+    std::replace(inside.begin(), inside.end(), ' ', '_');
+    // selected: the selected primitive's index in the scene block's list ("none").
+    const auto sel = ctx_.selection();
+    const std::string selected = sel ? std::to_string(*sel) : "none";
+    char line[640];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
-                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b);
+                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
+                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0));
     if (line == status_line_) return;
     try {
         write_file_atomic(*options_.status_file, line);
@@ -259,19 +269,34 @@ void ViewerApp::draw_panels() {
     }
     const ImGuiIO& io = ImGui::GetIO();
     const float bar_h = float(ctx_.status_bar_height() / std::max(1.0f, io.DisplayFramebufferScale.y));
-    // The panel keeps the right edge above the status bar; its left edge can be dragged.
-    const float max_w = std::max(200.0f, io.DisplaySize.x * 0.5f);
-    float& width = ui_.panel_width;
-    width = std::clamp(width, 200.0f, max_w);
+    // The panel keeps the right edge above the status bar. The width the user chose stays
+    // what it is: a small window only shows it narrower, and it comes back when the window grows.
+    const float width = shown_panel_width(ui_.panel_width, float(io.DisplaySize.x));
+    const float height = io.DisplaySize.y - bar_h;
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width, 0));
-    ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y - bar_h));
-    ImGui::SetNextWindowSizeConstraints(ImVec2(200, io.DisplaySize.y - bar_h), ImVec2(max_w, io.DisplaySize.y - bar_h));
-    ImGui::Begin("keithray", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoTitleBar);
-    // The width the user dragged it to, for the next frame's layout.
-    if (ImGui::IsWindowFocused() && io.MouseDown[0]) width = ImGui::GetWindowWidth();
+    ImGui::SetNextWindowSize(ImVec2(width, height));
+    ImGui::Begin("keithray", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoResize);
+    // Labels keep their room: the fields narrow instead.
+    ImGui::PushItemWidth(-kPanelLabelWidth);
     draw_panel_list(ctx_);
+    ImGui::PopItemWidth();
     overwrite_popup(ctx_);
     ImGui::End();
+    // The panel's left edge: a grip kPanelGripWidth wide that drags the width.
+    ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - kPanelGripWidth / 2, 0));
+    ImGui::SetNextWindowSize(ImVec2(kPanelGripWidth, height));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowPadding, ImVec2(0, 0));
+    ImGui::PushStyleVar(ImGuiStyleVar_WindowMinSize, ImVec2(1, 1));
+    ImGui::Begin("##panel edge", nullptr,
+                 ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoBackground | ImGuiWindowFlags_NoSavedSettings |
+                     ImGuiWindowFlags_NoMove);
+    ImGui::InvisibleButton("##grip", ImVec2(kPanelGripWidth, height));
+    if (ImGui::IsItemHovered() || ImGui::IsItemActive()) ImGui::SetMouseCursor(ImGuiMouseCursor_ResizeEW);
+    if (ImGui::IsItemActive())
+        ui_.panel_width = shown_panel_width(io.DisplaySize.x - io.MousePos.x, io.DisplaySize.x);
+    ImGui::End();
+    ImGui::PopStyleVar(2);
 }
 
 bool ViewerApp::draw_frame() {
@@ -332,6 +357,9 @@ int ViewerApp::run() {
                 input_seen_ = true;  // draw the new state once
             }))
             break;
+        // A message that expired goes from the status bar at once.
+        messages_.error_sticks = !model_.has_scene();
+        if (messages_.expire(UiClock::now())) input_seen_ = true;
         const auto latest = worker_->latest();
         const bool new_snapshot = latest && latest->serial != ui_.shown_serial;
         // Redraw only on input, a new snapshot, or something moving; else sleep until one of

@@ -32,7 +32,7 @@ public:
 
     // The GLFW callbacks.
     void note_input() { input_seen_ = true; }
-    void note_key(int key, int action);
+    void note_key(int key, int action, int mods);
     void on_close_request();
 
 private:

@@ -10,6 +10,7 @@
 
 #include "core/image_compare.h"
 #include "core/text.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 namespace kr::viewer {
@@ -32,8 +33,8 @@ void keep_image_b(PanelContext& ctx, const Snapshot& frame) {
     CompareTool& tool = ctx.ui.compare;
     tool.comparison.settings.b = tool.comparison.keep(frame.radiance, frame.spp);
     tool.picture_key.clear();
-    ctx.messages.status =
-        "kept the image as " + tool.comparison.slots()[size_t(tool.comparison.settings.b)]->name + " (image B)";
+    ctx.messages.show_status("kept the image as " + tool.comparison.slots()[size_t(tool.comparison.settings.b)]->name +
+                             " (image B)");
 }
 
 std::optional<PixelProbe> probe(const PanelContext& ctx, int x, int y) {
@@ -85,7 +86,12 @@ void update_pictures(PanelContext& ctx, Display& display) {
     Rgb8Image b_bytes = b ? b->display(tone) : Rgb8Image{};
     tool.figures.reset();
     tool.figures_note.clear();
-    if (b && full) {
+    const bool reference_off_view =
+        b && tool.comparison.reference() && b == &*tool.comparison.reference() && !model.view_as_loaded();
+    if (reference_off_view) {
+        // The reference is the file's view: another view's figures against it mean nothing.
+        tool.figures_note = "the camera left the reference's view";
+    } else if (b && full) {
         tool.figures = compare_figures(a, b_bytes);
         if (!tool.figures)
             tool.figures_note = "B is " + std::to_string(b->width()) + "x" + std::to_string(b->height()) + ", the image " +
@@ -95,7 +101,7 @@ void update_pictures(PanelContext& ctx, Display& display) {
     }
     if (shown->generation == model.generation()) {
         std::optional<CompareFigures> truth;
-        if (full && tool.comparison.reference())
+        if (full && tool.comparison.reference() && model.view_as_loaded())
             truth = b == &*tool.comparison.reference() ? tool.figures : compare_figures(a, tool.comparison.reference()->display(tone));
         tool.convergence.record(*shown, truth);
     }
@@ -138,6 +144,7 @@ void draw_image(const PanelContext& ctx, Display& display, const PixelRect& rect
     const PixelRect area = ctx.view_area();
     const ToneSettings& tone = model.settings().tone;
     const ViewMode mode = tool.comparison.settings.mode;
+    display.set_smooth(tool.smooth);
     if (mode == ViewMode::render || !tool.picture_current) {
         display.draw(rect, area, fb_w, fb_h, tone);  // the render, also while B or a map is missing
         return;
@@ -156,8 +163,8 @@ void draw_image(const PanelContext& ctx, Display& display, const PixelRect& rect
     display.draw_bytes(rect, clip(divider, rect.x + rect.width), fb_w, fb_h);
 }
 
-void draw_inspector(const PanelContext& ctx, const PixelRect& rect) {
-    const CompareTool& tool = ctx.ui.compare;
+void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
+    CompareTool& tool = ctx.ui.compare;
     const ViewerModel& model = ctx.model;
     ImGuiIO& io = ImGui::GetIO();
     const float to_points = 1.0f / std::max(1.0f, io.DisplayFramebufferScale.x);
@@ -176,15 +183,54 @@ void draw_inspector(const PanelContext& ctx, const PixelRect& rect) {
         draw->AddRect(ImVec2(cx - size / 2 - 1, cy - size / 2 - 1), ImVec2(cx + size / 2 + 1, cy + size / 2 + 1),
                       IM_COL32(255, 80, 80, 255));
     }
+    // The selected sphere's outline, as the camera sees it.
+    if (const auto sel = ctx.selection(); sel && model.prepared()) {
+        const Scene& s = model.scene();
+        const Shape& shape = s.shapes[size_t(s.primitives[size_t(*sel)].shape)];
+        const auto outline = sphere_outline(model.prepared()->camera, shape.centre, shape.radius, 64);
+        std::vector<ImVec2> points;
+        for (const auto& [fx, fy] : outline)
+            points.emplace_back(float(rect.x + fx * rect.width) * to_points, float(rect.y + fy * rect.height) * to_points);
+        if (!points.empty()) {
+            draw->PushClipRect(ImVec2(float(ctx.view_area().x) * to_points, float(ctx.view_area().y) * to_points),
+                               ImVec2(float(ctx.view_area().x + ctx.view_area().width) * to_points,
+                                      float(ctx.view_area().y + ctx.view_area().height) * to_points));
+            draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);
+            draw->PopClipRect();
+        }
+    }
+    // Which view the image shows, on the image (the render needs no label).
+    const ViewMode mode = tool.comparison.settings.mode;
+    if (mode != ViewMode::render) {
+        const CompareImage* b = tool.comparison.b();
+        std::string label = std::string(view_mode_names.name(mode));
+        if (mode == ViewMode::split) label = "split: render | " + (b ? b->name : std::string("no image B"));
+        else if ((mode == ViewMode::reference || mode == ViewMode::error) && b) label += ": " + b->name;
+        if (!tool.picture_current) label += " (not available: showing the render)";
+        const PixelRect view = ctx.view_area();
+        const ImVec2 at(float(std::max(rect.x, view.x) + 6) * to_points, float(std::max(rect.y, view.y) + 6) * to_points);
+        const ImVec2 size = ImGui::CalcTextSize(label.c_str());
+        draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 160));
+        draw->AddText(at, IM_COL32(255, 255, 255, 230), label.c_str());
+    }
     // Hovering the image with no button down shows its pixel.
     const PixelRect area = ctx.view_area();
     const double mx = io.MousePos.x / to_points, my = io.MousePos.y / to_points;
     const bool over = mx >= std::max(rect.x, area.x) && my >= std::max(rect.y, area.y) &&
                       mx < std::min(rect.x + rect.width, area.x + area.width) &&
                       my < std::min(rect.y + rect.height, area.y + area.height);
+    tool.hover_text.clear();
     if (!over || io.WantCaptureMouse || io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || !ctx.ui.shown) return;
     const auto p = probe(ctx, int(std::floor((mx - rect.x) / scale)), int(std::floor((my - rect.y) / scale)));
     if (!p) return;
+    // One line for the status bar; the box at the pointer only when asked for (I).
+    char line[256];
+    const int n = std::snprintf(line, sizeof line, "pixel %d, %d   radiance %.4g %.4g %.4g   shown %d %d %d", p->x, p->y,
+                                p->mean.x, p->mean.y, p->mean.z, p->displayed[0], p->displayed[1], p->displayed[2]);
+    if (n > 0 && size_t(n) < sizeof line && !p->preview && std::isfinite(p->standard_error))
+        std::snprintf(line + n, sizeof line - size_t(n), "   %u samples, std. error %.3g", p->samples, p->standard_error);
+    tool.hover_text = line;
+    if (!tool.probe_box) return;
     ImGui::BeginTooltip();
     ImGui::Text("pixel %d, %d", p->x, p->y);
     ImGui::Text("radiance %.4g %.4g %.4g", p->mean.x, p->mean.y, p->mean.z);

@@ -26,6 +26,6 @@ void update_pictures(PanelContext& ctx, Display& display);
 // The image in `rect` as the view asks: the render, a picture, or both split.
 void draw_image(const PanelContext& ctx, Display& display, const PixelRect& rect, int fb_w, int fb_h);
 // The divider, the locked probe's square, and the hovered pixel's tooltip.
-void draw_inspector(const PanelContext& ctx, const PixelRect& rect);
+void draw_inspector(PanelContext& ctx, const PixelRect& rect);
 
 }  // namespace kr::viewer

@@ -6,6 +6,7 @@
 #include <imgui.h>
 
 #include "scene/load.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 namespace kr::viewer {
@@ -37,7 +38,8 @@ double PanelContext::status_bar_height() const {
 }
 
 PixelRect PanelContext::view_area() const {
-    const double panel = ui.panel_visible ? ui.panel_width * ImGui::GetIO().DisplayFramebufferScale.x : 0.0;
+    const ImGuiIO& io = ImGui::GetIO();
+    const double panel = ui.panel_visible ? shown_panel_width(ui.panel_width, io.DisplaySize.x) * io.DisplayFramebufferScale.x : 0.0;
     return {0, 0, std::max(1.0, ui.framebuffer_width - panel), std::max(1.0, ui.framebuffer_height - status_bar_height())};
 }
 
@@ -45,6 +47,43 @@ PixelRect PanelContext::image_rect() const {
     if (!model.has_scene()) return {};
     // Fitted whole (whole screen pixels per image pixel when it fits), or zoomed and panned.
     return ui.compare.view.placement(view_area(), model.scene().renderer.width, model.scene().renderer.height);
+}
+
+std::optional<int> PanelContext::selection() const {
+    if (!ui.selected || !model.has_scene() || *ui.selected < 0 || size_t(*ui.selected) >= model.scene().primitives.size())
+        return std::nullopt;
+    return ui.selected;
+}
+
+void duplicate_selection(PanelContext& ctx) {
+    const auto sel = ctx.selection();
+    if (!sel) return;
+    ctx.model.seal_undo_step();
+    int copy = -1;
+    const CameraModel& cam = ctx.model.prepared()->camera;
+    ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) {
+        const double r = s.shapes[size_t(s.primitives[size_t(*sel)].shape)].radius;
+        copy = duplicate_primitive(s, *sel, cam.right * (2.2 * r));  // beside it, as seen
+    }, "duplicate");
+    if (copy >= 0) ctx.ui.selected = copy;
+}
+
+void delete_selection(PanelContext& ctx) {
+    const auto sel = ctx.selection();
+    if (!sel) return;
+    ctx.model.seal_undo_step();
+    if (ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) { delete_primitive(s, *sel); }, "delete"))
+        ctx.ui.selected.reset();
+}
+
+void add_sphere_at_target(PanelContext& ctx) {
+    ctx.model.seal_undo_step();
+    int added = -1;
+    const Camera cam = ctx.model.camera();
+    ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) {
+        added = add_sphere(s, cam.target, std::max(1e-3, 0.05 * length(cam.target - cam.position)));
+    }, "add sphere");
+    if (added >= 0) ctx.ui.selected = added;
 }
 
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
@@ -56,11 +95,14 @@ void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
     open_scene(ctx, file);
 }
 
-void open_scene(PanelContext& ctx, const std::filesystem::path& file) {
+void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_view) {
     SceneFiles& files = ctx.ui.files;
     try {
-        ctx.model.load(file);
-        ctx.messages.error.clear();
+        if (keep_view) ctx.model.load_keeping_view(file);
+        else ctx.model.load(file);
+        // The messages and the selection of the scene shown before belong to it.
+        ctx.messages.clear();
+        ctx.ui.selected.reset();
         if (file != files.watch.file()) {
             files.watch.watch(file);
             ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene());

@@ -4,6 +4,7 @@
 // compare tool). ViewerApp (ui_app.h) owns them and hands each frame a PanelContext.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -21,6 +22,7 @@
 #include "viewer/image_view.h"
 #include "viewer/inspect.h"
 #include "viewer/model.h"
+#include "viewer/navigation.h"
 #include "viewer/render_worker.h"
 #include "viewer/save_dialog.h"
 #include "viewer/status.h"
@@ -29,14 +31,34 @@ namespace kr::viewer {
 
 using UiClock = std::chrono::steady_clock;
 
-// The status bar's message line.
+// The status bar's message line. A message belongs to the event that made it: it expires
+// (kStatusSeconds, kErrorSeconds), and opening or reloading a scene clears it.
 struct Messages {
+    static constexpr double kStatusSeconds = 8, kErrorSeconds = 20;
     std::string error;                 // the last refused edit or failed load, red until the next success
     UiClock::time_point error_time{};  // when it was set: flashed at the pointer for a moment
     std::string status;                // the last save or keep message
-    void show_error(std::string message) {
+    UiClock::time_point status_time{};
+    bool error_sticks = false;         // there is no scene to show: the error is the state, it stays
+    void show_error(std::string message, UiClock::time_point now = UiClock::now()) {
         error = std::move(message);
-        error_time = UiClock::now();
+        error_time = now;
+    }
+    void show_status(std::string message, UiClock::time_point now = UiClock::now()) {
+        status = std::move(message);
+        status_time = now;
+    }
+    void clear() {
+        error.clear();
+        status.clear();
+    }
+    // Drops the messages older than their time; true when one went.
+    bool expire(UiClock::time_point now) {
+        auto old = [&](UiClock::time_point t, double limit) { return std::chrono::duration<double>(now - t).count() > limit; };
+        bool gone = false;
+        if (!status.empty() && old(status_time, kStatusSeconds)) status.clear(), gone = true;
+        if (!error.empty() && !error_sticks && old(error_time, kErrorSeconds)) error.clear(), gone = true;
+        return gone;
     }
     // The error is new enough to show at the pointer.
     bool flashing(UiClock::time_point now) const {
@@ -49,6 +71,7 @@ struct Messages {
 // figures of A against B, the locked probe and the convergence log.
 struct CompareTool {
     ImageView view;
+    bool smooth = false;        // linear filtering of a scaled image
     bool zoom_applied = false;  // --zoom waits for the first frame's layout
     Comparison comparison;
     bool reference_automatic = false;  // the brief's reference for this scene, not --reference
@@ -61,6 +84,8 @@ struct CompareTool {
     std::string picture_key;       // what the picture was made from (cleared: make it again)
     double linear_scale = 0;       // tonemap_scale of the shown frame (the inspector)
     std::optional<std::pair<int, int>> locked_probe;
+    std::string hover_text;   // the inspector's numbers for the pixel under the pointer (status bar)
+    bool probe_box = false;   // ... also in a box at the pointer (I)
     bool open_panel = false;  // the command line asked for a view or a probe: the panel opens once
 };
 
@@ -79,15 +104,26 @@ struct SaveTool {
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
 };
 
+// The panel's width in window points: the default (labels uncut at the default font), the
+// room kept for labels, the grip along its left edge, and the width shown in a window
+// `window_width` wide for the one the user chose: at most half the window, at least the minimum.
+inline constexpr float kDefaultPanelWidth = 440, kMinPanelWidth = 260, kPanelLabelWidth = 150, kPanelGripWidth = 8;
+inline float shown_panel_width(float chosen, float window_width) {
+    return std::max(kMinPanelWidth, std::min(chosen, window_width * 0.5f));
+}
+
 // The window's state that the panels, the input handling and the scripted mode share.
 struct UiState {
     TypedFields typed;                       // numbers being typed into panel fields
     std::shared_ptr<const Snapshot> shown;   // the frame in the texture
     uint64_t shown_serial = 0;
     int framebuffer_width = 0, framebuffer_height = 0;  // this frame's
-    float panel_width = 400;                 // window points; the user can resize it
+    float panel_width = kDefaultPanelWidth;  // window points, as the user chose (shown_panel_width)
     bool panel_visible = true, help_visible = false;
     bool pick_focus = false;                 // the next click on the image focuses the lens
+    NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
+    std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
+    int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
     std::optional<std::string> inside_sphere;  // the camera is inside this sphere
     double ui_fps = 0, ui_work = 0;          // UI frames per second, seconds of work each (smoothed)
     SceneFiles files;
@@ -113,16 +149,26 @@ struct PanelContext {
     double status_bar_height() const;  // framebuffer pixels
     PixelRect view_area() const;       // the free area left of the panel, above the status bar
     PixelRect image_rect() const;      // where the image is drawn in it (zoom and pan)
+    // The selection when it names a primitive of the current scene (an undo may remove it).
+    std::optional<int> selection() const;
 };
 
+// The selection's edits, each one undoable step (viewer/scene_edit.h).
+void duplicate_selection(PanelContext& ctx);  // Ctrl+D: the copy beside it, selected
+void delete_selection(PanelContext& ctx);     // Delete
+void add_sphere_at_target(PanelContext& ctx); // a sphere at the camera's target, selected
+
 // Opens `file` now (a reload when it is the current one); on failure the last good scene stays.
-void open_scene(PanelContext& ctx, const std::filesystem::path& file);
+// `keep_view`: a reload that puts the current view back over the file's cameras.
+void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_view = false);
 // The same, asking first when there are unsaved edits.
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file);
 
 // Writes `kind` to `path` (viewer/save_dialog.h), asking first when a file would be
 // replaced; the outcome is the status message (ui_panel_save.cpp).
 void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path& path);
+// Save: the scene over its own file, without asking (Ctrl+S).
+void save_scene_in_place(PanelContext& ctx);
 // The overwrite question, drawn every frame where request_save may have opened it.
 void overwrite_popup(PanelContext& ctx);
 

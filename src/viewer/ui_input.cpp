@@ -4,15 +4,26 @@
 #include <cmath>
 
 #include "render/trace.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 #include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
 #include <imgui.h>
+#include <imgui_internal.h>  // ClosePopupToLevel: Esc closes an open drop-down
 
 namespace kr::viewer {
 
-void InputState::note_key(int key, int action) {
-    if (action == GLFW_PRESS && key_presses.size() < 64) key_presses.push_back(key);
+void InputState::note_key(int key, int action, int mods) {
+    if (action == GLFW_PRESS && key_presses.size() < 64) {
+        key_presses.push_back(key);
+        key_mods.push_back(mods);
+    }
+}
+
+bool InputState::pressed_with_ctrl(int key) const {
+    for (size_t i = 0; i < key_presses.size(); ++i)
+        if (key_presses[i] == key && (key_mods[i] & GLFW_MOD_CONTROL)) return true;
+    return false;
 }
 
 int InputState::pressed_bits() const {
@@ -37,6 +48,12 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     const PixelRect area = ctx.view_area();
     auto inside = [&](const PixelRect& r) { return mx >= r.x && my >= r.y && mx < r.x + r.width && my < r.y + r.height; };
     const bool over_image = inside(area) && inside(rect);
+    // A left press and release that never became a drag is a click: it selects the sphere
+    // under it, or clears the selection.
+    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && in.drags[0].pressed && !in.drags[0].dragging) {
+        ctx.ui.selected = in.press_pick;
+        ctx.ui.axis_lock = -1;
+    }
     for (int b = 0; b < 3; ++b)
         if (!io.MouseDown[b]) in.drags[b].release();
     if (!io.MouseDown[0]) in.divider_drag = false;
@@ -44,13 +61,28 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     if (io.WantCaptureMouse || !over_image) {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
-        if (!io.WantCaptureMouse && inside(area) && io.KeyCtrl && io.MouseWheel != 0)
+        if (!io.WantCaptureMouse && inside(area) && !io.KeyShift && io.MouseWheel != 0)
             tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
     } else {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b))
                 in.drags[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
         const bool left_click = ImGui::IsMouseClicked(ImGuiMouseButton_Left);
+        if (left_click) {
+            // The orbit's pivot: the surface under the press, else the target.
+            in.pivot = model.camera().target;
+            const double px = io.MouseClickedPos[0].x * to_fb, py = io.MouseClickedPos[0].y * to_fb;
+            const double fx = (px - rect.x) / rect.width, fy = (py - rect.y) / rect.height;
+            if (ctx.ui.nav.orbit_picked && model.prepared())
+                if (const auto p = surface_point(*model.prepared(), fx, fy)) in.pivot = *p;
+            // The sphere under it: a click selects it; a drag from the selection moves it.
+            in.press_pick = model.prepared() ? pick_primitive(model.scene(), model.prepared()->camera, fx, fy) : std::nullopt;
+            in.moves_selection = in.press_pick && in.press_pick == ctx.selection() && !ctx.ui.nav.fly;
+            if (in.moves_selection) {
+                const Scene& s = model.scene();
+                in.move_start = s.shapes[size_t(s.primitives[size_t(*in.press_pick)].shape)].centre;
+            }
+        }
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
         if (left_click && io.KeyShift) {
             in.drags[0].release();  // Shift+click locks the inspector on a pixel, or frees it
@@ -68,15 +100,19 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             ctx.ui.pick_focus = false;
         }
         if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
-            // The middle button pans a zoomed image; on a fitted one it dollies the camera.
-            in.middle_pans = !tool.view.fitted();
+            // The middle button pans the image, as the wheel zooms it; Shift+middle dollies.
+            in.middle_pans = !io.KeyShift;
             in.pan_last_x = in.pan_last_y = 0;
         }
         if (io.MouseWheel != 0) {
-            if (io.KeyCtrl) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            // The wheel zooms the image about the pointer (samples kept); Shift+wheel dollies.
+            if (!io.KeyShift) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
             else
                 ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-                    dolly(s.cameras[size_t(s.camera)], std::pow(0.9, double(io.MouseWheel)));
+                    Camera& cam = s.cameras[size_t(s.camera)];
+                    const Camera before = cam;
+                    dolly(cam, std::pow(0.9, double(io.MouseWheel) * ctx.ui.nav.speed));
+                    if (ctx.ui.nav.stop_at_surfaces) keep_outside(s, before, cam);
                 }, "dolly", "wheel");
         }
     }
@@ -91,17 +127,34 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         dy /= image_scale;
         return true;
     };
-    if (drag(in.drags[0]))
+    const NavigationSettings& nav = ctx.ui.nav;
+    const auto selected = ctx.selection();
+    if (in.moves_selection && selected && drag(in.drags[0])) {
+        // The selection follows the pointer in the view plane, or along the locked axis
+        // (X, Y or Z held, or the Selection panel's lock).
+        int axis = ctx.ui.axis_lock;
+        if (ImGui::IsKeyDown(GLFW_KEY_X)) axis = 0;
+        if (ImGui::IsKeyDown(GLFW_KEY_Y)) axis = 1;
+        if (ImGui::IsKeyDown(GLFW_KEY_Z)) axis = 2;
+        const Vec3 to = in.move_start + drag_offset(model.prepared()->camera, in.move_start, dx, dy, h, axis);
+        ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) { own_shape(s, *selected).centre = to; }, "move", "move");
+    } else if (!in.moves_selection && drag(in.drags[0]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[0].start_camera;
-            orbit_drag(cam, dx, dy);
-            s.cameras[size_t(active)] = cam;
+            Camera& cam = s.cameras[size_t(active)];
+            if (nav.fly) {
+                cam = in.drags[0].start_camera;
+                look_drag(cam, dx, dy);
+            } else {
+                cam = orbit_step(s, in.drags[0].start_camera, cam, in.pivot, dx, dy, nav.stop_at_surfaces);
+            }
         }, "orbit", "orbit");
     if (drag(in.drags[1]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[1].start_camera;
+            Camera& cam = s.cameras[size_t(active)];
+            const Camera before = cam;
+            cam = in.drags[1].start_camera;
             pan_drag(cam, dx, dy, h);
-            s.cameras[size_t(active)] = cam;
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
         }, "pan", "pan");
     if (in.middle_pans) {
         // The image follows the pointer from where the button went down: this frame's part of
@@ -114,9 +167,11 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         }
     } else if (drag(in.drags[2])) {
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera cam = in.drags[2].start_camera;
-            dolly(cam, std::exp(dy * 0.005));
-            s.cameras[size_t(active)] = cam;
+            Camera& cam = s.cameras[size_t(active)];
+            const Camera before = cam;
+            cam = in.drags[2].start_camera;
+            dolly(cam, std::exp(dy * 0.005 * nav.speed));
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
         }, "dolly", "dolly");
     }
 }
@@ -136,7 +191,9 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         py = area.y + area.height / 2;
     }
     bool acted = false;
-    for (const int key : in.key_presses) {
+    for (size_t i = 0; i < in.key_presses.size(); ++i) {
+        const int key = in.key_presses[i];
+        if (in.key_mods[i] & GLFW_MOD_CONTROL) continue;  // a Ctrl chord, not a zoom key
         acted = true;
         if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
         else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
@@ -145,11 +202,38 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         else if (key == GLFW_KEY_V) {
             auto& mode = tool.comparison.settings.mode;
             mode = ViewMode((int(mode) + 1) % int(view_mode_names.names.size()));
+        } else if (key == GLFW_KEY_I) {
+            tool.probe_box = !tool.probe_box;
         } else if (key == GLFW_KEY_K && ctx.ui.shown && ctx.ui.shown->scale == 1) {
             keep_image_b(ctx, *ctx.ui.shown);
         } else acted = false;
     }
     return acted;
+}
+
+// The window's own keys, with or without a scene (a broken starting scene must not freeze
+// them), in the order they were pressed: taps that reach one frame together (a busy
+// machine) act as they would one frame each (F1 then Esc shows and closes the help; Esc
+// then F1 asks to quit, then shows the help). F1 and F11 work even while a field has the keyboard.
+void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
+    UiState& ui = ctx.ui;
+    const ImGuiIO& io = ImGui::GetIO();
+    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
+    for (const int key : in.key_presses) {
+        if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
+        else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
+        else if (typing) continue;
+        else if (key == GLFW_KEY_ESCAPE) {
+            // Esc closes what is open first: the help, a drop-down or a question; then quits.
+            if (ui.help_visible) ui.help_visible = false;
+            else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && ui.selected) ui.selected.reset();
+            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
+            else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
+            // (a question closes itself on Esc: its Cancel)
+        } else if (key == GLFW_KEY_TAB) {
+            ui.panel_visible = !ui.panel_visible;
+        }
+    }
 }
 
 void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
@@ -166,27 +250,32 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     // (a busy machine) act as they would one frame each (F1 then Esc shows and closes the
     // help; Esc then F1 asks to quit, then shows the help). F1 and F11 work even while a
     // field has the keyboard.
-    const bool typing = io.WantTextInput || ImGui::IsAnyItemActive();
-    for (const int key : in.key_presses) {
-        if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
-        else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
-        else if (typing) continue;
-        else if (key == GLFW_KEY_ESCAPE) {
-            if (ui.help_visible) ui.help_visible = false;
-            else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
-        } else if (key == GLFW_KEY_TAB) {
-            ui.panel_visible = !ui.panel_visible;
-        }
-    }
-    if (typing) {
+    window_keys(ctx, in, requests);
+    if (io.WantTextInput || ImGui::IsAnyItemActive()) {
         in.motion_keys_held = false;
         return;
     }
     bool question = false;
     for (ImWchar c : io.InputQueueCharacters) question |= c == '?';
     if (question) ui.help_visible = !ui.help_visible;
-    if (io.KeyCtrl && (pressed(GLFW_KEY_Z) || pressed(GLFW_KEY_Y))) {
-        const bool redo = pressed(GLFW_KEY_Y) || io.KeyShift;
+    // Ctrl chords by the modifiers each key event had: a fast chord can start and end between frames.
+    auto ctrl_pressed = [&](int key) { return in.pressed_with_ctrl(key) || (io.KeyCtrl && ImGui::IsKeyPressed(key, false)); };
+    auto shift_with = [&](int key) {
+        for (size_t i = 0; i < in.key_presses.size(); ++i)
+            if (in.key_presses[i] == key && (in.key_mods[i] & GLFW_MOD_SHIFT)) return true;
+        return io.KeyShift;
+    };
+    if (ctrl_pressed(GLFW_KEY_S)) {
+        save_scene_in_place(ctx);
+        return;
+    }
+    if (ctrl_pressed(GLFW_KEY_D)) {
+        duplicate_selection(ctx);
+        return;
+    }
+    if (pressed(GLFW_KEY_DELETE)) delete_selection(ctx);
+    if (ctrl_pressed(GLFW_KEY_Z) || ctrl_pressed(GLFW_KEY_Y)) {
+        const bool redo = ctrl_pressed(GLFW_KEY_Y) || shift_with(GLFW_KEY_Z);
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
         return;
     }
@@ -200,7 +289,8 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         model.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
     }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
-    if (!io.KeyCtrl) zoom_keys(ctx, in);
+    if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
+    if (!io.KeyCtrl) zoom_keys(ctx, in);  // (zoom_keys skips presses made with Ctrl)
     if (pressed(GLFW_KEY_SPACE))
         ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
     if (io.KeyCtrl) {
@@ -218,8 +308,14 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         // The time since the previous frame with keys held; a first frame moves one 60 Hz step.
         const double dt = in.motion_keys_held ? std::clamp(std::chrono::duration<double>(now - in.last_motion).count(), 0.0, 0.1) : 1.0 / 60;
         const int h = model.scene().renderer.height;
+        const NavigationSettings& nav = ui.nav;
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            apply_key_motion(s.cameras[size_t(s.camera)], keys, dt, h);
+            Camera& cam = s.cameras[size_t(s.camera)];
+            const Camera before = cam;
+            apply_key_motion(cam, keys, dt, h, nav);
+            // Arrow keys orbit about the target: stopped at a wall, they slide along it.
+            const bool orbiting = !nav.fly && (keys.orbit_x || keys.orbit_y);
+            if (nav.stop_at_surfaces) keep_outside(s, before, cam, orbiting ? &before.target : nullptr);
         }, "camera keys", "keys");
     }
     in.motion_keys_held = keys.any();
@@ -231,12 +327,15 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
 WindowRequests handle_input(PanelContext& ctx, InputState& in) {
     WindowRequests requests;
     if (!ctx.model.has_scene()) {
+        window_keys(ctx, in, requests);
         in.key_presses.clear();
+        in.key_mods.clear();
         return requests;
     }
     handle_mouse(ctx, in, ctx.image_rect());
     handle_keys(ctx, in, requests);
     in.key_presses.clear();
+    in.key_mods.clear();
     // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
     if (!in.moving() && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
     return requests;

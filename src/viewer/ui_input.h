@@ -3,6 +3,7 @@
 // split view's divider, zoom, the camera keys, undo, the window's own keys.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "viewer/navigation.h"
@@ -11,9 +12,13 @@
 namespace kr::viewer {
 
 struct InputState {
-    DragGesture drags[3];        // left: orbit, right: pan, middle: dolly (or pan a zoomed image)
+    DragGesture drags[3];        // left: orbit (fly: look), right: pan, middle: pan the image (Shift: dolly)
+    Vec3 pivot;                  // what the left drag orbits about: the surface under the press, or the target
+    std::optional<int> press_pick;   // the primitive under the left press (a click selects it)
+    bool moves_selection = false;    // the left drag started on the selection: it moves it
+    Vec3 move_start;                 // the selection's centre when that drag started
     bool divider_drag = false;   // the left button holds the split view's divider
-    bool middle_pans = false;    // the middle drag pans a zoomed image, not the camera
+    bool middle_pans = false;    // the middle drag pans the image (not Shift+middle: that dollies)
     double pan_last_x = 0, pan_last_y = 0;  // the middle pan so far, framebuffer pixels
     bool motion_keys_held = false;
     UiClock::time_point last_motion{};  // previous frame with motion keys held
@@ -21,8 +26,11 @@ struct InputState {
     // only whether a key is down at each frame, so a press and release between two frames
     // (a short tap on a busy machine) never shows in ImGui::IsKeyPressed.
     std::vector<int> key_presses;
+    std::vector<int> key_mods;  // each press's modifiers (GLFW_MOD_*), as the event had them
 
-    void note_key(int key, int action);
+    void note_key(int key, int action, int mods = 0);
+    // `key` was pressed since the last frame with Ctrl held (by its event, not the frame's state).
+    bool pressed_with_ctrl(int key) const;
     // The buttons held on the image for --status-file: 1 left, 2 right, 4 middle, 8 the divider.
     int pressed_bits() const;
     // A held button or camera key: the window redraws at its frame rate.

@@ -15,27 +15,35 @@ namespace {
 
 // The keys and mouse controls, for the help window (F1 or ?).
 constexpr const char* kHelpRows[][2] = {
-    {"left drag", "orbit about the target"},
+    {"left drag", "orbit about the surface under the pointer (else the target); stops at surfaces"},
+    {"left drag (fly mode)", "look around"},
+    {"click", "select the sphere under the pointer (Esc: none)"},
+    {"left drag on the selection", "move it in the view plane; hold X, Y or Z for one axis"},
     {"right drag", "pan"},
-    {"wheel, middle drag", "dolly (middle drag pans a zoomed image)"},
-    {"Ctrl+wheel, + / -", "zoom the image about the pointer (up to 16x)"},
+    {"wheel, Ctrl+wheel, + / -", "zoom the image about the pointer (samples kept)"},
+    {"Shift+wheel, Shift+middle drag", "dolly the camera"},
+    {"middle drag", "pan the image"},
     {"0 / 1", "fit the image to the window / show it 1:1"},
-    {"hover / Shift+click", "read a pixel / lock the probe on it"},
+    {"hover / Shift+click", "read a pixel in the status bar / lock the probe on it"},
+    {"I", "the pixel's numbers also in a box at the pointer"},
     {"V", "next view: render, reference, split, error, noise, samples"},
     {"K", "keep the image as a snapshot (image B)"},
     {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
-    {"arrows", "orbit"},
-    {"W / S", "dolly in / out"},
-    {"A / D / Q / E", "pan left / right / down / up"},
-    {"Home or R", "reset the view to the file's camera"},
+    {"G", "fly mode on / off (speed: Camera panel)"},
+    {"arrows", "orbit (fly mode: look)"},
+    {"W / S", "dolly in / out (fly mode: forward / back)"},
+    {"A / D / Q / E", "pan left / right / down / up (fly mode: fly)"},
+    {"Home or R", "reset the view to the file's camera (the lens stays)"},
+    {"Ctrl+D / Delete", "duplicate / delete the selection"},
+    {"Ctrl+S", "save the scene over its file"},
     {"[ / ]", "halve / double the target spp (keeps the samples taken)"},
     {"Space", "pause / resume"},
     {"Ctrl+Z", "undo"},
     {"Ctrl+Shift+Z, Ctrl+Y", "redo"},
-    {"Tab", "hide / show the panel"},
+    {"Tab", "hide / show the panel (drag its left edge to resize it)"},
     {"F11", "fullscreen"},
     {"F1 or ?", "this help"},
-    {"Esc", "close this help; quit (asks first with unsaved edits)"},
+    {"Esc", "close the help, a drop-down or the selection; quit (asks first with unsaved edits)"},
     {"typed numbers", "apply on Enter or when the field is left"},
 };
 
@@ -74,8 +82,10 @@ void draw_status_bar(PanelContext& ctx) {
         if (st.state == RunState::done) std::snprintf(overlay, sizeof overlay, "done (%s)", st.rule.c_str());
         else if (st.eta >= 0) std::snprintf(overlay, sizeof overlay, "ETA %s (%s)", format_duration(st.eta).c_str(), st.rule.c_str());
         else std::snprintf(overlay, sizeof overlay, "%s", st.rule.c_str());
+    } else if (!st.unlimited) {
+        std::snprintf(overlay, sizeof overlay, "starting (spp)");  // no frame yet: towards the target
     } else {
-        std::snprintf(overlay, sizeof overlay, "no stop rule");
+        std::snprintf(overlay, sizeof overlay, "unlimited: no stop rule");
     }
     ImGui::ProgressBar(st.progress >= 0 ? float(st.progress) : 0.0f, ImVec2(220, 0), overlay);
     ImGui::SameLine(480);
@@ -83,12 +93,13 @@ void draw_status_bar(PanelContext& ctx) {
     ImGui::SameLine(560);
     ImGui::Text("%.2f Mrays/s", st.mrays_per_second);
     ImGui::SameLine(680);
-    if (st.noise >= 0) ImGui::Text("noise %.3g%%", 100 * st.noise);
+    // A fixed width, so the figure after it never runs into it.
+    if (st.noise >= 0) ImGui::Text("noise %s", format_noise(st.noise).c_str());
     else ImGui::TextDisabled("noise: needs 2 spp");
     const std::optional<CompareFigures>& figures = ctx.ui.compare.figures;
     if (figures && current) {
         // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
-        ImGui::SameLine(790);
+        ImGui::SameLine(800);
         ImGui::Text("vs B %.2f dB", figures->psnr);
     }
     // Line 2: one message, the most important first; full text on hover.
@@ -115,8 +126,11 @@ void draw_status_bar(PanelContext& ctx) {
             ImGui::SameLine();
             if (ImGui::SmallButton("dismiss")) messages.error.clear();
         }
+    } else if (!ctx.ui.compare.hover_text.empty()) {
+        // The inspector's numbers for the pixel under the pointer: here, not over the image.
+        ImGui::TextUnformatted(ctx.ui.compare.hover_text.c_str());
     } else {
-        ImGui::TextDisabled("F1 or ?: keys and mouse   Tab: panel   F11: fullscreen");
+        ImGui::TextDisabled("F1 or ?: keys and mouse   Tab: panel   F11: fullscreen   I: pixel box at the pointer");
     }
     ImGui::End();
 }
@@ -188,8 +202,14 @@ void discard_popup(PanelContext& ctx) {
         ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
+    if (same && ImGui::Button("Take the file's changes, keep my view")) {
+        open_scene(ctx, *files.pending_open, true);
+        files.pending_open.reset();
+        ImGui::CloseCurrentPopup();
+    }
+    if (same) ImGui::SameLine();
     if (ImGui::Button("Keep my edits") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) {
-        if (same) ctx.messages.status = "kept your edits; the file on disk differs (Save scene JSON to keep them)";
+        if (same) ctx.messages.show_status("kept your edits; the file on disk differs (Save scene JSON to keep them)");
         files.pending_open.reset();
         ImGui::CloseCurrentPopup();
     }

@@ -31,6 +31,20 @@ void panel_camera(PanelContext& ctx) {
     if (field(ctx, "target", &cam.target.x, 3, float(0.005 * span), -kHuge, kHuge)) apply("camera target");
     if (field(ctx, "fov (deg)", &cam.fov, 1, 0.1f, 0.5, 179.5)) apply("fov");
     if (field(ctx, "aspect", &cam.aspect, 1, 0.005f, 0.05, 20)) apply("aspect");
+    // How the mouse and keys move the camera: the window's, not the scene's.
+    NavigationSettings& nav = ctx.ui.nav;
+    ImGui::Separator();
+    int mode = nav.fly ? 1 : 0;
+    ImGui::RadioButton("orbit", &mode, 0);
+    ImGui::SameLine();
+    ImGui::RadioButton("fly (G)", &mode, 1);
+    nav.fly = mode == 1;
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("left drag looks around; W/S forward, A/D sideways, Q/E down/up");
+    float speed = float(nav.speed);
+    if (ImGui::SliderFloat("speed", &speed, float(kMinSpeed), float(kMaxSpeed), "%.2fx", ImGuiSliderFlags_Logarithmic))
+        nav.speed = std::clamp(double(speed), kMinSpeed, kMaxSpeed);
+    ImGui::Checkbox("stop at surfaces", &nav.stop_at_surfaces);
+    ImGui::Checkbox("orbit about the clicked surface", &nav.orbit_picked);
 }
 
 }  // namespace kr::viewer

@@ -61,6 +61,27 @@ void panel_compare(PanelContext& ctx) {
     if (ImGui::SmallButton("+")) tool.view.zoom_steps(area, w, h, 1, cx, cy);
     ImGui::SameLine();
     if (ImGui::SmallButton("-")) tool.view.zoom_steps(area, w, h, -1, cx, cy);
+    // The fit: any factor (smooth or in blocks), or whole screen pixels per image pixel.
+    ImGui::Checkbox("fit in whole pixels", &tool.view.whole_pixels);
+    ImGui::SameLine();
+    ImGui::Checkbox("smooth (linear filter)", &tool.smooth);
+    // The render's resolution: a scale of the file's, or the free area's size.
+    ImGui::Text("render %d x %d", w, h);
+    const auto [fw, fh] = ctx.model.file_resolution();
+    for (const double f : {0.25, 0.5, 1.0, 2.0}) {
+        ImGui::SameLine();
+        char label[24];
+        std::snprintf(label, sizeof label, f == 1 ? "file" : "%gx", f);
+        if (ImGui::SmallButton(label) && !ctx.model.set_resolution(int(fw * f + 0.5), int(fh * f + 0.5), false))
+            ctx.messages.show_error("resolution: the scene cannot be prepared at that size");
+    }
+    ImGui::SameLine();
+    if (ImGui::SmallButton("window")) {
+        const double to_points = 1.0 / std::max(1.0f, ImGui::GetIO().DisplayFramebufferScale.x);
+        ctx.model.set_resolution(int(area.width * to_points), int(area.height * to_points), true);
+        tool.view.fit();
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("the free area's size; the camera's aspect follows");
 
     // The view.
     CompareSettings& cs = tool.comparison.settings;

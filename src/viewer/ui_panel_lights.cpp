@@ -1,31 +1,42 @@
 // The Lights panel: each active light's position and power; an area light's sphere.
+#include <algorithm>
 #include <string>
 
 #include <imgui.h>
 
 #include "viewer/ui_panels.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_widgets.h"
 
 namespace kr::viewer {
 
 void panel_lights(PanelContext& ctx) {
     const Scene& scene = ctx.model.scene();
-    if (scene.active_lights.empty() || !ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) return;
-    for (int index : scene.active_lights) {
+    if (scene.lights.empty() || !ImGui::CollapsingHeader("Lights", ImGuiTreeNodeFlags_DefaultOpen)) return;
+    // Every light of the file, on (in the scene block) or off.
+    for (int index = 0; index < int(scene.lights.size()); ++index) {
         const Light& light = scene.lights[size_t(index)];
         ImGui::PushID(index);
-        ImGui::Text("%s (%s)", light.id.c_str(), std::string(light_type_names.name(light.type)).c_str());
+        bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
+        const std::string label = light.id + " (" + std::string(light_type_names.name(light.type)) + ")";
+        if (ImGui::Checkbox(label.c_str(), &on))
+            ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { set_light_on(s, index, on); }, "light on/off");
+        if (!on) {
+            ImGui::PopID();
+            continue;
+        }
         Light edited = light;
         const std::string name = "light " + light.id;
         if (light.type == LightType::point) {
             bool changed = field(ctx, "position", &edited.position.x, 3, 0.02f, -kHuge, kHuge);
-            changed |= field(ctx, "intensity", &edited.power.x, 3, 0.5f, 0.0, kHuge);
+            // "power" as the file says it: a point light's intensity, an area light's radiance.
+            changed |= field(ctx, "power", &edited.power.x, 3, 0.5f, 0.0, kHuge);
             if (changed) ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = edited; }, name, name);
         } else {
             Shape shape = scene.shapes[size_t(light.shape)];
             bool changed = field(ctx, "position", &shape.centre.x, 3, 0.02f, -kHuge, kHuge);
             changed |= field(ctx, "radius", &shape.radius, 1, 0.005f, 1e-4, kHuge);
-            changed |= field(ctx, "radiance", &edited.power.x, 3, 0.1f, 0.0, kHuge);
+            changed |= field(ctx, "power", &edited.power.x, 3, 0.1f, 0.0, kHuge);
             if (changed)
                 ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) {
                     s.lights[size_t(index)] = edited;

@@ -33,26 +33,36 @@ void panel_save(PanelContext& ctx) {
     if (ImGui::Button("Save PFM")) request_save(ctx, SaveKind::pfm, image_save_path(SaveKind::pfm, paths.hdr));
     ImGui::EndDisabled();
     ImGui::InputText("scene", &paths.scene);
-    if (ImGui::Button("Save scene JSON")) request_save(ctx, SaveKind::scene, paths.scene);
+    // Save As: the file becomes the scene's (watched, in the title, saved); a copy leaves it.
+    if (ImGui::Button("Save scene as")) request_save(ctx, SaveKind::scene, paths.scene);
+    ImGui::SameLine();
+    if (ImGui::Button("Save a copy")) request_save(ctx, SaveKind::scene_copy, paths.scene);
+    if (ImGui::Button("Save (Ctrl+S)")) save_scene_in_place(ctx);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("over the scene's own file");
     ImGui::TextDisabled("messages appear in the status bar");
 }
 
 namespace {
 
 void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
-    std::string& status = ctx.messages.status;
     try {
-        status = save_output(kind, path, ctx.model, ctx.ui.shown.get(), ctx.ui.compare.convergence.csv());
-        // Saving over the watched file should not read like an outside change.
+        ctx.messages.show_status(save_output(kind, path, ctx.model, ctx.ui.shown.get(), ctx.ui.compare.convergence.csv()));
+        // Saving over the watched file should not read like an outside change; Save As
+        // watches the new file.
         std::error_code ec;
         FileWatch& watch = ctx.ui.files.watch;
-        if (kind == SaveKind::scene && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
+        if (kind == SaveKind::scene_copy && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
+        if (kind == SaveKind::scene) watch.watch(path);
     } catch (const std::exception& e) {
-        status = std::string("save failed: ") + e.what();
+        ctx.messages.show_error(std::string("save failed: ") + e.what());
     }
 }
 
 }  // namespace
+
+void save_scene_in_place(PanelContext& ctx) {
+    if (ctx.model.has_scene()) save_now(ctx, SaveKind::scene, ctx.ui.files.watch.file());
+}
 
 void request_save(PanelContext& ctx, SaveKind kind, const fs::path& path) {
     // Never overwrite silently (an image's depth file included): the popup asks.
@@ -78,7 +88,7 @@ void overwrite_popup(PanelContext& ctx) {
     ImGui::SameLine();
     if (ImGui::Button("Cancel")) {
         pending.reset();
-        ctx.messages.status = "not saved";
+        ctx.messages.show_status("not saved");
         ImGui::CloseCurrentPopup();
     }
     ImGui::EndPopup();

@@ -21,10 +21,12 @@ void panel_scene(PanelContext& ctx) {
     const fs::path current = files.watch.file();
     ImGui::TextWrapped("%s", current.string().c_str());
     if (files.folders.empty()) {
-        // The scene's own folder, then the bundled scenes' (default_scenes); a file listed
-        // from both shows once.
+        // The scene's own folder, then the bundled scenes' (default_scenes) and the examples'
+        // (example_scenes); a file listed from two shows once.
         std::vector<fs::path> folders{current.parent_path().empty() ? fs::path(".") : current.parent_path()};
-        for (const fs::path& p : default_scenes())
+        std::vector<fs::path> bundled = default_scenes();
+        for (fs::path& p : example_scenes()) bundled.push_back(std::move(p));
+        for (const fs::path& p : bundled)
             if (std::find(folders.begin(), folders.end(), p.parent_path()) == folders.end())
                 folders.push_back(p.parent_path());
         files.choices = scene_choices(folders);

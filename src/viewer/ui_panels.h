@@ -8,6 +8,7 @@
 
 #define KR_VIEWER_PANELS(PANEL)  \
     PANEL(scene, always)         \
+    PANEL(selection, with_scene) \
     PANEL(camera, with_scene)    \
     PANEL(lens, with_scene)      \
     PANEL(lights, with_scene)    \

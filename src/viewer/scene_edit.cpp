@@ -1,0 +1,203 @@
+#include "viewer/scene_edit.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace kr::viewer {
+
+void set_light_on(Scene& scene, int index, bool on) {
+    std::vector<int>& active = scene.active_lights;
+    const auto it = std::find(active.begin(), active.end(), index);
+    if (on && it == active.end()) active.push_back(index);
+    if (!on && it != active.end()) active.erase(it);
+}
+
+std::optional<int> pick_primitive(const Scene& scene, const CameraModel& camera, double fx, double fy) {
+    CameraModel pinhole = camera;
+    pinhole.lens_radius = 0;
+    const CameraRay ray = pinhole.generate(fx, fy, 0.5, 0.5);
+    std::optional<int> best;
+    double best_t = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < scene.primitives.size(); ++i) {
+        const int si = scene.primitives[i].shape;
+        if (si < 0) continue;
+        const Shape& s = scene.shapes[size_t(si)];
+        // |o + t d - c|^2 = r^2 with |d| = 1: the nearest t > 0.
+        const Vec3 oc = ray.origin - s.centre;
+        const double b = dot(oc, ray.direction), c = dot(oc, oc) - s.radius * s.radius;
+        const double disc = b * b - c;
+        if (disc < 0) continue;
+        const double root = std::sqrt(disc);
+        double t = -b - root;
+        if (t <= 1e-9 * (1 + std::abs(b))) t = -b + root;
+        if (t > 1e-9 * (1 + std::abs(b)) && t < best_t) {
+            best_t = t;
+            best = int(i);
+        }
+    }
+    return best;
+}
+
+std::optional<ImageCircle> project_sphere(const CameraModel& camera, const Vec3& centre, double radius) {
+    const Vec3 p = centre - camera.position;
+    const double z = dot(p, camera.forward);
+    if (!(z > 0)) return std::nullopt;
+    // The inverse of the pinhole's image point to direction (fy grows downwards).
+    ImageCircle c;
+    c.fx = 0.5 + 0.5 * dot(p, camera.right) / (z * camera.tan_half_fov * camera.aspect);
+    c.fy = 0.5 - 0.5 * dot(p, camera.up) / (z * camera.tan_half_fov);
+    // The silhouette's angular radius asin(r / d), as a fraction of the image height.
+    const double d = length(p);
+    const double angle = radius < d ? std::asin(radius / d) : kPi / 2;
+    c.radius = 0.5 * std::tan(std::min(angle, 1.5)) / camera.tan_half_fov;
+    return c;
+}
+
+namespace {
+
+// A point's image point, when it is in front of the camera.
+std::optional<std::pair<double, double>> image_point(const CameraModel& camera, const Vec3& point) {
+    const Vec3 p = point - camera.position;
+    const double z = dot(p, camera.forward);
+    if (!(z > 0)) return std::nullopt;
+    return std::make_pair(0.5 + 0.5 * dot(p, camera.right) / (z * camera.tan_half_fov * camera.aspect),
+                          0.5 - 0.5 * dot(p, camera.up) / (z * camera.tan_half_fov));
+}
+
+}  // namespace
+
+std::vector<std::pair<double, double>> sphere_outline(const CameraModel& camera, const Vec3& centre, double radius,
+                                                      int n) {
+    // The silhouette is the circle of tangent points: centre c + (r^2 / d^2)(eye - c), radius
+    // r sqrt(d^2 - r^2) / d, in the plane perpendicular to the view of the centre.
+    const Vec3 to_eye = camera.position - centre;
+    const double d2 = dot(to_eye, to_eye);
+    std::vector<std::pair<double, double>> out;
+    if (!(d2 > radius * radius)) return out;
+    const Vec3 w = to_eye / std::sqrt(d2);
+    const Vec3 ring_centre = centre + to_eye * (radius * radius / d2);
+    const double ring = radius * std::sqrt(d2 - radius * radius) / std::sqrt(d2);
+    Vec3 u = cross(w, std::abs(w.y) < 0.9 ? Vec3(0, 1, 0) : Vec3(1, 0, 0));
+    u = u / length(u);
+    const Vec3 v = cross(w, u);
+    for (int i = 0; i < n; ++i) {
+        const double a = 2 * kPi * i / n;
+        const auto p = image_point(camera, ring_centre + (u * std::cos(a) + v * std::sin(a)) * ring);
+        if (!p) return {};
+        out.push_back(*p);
+    }
+    return out;
+}
+
+Vec3 drag_offset(const CameraModel& camera, const Vec3& centre, double dx_pixels, double dy_pixels, int image_height,
+                 int axis) {
+    const double depth = std::max(1e-9, dot(centre - camera.position, camera.forward));
+    const double per_pixel = 2.0 * depth * camera.tan_half_fov / std::max(1, image_height);
+    Vec3 move = camera.right * (dx_pixels * per_pixel) - camera.up * (dy_pixels * per_pixel);
+    if (axis >= 0 && axis < 3) {
+        // Along one world axis: the part of the motion along it, scaled so a drag along the
+        // axis's image direction moves it as far as the pointer.
+        Vec3 unit(0, 0, 0);
+        (axis == 0 ? unit.x : axis == 1 ? unit.y : unit.z) = 1;
+        const Vec3 seen = camera.right * dot(unit, camera.right) + camera.up * dot(unit, camera.up);
+        const double s2 = dot(seen, seen);
+        move = s2 > 1e-12 ? unit * (dot(move, seen) / s2) : Vec3(0, 0, 0);
+    }
+    return move;
+}
+
+Shape& own_shape(Scene& scene, int primitive) {
+    Primitive& prim = scene.primitives[size_t(primitive)];
+    int users = 0;
+    for (const Primitive& p : scene.primitives) users += p.shape == prim.shape;
+    for (const Light& l : scene.lights) users += l.shape == prim.shape && prim.type != PrimitiveType::emissive;
+    if (users > 1) {
+        Shape copy = scene.shapes[size_t(prim.shape)];
+        copy.id = unused_id(scene.shapes, copy.id);
+        scene.shapes.push_back(copy);
+        prim.shape = int(scene.shapes.size()) - 1;
+    }
+    return scene.shapes[size_t(prim.shape)];
+}
+
+int duplicate_primitive(Scene& scene, int p, const Vec3& offset) {
+    Primitive copy = scene.primitives[size_t(p)];
+    Shape shape = scene.shapes[size_t(copy.shape)];
+    shape.id = unused_id(scene.shapes, shape.id);
+    shape.centre += offset;
+    scene.shapes.push_back(shape);
+    copy.shape = int(scene.shapes.size()) - 1;
+    copy.id = unused_id(scene.primitives, copy.id);
+    if (copy.type == PrimitiveType::emissive && copy.light >= 0) {
+        // Its own light, on, over the new shape.
+        Light light = scene.lights[size_t(copy.light)];
+        light.id = unused_id(scene.lights, light.id);
+        light.shape = copy.shape;
+        scene.lights.push_back(light);
+        copy.light = int(scene.lights.size()) - 1;
+        set_light_on(scene, copy.light, true);
+    }
+    scene.primitives.push_back(copy);
+    return int(scene.primitives.size()) - 1;
+}
+
+void delete_primitive(Scene& scene, int p) {
+    const Primitive prim = scene.primitives[size_t(p)];
+    scene.primitives.erase(scene.primitives.begin() + p);
+    if (prim.type == PrimitiveType::emissive && prim.light >= 0) set_light_on(scene, prim.light, false);
+}
+
+int add_sphere(Scene& scene, const Vec3& centre, double radius) {
+    int material = -1;
+    for (size_t i = 0; i < scene.materials.size() && material < 0; ++i)
+        if (scene.materials[i].type == MaterialType::diffuse) material = int(i);
+    if (material < 0) {
+        Material grey;
+        grey.id = unused_id(scene.materials, "grey diffuse");
+        scene.materials.push_back(grey);
+        material = int(scene.materials.size()) - 1;
+    }
+    Shape shape;
+    shape.id = unused_id(scene.shapes, "sphere");
+    shape.centre = centre;
+    shape.radius = radius;
+    scene.shapes.push_back(shape);
+    Primitive prim;
+    prim.id = unused_id(scene.primitives, shape.id);
+    prim.shape = int(scene.shapes.size()) - 1;
+    prim.material = material;
+    scene.primitives.push_back(prim);
+    return int(scene.primitives.size()) - 1;
+}
+
+void new_material_for(Scene& scene, int p) {
+    Primitive& prim = scene.primitives[size_t(p)];
+    Material copy = prim.material >= 0 ? scene.materials[size_t(prim.material)] : Material{};
+    copy.id = unused_id(scene.materials, prim.material >= 0 ? copy.id : std::string("material"));
+    scene.materials.push_back(copy);
+    prim.material = int(scene.materials.size()) - 1;
+}
+
+void set_emissive(Scene& scene, int p, bool emissive, const Color& power) {
+    Primitive& prim = scene.primitives[size_t(p)];
+    if (emissive == (prim.type == PrimitiveType::emissive)) return;
+    if (!emissive) {
+        if (prim.light >= 0) set_light_on(scene, prim.light, false);
+        prim.type = PrimitiveType::geometric;
+        prim.light = -1;
+        return;
+    }
+    own_shape(scene, p);
+    Light light;
+    light.id = unused_id(scene.lights, prim.id + " light");
+    light.type = LightType::area;
+    light.power = power;
+    light.shape = prim.shape;
+    scene.lights.push_back(light);
+    prim.type = PrimitiveType::emissive;
+    prim.light = int(scene.lights.size()) - 1;
+    set_light_on(scene, prim.light, true);
+}
+
+}  // namespace kr::viewer
