@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -256,4 +257,115 @@ TEST_F(CheckpointCli, FlagsAreChecked) {
     const test::CommandResult missing = cli_here("render '" + scene.string() + "' -q --resume nowhere.ckpt");
     EXPECT_EQ(missing.status, 1);
     EXPECT_NE(missing.err.find("nowhere.ckpt"), std::string::npos) << missing.err;
+}
+
+namespace {
+
+// keithray started in `dir` with KEITHRAY_TEST_STOP_BEFORE_RENAME=`hook` (core/file_write.cpp):
+// it stops itself inside the chosen write, every temporary whole and none renamed. Returns
+// the child, stopped there (or -1 if it ended first, `status` then holds how).
+pid_t start_stopped_in_write(const fs::path& dir, const std::string& args, const std::string& hook, int& status) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::setenv("KEITHRAY_TEST_STOP_BEFORE_RENAME", hook.c_str(), 1);
+        ::signal(SIGINT, SIG_DFL);  // whatever the test runner's dispositions
+        ::signal(SIGTERM, SIG_DFL);
+        const std::string cmd = "cd '" + dir.string() + "' && exec '" + std::string(KEITHRAY_EXE) + "' " + args +
+                                " >out.txt 2>err.txt";
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    if (::waitpid(child, &status, WUNTRACED) != child || !WIFSTOPPED(status)) return -1;
+    return child;
+}
+
+// Sends `signals` to the stopped child, lets it go on and returns its status.
+int signal_and_wait(pid_t child, std::initializer_list<int> signals) {
+    for (int sig : signals) ::kill(child, sig);
+    ::kill(child, SIGCONT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    return status;
+}
+
+bool has_temporary(const fs::path& dir) {
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.path().filename().string().find(".tmp") != std::string::npos) return true;
+    return false;
+}
+
+}  // namespace
+
+// A signal while a checkpoint is being written: the write completes (the new checkpoint is
+// whole), the render stops as documented (exit 128 + signal, no image, "holds them") with no
+// "checkpoint not written" warning, and --resume finishes the uninterrupted render's bytes.
+TEST_F(CheckpointCli, SignalDuringACheckpointWriteKeepsItWholeAndStops) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.ppm").status, 0);
+    for (int sig : {SIGTERM, SIGINT}) {
+        fs::remove(dir / "r.ckpt");
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "r.ckpt:2", status);
+        ASSERT_GT(child, 0) << "ended before its second checkpoint: " << status << test::read_file(dir / "err.txt");
+        status = signal_and_wait(child, {sig});
+        const std::string err = test::read_file(dir / "err.txt");
+        ASSERT_TRUE(WIFEXITED(status)) << status << err;
+        EXPECT_EQ(WEXITSTATUS(status), 128 + sig) << err;
+        EXPECT_NE(err.find("stopped by a signal"), std::string::npos) << err;
+        EXPECT_NE(err.find("holds them (go on with --resume)"), std::string::npos) << err;
+        EXPECT_EQ(err.find("not written"), std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(dir / "cut.ppm"));
+        EXPECT_FALSE(has_temporary(dir));
+        const test::CommandResult resumed = cli_here(common + "-o cut.ppm --resume r.ckpt");
+        ASSERT_EQ(resumed.status, 0) << resumed.err;
+        EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
+        fs::remove(dir / "cut.ppm");
+        fs::remove(dir / "cut-depth.ppm");
+    }
+}
+
+// A second signal during that write ends the run at once: the temporary is removed and the
+// previous checkpoint stays whole (it resumes to the same bytes).
+TEST_F(CheckpointCli, SecondSignalDuringACheckpointWriteLeavesTheOldOneWhole) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.ppm").status, 0);
+    int status = 0;
+    const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "r.ckpt:3", status);
+    ASSERT_GT(child, 0) << status;
+    const std::string old = test::read_file(dir / "r.ckpt");
+    status = signal_and_wait(child, {SIGINT, SIGTERM});
+    EXPECT_TRUE(WIFSIGNALED(status)) << status;
+    EXPECT_FALSE(has_temporary(dir));
+    EXPECT_EQ(test::read_file(dir / "r.ckpt"), old);
+    EXPECT_FALSE(fs::exists(dir / "cut.ppm"));
+    const test::CommandResult resumed = cli_here(common + "-o cut.ppm --resume r.ckpt");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
+}
+
+// The image is written after checkpoints were: a signal inside that write still finds the
+// cleanup handler (the render's stop handling ended with its passes): no temporary, the old
+// image untouched, the checkpoint whole, the process ended by the signal.
+TEST_F(CheckpointCli, SignalDuringTheImageWriteAfterCheckpointsLeavesNoTemporary) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 4 -q --threads 1 ";
+    for (int sig : {SIGTERM, SIGINT}) {
+        fs::remove(dir / "r.ckpt");
+        {
+            std::ofstream old(dir / "cut.ppm");
+            old << "old";
+        }
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "cut.ppm:1", status);
+        ASSERT_GT(child, 0) << status;
+        status = signal_and_wait(child, {sig});
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status << test::read_file(dir / "err.txt");
+        EXPECT_FALSE(has_temporary(dir));
+        EXPECT_EQ(test::read_file(dir / "cut.ppm"), "old");
+        EXPECT_FALSE(fs::exists(dir / "cut-depth.ppm"));
+        const test::CommandResult resumed = cli_here(common + "-o done.ppm --resume r.ckpt");
+        EXPECT_EQ(resumed.status, 0) << resumed.err;
+    }
 }

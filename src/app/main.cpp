@@ -170,10 +170,6 @@ bool out_of_memory(const std::exception& e) {
     return dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e);
 }
 
-// The signal (SIGINT, SIGTERM) that asked a checkpointed render to stop, else 0.
-volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
-
 // Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
 // why where it could not be written; the previous checkpoint then stays as it was.
 bool write_checkpoint(const Cluster& cluster, const fs::path& path, const CheckpointKey& key, RenderState& state) {
@@ -221,31 +217,6 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
                 costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
                 costs.front().exchanges, between);
 }
-
-// A checkpointed render's SIGINT and SIGTERM handlers while it runs: they end the pass under
-// way, the checkpoint is written and the render stops. The previous handlers come back after.
-class StopSignals {
-public:
-    explicit StopSignals(bool install) : installed_(install) {
-        if (!installed_) return;
-        struct sigaction stop {};
-        stop.sa_handler = on_stop_signal;
-        sigemptyset(&stop.sa_mask);
-        ::sigaction(SIGINT, &stop, &previous_int_);
-        ::sigaction(SIGTERM, &stop, &previous_term_);
-    }
-    ~StopSignals() {
-        if (!installed_) return;
-        ::sigaction(SIGINT, &previous_int_, nullptr);
-        ::sigaction(SIGTERM, &previous_term_, nullptr);
-    }
-    StopSignals(const StopSignals&) = delete;
-    StopSignals& operator=(const StopSignals&) = delete;
-
-private:
-    bool installed_;
-    struct sigaction previous_int_ {}, previous_term_ {};
-};
 
 // One scene's render, in the order its steps run: load, check the outputs, check the memory,
 // resume, render with checkpoints, gather and report, write. Each step that fails prints why
@@ -402,18 +373,21 @@ private:
     }
 
     // The passes, with the checkpoints, the stop signals and the progress bar between them.
+    // With a checkpoint, SIGINT and SIGTERM during the passes end the pass under way, the
+    // checkpoint is written and the render stops without an image; once the passes are over a
+    // signal ends the run at once (the cleanup handler removes what was being written).
     StopReason render() {
         auto last_checkpoint = std::chrono::steady_clock::now();
         double last_draw = -1;
-        const StopSignals signals(opt_.checkpoint.has_value());
+        StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
         hooks_ = cluster_.deal_rows(open_ended_);
         stage_ = "rendering a " + image_;
-        return render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
+        StopReason reason = render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
             if (opt_.checkpoint) {
                 // One decision for every rank: rank 0's clock, any rank's signal.
                 const bool due = leader_ && std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                                           last_checkpoint).count() >= opt_.checkpoint_every;
-                const int flags = cluster_.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
+                const int flags = cluster_.any_flags((due ? 1 : 0) | (stop_signal() ? 2 : 0));
                 if (flags) {
                     checkpoint_written_ = write_checkpoint(cluster_, *opt_.checkpoint, key_, state_);
                     last_checkpoint = std::chrono::steady_clock::now();
@@ -434,6 +408,13 @@ private:
             }
             return true;
         }, hooks_.get());
+        // A signal after the last pass's check still stops the render, with its checkpoint.
+        stop_on_signal.release();
+        if (opt_.checkpoint && reason != StopReason::cancelled && cluster_.any_flags(stop_signal() ? 1 : 0)) {
+            checkpoint_written_ = write_checkpoint(cluster_, *opt_.checkpoint, key_, state_);
+            reason = StopReason::cancelled;
+        }
+        return reason;
     }
 
     // Every rank's costs, and the state gathered at rank 0 with the job's counts.
@@ -540,6 +521,7 @@ bool stdout_written() {
 }  // namespace
 
 int main(int argc, char** argv) {
+    install_signal_cleanup();  // one handler for every write of the run (core/file_write.h)
     const std::string command = argc > 1 ? argv[1] : "";
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(usage().c_str(), stdout);
@@ -621,10 +603,10 @@ int main(int argc, char** argv) {
             // The other ranks wait for this one in the next exchange: end the job.
             if (cluster.distributed()) cluster.abort(1);
         }
-        if (g_stop_signal) break;  // a checkpointed render stopped by a signal: no further scene
+        if (stop_signal()) break;  // a checkpointed render stopped by a signal: no further scene
     }
     // Every rank exits with the same status.
     ok = cluster.any_flags(!(stdout_written() && ok)) == 0;
-    if (g_stop_signal) return 128 + int(g_stop_signal);
+    if (stop_signal()) return 128 + stop_signal();
     return ok ? 0 : 1;
 }
