@@ -9,6 +9,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -167,6 +168,13 @@ TEST(Checkpoint, RefusesAnotherSceneSettingsSizeOrDamage) {
     StopRule noisier = rule;
     noisier.noise = 0.5;
     expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, noisier)), "noise=");
+    // The pass limit, an open-ended render's implicit cap included.
+    StopRule capped = rule;
+    capped.max_passes = 65536;
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, capped)), "passes=65536\" here");
+    StopRule timed = rule;
+    timed.seconds = 5;  // more or less time goes on to the same samples
+    EXPECT_EQ(refusal(bytes, checkpoint_key(authored, scene, settings, timed)), "(accepted)");
 
     Scene larger = authored;
     larger.renderer.width = 9;
@@ -368,4 +376,44 @@ TEST_F(CheckpointCli, SignalDuringTheImageWriteAfterCheckpointsLeavesNoTemporary
         const test::CommandResult resumed = cli_here(common + "-o done.ppm --resume r.ckpt");
         EXPECT_EQ(resumed.status, 0) << resumed.err;
     }
+}
+
+// An open-ended render (--time or --noise without --spp) runs up to the cap of 65536
+// passes: resumed plainly it would end at the scene's spp instead, another image. Refused,
+// naming the pass limit; resumed with its --noise it goes on.
+TEST_F(CheckpointCli, OpenEndedRenderResumedPlainlyIsRefused) {
+    const fs::path scene = small_scene(8);
+    const std::string common = "render '" + scene.string() + "' -q --threads 1 -o out.ppm ";
+    const test::CommandResult first = cli_here(common + "--noise 0.5 --checkpoint r.ckpt --every 0");
+    ASSERT_EQ(first.status, 0) << first.err;
+    const test::CommandResult refused = cli_here(common + "--resume r.ckpt");
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_NE(refused.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << refused.err;
+    // A --time render likewise (it may have stopped by its time or at the cap).
+    ASSERT_EQ(cli_here(common + "--time 0.2 --checkpoint t.ckpt --every 0").status, 0);
+    const test::CommandResult timed = cli_here(common + "--resume t.ckpt");
+    EXPECT_EQ(timed.status, 1);
+    EXPECT_NE(timed.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << timed.err;
+    const test::CommandResult again = cli_here(common + "--noise 0.5 --resume r.ckpt");
+    EXPECT_EQ(again.status, 0) << again.err;
+}
+
+// The checkpoint's target is checked before the render, like the images': a folder, a
+// device, a read-only file; one line, exit 1, nothing rendered or written.
+TEST_F(CheckpointCli, CheckpointTargetIsCheckedBeforeRendering) {
+    const fs::path scene = small_scene(8);
+    fs::create_directories(dir / "folder");
+    {
+        std::ofstream ro(dir / "ro.ckpt");
+        ro << "old";
+    }
+    fs::permissions(dir / "ro.ckpt", fs::perms::owner_read);
+    for (const std::string target : {"folder", "/dev/null", "ro.ckpt"}) {
+        const test::CommandResult r = cli_here("render scene.json -q -o out.ppm --spp 2 --checkpoint " + target);
+        EXPECT_EQ(r.status, 1) << target;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find("nothing rendered"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "out.ppm")) << target;
+    }
+    EXPECT_EQ(test::read_file(dir / "ro.ckpt"), "old");
 }

@@ -313,6 +313,16 @@ private:
                                  shown(*opt_.checkpoint).c_str(), shown(other).c_str());
                     overwrites_input = true;
                 }
+        // Every file written later (the images after the render, the checkpoint during it)
+        // checked now, as the writer would: not after hours of rendering.
+        if (leader_ && !overwrites_input) try {
+                std::vector<fs::path> targets = outputs;
+                if (opt_.checkpoint) targets.push_back(*opt_.checkpoint);
+                check_output_targets(targets);
+            } catch (const std::runtime_error& e) {
+                std::fprintf(stderr, "error: %s: %s; nothing rendered\n", file_.c_str(), e.what());
+                overwrites_input = true;
+            }
         return !cluster_.broadcast(overwrites_input);
     }
 
