@@ -39,7 +39,13 @@ HdrImage hdr_from_radiance(const Image& radiance) {
     out.height = radiance.height;
     out.rgb.resize(radiance.pixels.size() * 3);
     for (size_t i = 0; i < radiance.pixels.size(); ++i)
-        for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(radiance.pixels[i][k]);
+        for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = stored_float(radiance.pixels[i][k]);
+    return out;
+}
+
+std::vector<float> stored_floats(const std::vector<double>& values) {
+    std::vector<float> out(values.size());
+    for (size_t i = 0; i < values.size(); ++i) out[i] = stored_float(values[i]);
     return out;
 }
 

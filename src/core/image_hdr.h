@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,17 @@ struct HdrImage {
 // The largest image read or written: each side, and the pixel count (2^26, 768 MiB of RGB floats).
 inline constexpr int kMaxHdrSide = 1 << 16;
 inline constexpr size_t kMaxHdrPixels = size_t(1) << 26;
+
+// A double as the files' 32-bit float: a finite value beyond float's range is clamped to
+// its largest (a finite mean stays finite, so an image equals itself); an infinite value (an
+// unknown variance) or a NaN stays what it is.
+inline float stored_float(double v) {
+    constexpr double kMax = std::numeric_limits<float>::max();
+    return static_cast<float>(v > kMax && v <= std::numeric_limits<double>::max() ? kMax
+                              : v < -kMax && v >= -std::numeric_limits<double>::max() ? -kMax
+                                                                                        : v);
+}
+std::vector<float> stored_floats(const std::vector<double>& values);
 
 // The HDR image of `radiance` alone (no other layer).
 HdrImage hdr_from_radiance(const Image& radiance);

@@ -71,7 +71,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 add_compensated(sum.x, lost.x, r.radiance.x);
                 add_compensated(sum.y, lost.y, r.radiance.y);
                 add_compensated(sum.z, lost.z, r.radiance.z);
-                px.depth_sum[pixel] += std::min(r.primary_distance, kMissDepth);
+                px.depth_sum[pixel] += r.primary_distance;  // kMissDepth for a miss; a farther hit stays farther
                 const double lum = luminance(r.radiance);
                 px.luminance_sq_sum[pixel] += lum * lum;
                 px.radiance_sq_sum[pixel] += r.radiance * r.radiance;
