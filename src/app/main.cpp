@@ -145,21 +145,6 @@ Options parse_options(int argc, char** argv) {
     return o;
 }
 
-// Whether writing path `a` would replace the existing file `b`: the same file under another
-// name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
-// through a folder x that does not exist yet (the writer would create it).
-bool same_file(const fs::path& a, const fs::path& b) {
-    std::error_code ec;
-    if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
-    auto resolved = [](const fs::path& p) {
-        std::error_code e;
-        const fs::path absolute = fs::absolute(p, e);
-        const fs::path canonical = fs::weakly_canonical(absolute, e);
-        return e ? absolute.lexically_normal() : canonical;
-    };
-    return resolved(a) == resolved(b);
-}
-
 // A file path in a message: as it is, or quoted and escaped when it holds control
 // characters, bytes that are not UTF-8 or too many of them (core/text.h).
 std::string shown(const fs::path& path) { return show_user_text(path.string()); }
@@ -331,15 +316,12 @@ private:
     bool check_memory() {
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
-        const uint64_t needed = render_memory_bytes(width, height, opt_.blur > 0);
-        const MemoryLimit limit = memory_limit();
-        if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
-            std::fprintf(stderr,
-                         "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)%s\n",
-                         file_.c_str(), image_.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
-                         format_bytes(limit.bytes).c_str(),
+        const std::string shortfall =
+            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0), "the render of a " + image_);
+        if (!shortfall.empty())  // every rank holds the whole state: each checks its own machine
+            std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
                          cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
-        if (cluster_.any_flags(needed > limit.bytes)) return false;
+        if (cluster_.any_flags(!shortfall.empty())) return false;
         stage_ = "the render state of a " + image_;
         state_.reset(width, height);
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
@@ -558,7 +540,10 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (command == "view") return viewer::run_viewer(argc, argv);
+    if (command == "view") {
+        const int status = viewer::run_viewer(argc, argv);
+        return stdout_written() ? status : 1;
+    }
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
                      command.empty() ? "" : quote_user_text(command, 40).c_str(), usage().c_str());

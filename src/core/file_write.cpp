@@ -288,6 +288,18 @@ void check_output_targets(const std::vector<fs::path>& paths) {
     for (const fs::path& path : paths) check_target(path);
 }
 
+bool same_file(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
+    auto resolved = [](const fs::path& p) {
+        std::error_code e;
+        const fs::path absolute = fs::absolute(p, e);
+        const fs::path canonical = fs::weakly_canonical(absolute, e);
+        return e ? absolute.lexically_normal() : canonical;
+    };
+    return resolved(a) == resolved(b);
+}
+
 std::string quoted_path(const fs::path& path) {
     const std::string& text = path.native();
     constexpr size_t kHead = 60, kTail = 140;

@@ -74,6 +74,12 @@ int stop_signal();
 // after a long render (the images, a checkpoint). Throws std::runtime_error as it does.
 void check_output_targets(const std::vector<std::filesystem::path>& paths);
 
+// Whether writing path `a` would replace the existing file `b`: the same file under another
+// name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
+// through a folder x that does not exist yet (the writer would create it). Only stats files:
+// it never opens one (a FIFO does not block it).
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+
 // A path for a message: quoted, control bytes escaped, at most about 200 bytes shown.
 std::string quoted_path(const std::filesystem::path& path);
 
