@@ -13,6 +13,7 @@
 
 #include "core/image_hdr.h"
 #include "core/image_io.h"
+#include "robustness_util.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -33,15 +34,7 @@ protected:
     }
     fs::path scene_file() {
         const fs::path file = dir / "scene.json";
-        std::ofstream(file) << R"({
-  "cameras": [{"id": "cam", "type": "pinhole", "fov": 45, "aspect": 1, "position": [0, 0, -5], "target": [0, 0, 0]}],
-  "materials": [{"id": "white", "type": "diffuse", "rho": [0.8, 0.8, 0.8]}],
-  "shapes": [{"id": "ball", "type": "sphere", "centre": [0, 0, 0], "radius": 1}],
-  "lights": [{"id": "lamp", "type": "point", "position": [0, 3, -3], "power": [50, 50, 50]}],
-  "scene": {"camera": "cam", "lights": ["lamp"],
-    "primitives": [{"id": "ball", "type": "geometric", "shape": "ball", "material": "white"}],
-    "renderer": {"type": "WRT", "dimensions": [8, 8], "samples": 1, "depth": 2, "output": "out.ppm"}}
-})";
+        std::ofstream(file) << robust::scene_json("out.ppm", "[8, 8]");
         return file;
     }
 };

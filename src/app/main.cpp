@@ -75,7 +75,8 @@ constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map t
                         the radiance and OUT-depth.pfm the distances as float PFMs
   --checkpoint FILE     write the render state to FILE (atomically) at most every
                         --every seconds and on SIGINT/SIGTERM, which then end the
-                        render without an image (only with a single scene)
+                        render without an image (a second signal ends it at once;
+                        only with a single scene)
   --every SECONDS       seconds between checkpoints, 0..1e6 (default: 60; 0: every pass)
   --resume FILE         go on from checkpoint FILE: the image is byte for byte the one
                         of an uninterrupted render; refused for another scene, other
