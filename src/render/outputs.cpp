@@ -14,7 +14,7 @@ namespace {
 std::vector<float> floats(const std::vector<Color>& values) {
     std::vector<float> out(3 * values.size());
     for (size_t i = 0; i < values.size(); ++i)
-        for (int k = 0; k < 3; ++k) out[3 * i + size_t(k)] = float(values[i][k]);
+        for (int k = 0; k < 3; ++k) out[3 * i + size_t(k)] = stored_float(values[i][k]);
     return out;
 }
 
@@ -54,7 +54,7 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
 
 HdrImage hdr_from_developed(Developed image) {
     HdrImage out = hdr_from_radiance(image.radiance);
-    out.depth.assign(image.depth.begin(), image.depth.end());
+    out.depth = stored_floats(image.depth);
     out.albedo = std::move(image.albedo);
     out.normal = std::move(image.normal);
     out.samples = std::move(image.samples);
@@ -85,7 +85,7 @@ std::vector<FileOutput> encode_outputs(const std::filesystem::path& path, Develo
         break;
     case ImageFormat::pfm:
         files.push_back({path, encode_pfm_rgb(hdr_from_radiance(image.radiance))});
-        files.push_back({depth_file, encode_pfm_gray(std::vector<float>(image.depth.begin(), image.depth.end()),
+        files.push_back({depth_file, encode_pfm_gray(stored_floats(image.depth),
                                                      width, height)});
         break;
     }

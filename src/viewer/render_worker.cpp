@@ -7,6 +7,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include "core/memory.h"
 #include "viewer/inspect.h"
 
 namespace kr::viewer {
@@ -101,6 +102,14 @@ void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
     if (on_publish_) on_publish_();
 }
 
+void RenderWorker::publish_error(uint64_t generation, std::string error) {
+    auto frame = std::make_shared<Snapshot>();
+    frame->generation = generation;
+    frame->finished = true;
+    frame->error = std::move(error);
+    publish(std::move(frame));
+}
+
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -131,7 +140,23 @@ void RenderWorker::run() {
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
-                state.reset(w, h);
+                // The estimate render applies, before allocating (render_state.h).
+                const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
+                if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false), "the render of a " + image);
+                    !shortfall.empty()) {
+                    driver.reset();
+                    lock.unlock();
+                    publish_error(job.generation, std::move(shortfall));
+                    continue;
+                }
+                try {
+                    state.reset(w, h);
+                } catch (const std::bad_alloc&) {
+                    driver.reset();
+                    lock.unlock();
+                    publish_error(job.generation, "not enough memory for the render state of a " + image);
+                    continue;
+                }
                 driver.emplace(*job.scene, job.settings, state, rule_);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
@@ -144,6 +169,9 @@ void RenderWorker::run() {
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
         const auto start = Clock::now();
         auto frame = std::make_shared<Snapshot>();
+        // An allocation that fails here (a preview, a pass's buffers, the frame's copies) is
+        // the window's error, not an abort of the viewer; the job is dropped.
+        try {
         if (next_preview < previews.size()) {
             const int scale = previews[next_preview];
             RenderState preview(scaled(w, scale), scaled(h, scale));
@@ -169,6 +197,12 @@ void RenderWorker::run() {
         frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
         frame->nonfinite_samples = state.nonfinite_samples;
         if (frame->scale == 1) record_pixel_statistics(state, *frame);
+        } catch (const std::bad_alloc&) {
+            driver.reset();
+            publish_error(job.generation, "not enough memory for rendering a " + std::to_string(w) + "x" +
+                                              std::to_string(h) + " image");
+            continue;
+        }
         {
             std::lock_guard lock(mutex_);
             frame->max_passes = rule_.max_passes;

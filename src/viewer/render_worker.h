@@ -52,6 +52,9 @@ struct Snapshot {
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished
+    // Not empty: the job could not be rendered (its state does not fit in memory); the frame
+    // has no image and the worker waits for the next job.
+    std::string error;
 };
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
@@ -90,6 +93,7 @@ public:
 private:
     void run();
     void publish(std::shared_ptr<Snapshot> frame);
+    void publish_error(uint64_t generation, std::string error);  // a frame with only the error
 
     std::function<void()> on_publish_;
     mutable std::mutex mutex_;

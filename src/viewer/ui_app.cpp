@@ -147,6 +147,15 @@ bool ViewerApp::fetch_frame() {
     ui_.shown_serial = frame->serial;
     // A frame of an older generation shows an image the user already changed.
     if (frame->generation != model_.generation()) return false;
+    if (!frame->error.empty()) {  // the render could not go on (memory): the window says so
+        messages_.show_error(frame->error);
+        if (options_.scripted()) {  // its passes will never come
+            std::fprintf(stderr, "error: %s: %s\n", options_.scene.string().c_str(), frame->error.c_str());
+            failed_ = true;
+            glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        }
+        return false;
+    }
     display_->upload(frame->radiance);
     ui_.shown = std::move(frame);
     return true;
@@ -251,12 +260,15 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0));
-    if (line == status_line_) return;
+    if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
         status_line_ = line;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        // Said once; a script waiting on the file would wait in vain, so a scripted run ends.
+        std::fprintf(stderr, "error: --status-file: %s\n", e.what());
+        failed_ = status_file_failed_ = true;
+        if (options_.scripted()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
     }
 }
 
@@ -392,7 +404,7 @@ int ViewerApp::run() {
         }
         glfwPollEvents();
     }
-    return script_.status();
+    return failed_ ? 1 : script_.status();
 }
 
 }  // namespace kr::viewer

@@ -73,6 +73,8 @@ private:
     int windowed_x_ = 0, windowed_y_ = 0, windowed_w_ = 0, windowed_h_ = 0;
     std::string title_;
     std::string status_line_;  // last written to --status-file
+    bool failed_ = false;              // a write of --status-file or a render failed: the run exits 1
+    bool status_file_failed_ = false;  // said once, not tried again
     bool quit_asked_ = false;  // the quit question is wanted
     uint64_t inside_checked_generation_ = 0;  // ui_.inside_sphere is this generation's
     int settle_frames_ = 0;   // frames still to draw after input, so ImGui settles
