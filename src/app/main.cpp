@@ -350,7 +350,7 @@ private:
     bool check_memory() {
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
-        const uint64_t needed = render_memory_bytes(width, height, opt_.blur > 0);
+        const uint64_t needed = render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off);
         const MemoryLimit limit = memory_limit();
         if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
             std::fprintf(stderr,
@@ -364,6 +364,8 @@ private:
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }
+
+    Denoise denoise() const { return opt_.render.denoise.value_or(Denoise::off); }
 
     void set_stop_rule() {
         rule_ = render_stop_rule(opt_.render, settings_);
@@ -471,6 +473,8 @@ private:
             OutputRequest request;
             request.path = output_;
             request.develop.blur = opt_.blur;
+            request.develop.denoise = denoise();
+            request.develop.sampling = settings_;
             request.display = loaded_.scene.display;
             if (opt_.gl)
                 request.tone_map = [](const Image& radiance, const DisplaySettings& display) {
