@@ -154,6 +154,37 @@ Planes prepare(const DenoiseInput& in) {
     return p;
 }
 
+// One tap of an a-trous pass along a row: pixels [x0, x1) of the row at p, their taps at
+// p + off. Compiled for AVX2 too where GCC can dispatch on the CPU (twice the lanes).
+struct TapRow {
+    const float *lum, *z, *inv_l, *inv_z, *f[4], *c[3], *var;
+    float *sw, *sc[3], *sv;
+};
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float sigma_normal) {
+    const float *l = r.lum, *ql = r.lum + off, *z = r.z, *qz = r.z + off, *il = r.inv_l, *iz = r.inv_z;
+    const float *f0 = r.f[0], *f1 = r.f[1], *f2 = r.f[2], *f3 = r.f[3];
+    const float *q0 = f0 + off, *q1 = f1 + off, *q2 = f2 + off, *q3 = f3 + off;
+    const float *qr = r.c[0] + off, *qg = r.c[1] + off, *qb = r.c[2] + off, *qv = r.var + off;
+    float *aw = r.sw, *ar = r.sc[0], *ag = r.sc[1], *ab = r.sc[2], *av = r.sv;
+#pragma omp simd
+    for (int x = x0; x < x1; ++x) {
+        // The edge stops, summed in one exponent.
+        const float el = std::fabs(l[x] - ql[x]) * il[x];
+        const float ez = std::fabs(z[x] - qz[x]) * iz[x];
+        const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
+        const float en = sigma_normal * std::max(0.f, 1.f - fd);
+        const float wt = tap * fast_exp_neg(el + ez + en);
+        aw[x] += wt;
+        ar[x] += wt * qr[x];
+        ag[x] += wt * qg[x];
+        ab[x] += wt * qb[x];
+        av[x] += wt * wt * qv[x];
+    }
+}
+
 }  // namespace
 
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params) {
@@ -165,24 +196,29 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params) {
     std::vector<float> c2[3], var2(n), inv_l(n), inv_z(n), lum(n);
     for (auto& c : c2) c.resize(n);
     constexpr float kTap[3] = {0.25f, 0.5f, 0.25f};
-    for (int it = 0; it < params.iterations; ++it) {
-        const int step = 1 << it;
-        // Per pixel, the stops' scales for this pass: the luminance's by the prefiltered
-        // standard deviation, the depth's by the gradient over the step.
-        const std::vector<float> var_blur = blur3(w, h, p.var);
-        const long count = long(n);
-#pragma omp parallel for schedule(static)
-        for (long li = 0; li < count; ++li) {
-            const size_t i = size_t(li);
-            lum[i] = kLum[0] * p.c[0][i] + kLum[1] * p.c[1][i] + kLum[2] * p.c[2][i];
-            const float sd = std::sqrt(std::max(0.f, var_blur[i]));
-            inv_l[i] = params.sigma_luminance > 0 ? 1 / (params.sigma_luminance * sd + 1e-12f) : 0;
-            inv_z[i] = 1 / (params.sigma_depth * p.zgrad[i] * float(step) + 1e-3f * p.z[i] + 1e-9f);
-        }
+    const std::vector<float> var_blur = blur3(w, h, p.var);
+    // One team of threads for every pass (each loop ends at a barrier).
 #pragma omp parallel
-        {
-            const size_t row_len = size_t(w);
-            std::vector<float> sw(row_len), sr(row_len), sg(row_len), sb(row_len), sv(row_len);
+    {
+        const size_t row_len = size_t(w);
+        std::vector<float> sw(row_len), sr(row_len), sg(row_len), sb(row_len), sv(row_len);
+        for (int it = 0; it < params.iterations; ++it) {
+            const int step = 1 << it;
+            // Per pixel, the stops' scales for this pass: the luminance's by the standard
+            // deviation (the first pass's variance 3x3-prefiltered; later passes' is filtered
+            // already), the depth's by the gradient over the step.
+            const float* var = it == 0 ? var_blur.data() : p.var.data();
+            const float gate = params.sigma_luminance > 0 ? 1.f : 0.f, zscale = params.sigma_depth * float(step);
+            const float *c0 = p.c[0].data(), *c1 = p.c[1].data(), *cb = p.c[2].data(), *zg = p.zgrad.data(),
+                        *zz = p.z.data();
+            float *lo = lum.data(), *ilo = inv_l.data(), *izo = inv_z.data();
+#pragma omp for simd schedule(static)
+            for (long i = 0; i < long(n); ++i) {
+                lo[i] = kLum[0] * c0[i] + kLum[1] * c1[i] + kLum[2] * cb[i];
+                const float sd = std::sqrt(std::max(0.f, var[i]));
+                ilo[i] = gate / (params.sigma_luminance * sd + 1e-12f);
+                izo[i] = 1 / (zscale * zg[i] + 1e-3f * zz[i] + 1e-9f);
+            }
 #pragma omp for schedule(static)
             for (int y = 0; y < h; ++y) {
                 std::fill(sw.begin(), sw.end(), 0.f);
@@ -191,54 +227,44 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params) {
                 std::fill(sb.begin(), sb.end(), 0.f);
                 std::fill(sv.begin(), sv.end(), 0.f);
                 const size_t row = size_t(y) * size_t(w);
+                const TapRow r{lum.data() + row,
+                               p.z.data() + row,
+                               inv_l.data() + row,
+                               inv_z.data() + row,
+                               {p.f[0].data() + row, p.f[1].data() + row, p.f[2].data() + row, p.f[3].data() + row},
+                               {p.c[0].data() + row, p.c[1].data() + row, p.c[2].data() + row},
+                               p.var.data() + row,
+                               sw.data(),
+                               {sr.data(), sg.data(), sb.data()},
+                               sv.data()};
                 for (int ty = -1; ty <= 1; ++ty) {
                     const int yy = y + ty * step;
                     if (yy < 0 || yy >= h) continue;
                     for (int tx = -1; tx <= 1; ++tx) {
                         const int dx = tx * step;
                         // The tap's pixels within the image: x + dx in [0, w).
-                        const int x0 = std::max(0, -dx), x1 = std::min(w, w - dx);
-                        const float tap = kTap[tx + 1] * kTap[ty + 1];
-                        const float sn = params.sigma_normal;
-                        const ptrdiff_t off = (ptrdiff_t(yy) - y) * w + dx;
-                        const float *l = lum.data() + row, *ql = lum.data() + row + off;
-                        const float *z = p.z.data() + row, *qz = p.z.data() + row + off;
-                        const float *il = inv_l.data() + row, *iz = inv_z.data() + row;
-                        const float *f0 = p.f[0].data() + row, *f1 = p.f[1].data() + row, *f2 = p.f[2].data() + row,
-                                    *f3 = p.f[3].data() + row;
-                        const float *q0 = f0 + off, *q1 = f1 + off, *q2 = f2 + off, *q3 = f3 + off;
-                        const float *qr = p.c[0].data() + row + off, *qg = p.c[1].data() + row + off,
-                                    *qb = p.c[2].data() + row + off, *qv = p.var.data() + row + off;
-                        float *aw = sw.data(), *ar = sr.data(), *ag = sg.data(), *ab = sb.data(), *av = sv.data();
-#pragma omp simd
-                        for (int x = x0; x < x1; ++x) {
-                            // The edge stops, summed in one exponent.
-                            const float el = std::fabs(l[x] - ql[x]) * il[x];
-                            const float ez = std::fabs(z[x] - qz[x]) * iz[x];
-                            const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
-                            const float en = sn * std::max(0.f, 1.f - fd);
-                            const float wt = tap * fast_exp_neg(el + ez + en);
-                            aw[x] += wt;
-                            ar[x] += wt * qr[x];
-                            ag[x] += wt * qg[x];
-                            ab[x] += wt * qb[x];
-                            av[x] += wt * wt * qv[x];
-                        }
+                        add_tap(r, (ptrdiff_t(yy) - y) * w + dx, std::max(0, -dx), std::min(w, w - dx),
+                                kTap[tx + 1] * kTap[ty + 1], params.sigma_normal);
                     }
                 }
                 // The centre tap always counts, so the weights' sum is at least 1/4.
+                float *o0 = c2[0].data() + row, *o1 = c2[1].data() + row, *o2 = c2[2].data() + row,
+                      *ov = var2.data() + row;
 #pragma omp simd
-                for (int x = 0; x < w; ++x) {
-                    const float inv = 1 / sw[size_t(x)];
-                    c2[0][row + size_t(x)] = sr[size_t(x)] * inv;
-                    c2[1][row + size_t(x)] = sg[size_t(x)] * inv;
-                    c2[2][row + size_t(x)] = sb[size_t(x)] * inv;
-                    var2[row + size_t(x)] = sv[size_t(x)] * inv * inv;
+                for (size_t x = 0; x < row_len; ++x) {
+                    const float inv = 1 / sw[x];
+                    o0[x] = sr[x] * inv;
+                    o1[x] = sg[x] * inv;
+                    o2[x] = sb[x] * inv;
+                    ov[x] = sv[x] * inv * inv;
                 }
             }
+#pragma omp single
+            {
+                for (int k = 0; k < 3; ++k) std::swap(p.c[k], c2[k]);
+                std::swap(p.var, var2);
+            }
         }
-        for (int k = 0; k < 3; ++k) std::swap(p.c[k], c2[k]);
-        std::swap(p.var, var2);
     }
     // Remodulate, then fade towards the raw radiance as its relative standard error drops
     // (the 3x3-prefiltered raw variance against the filtered luminance).
