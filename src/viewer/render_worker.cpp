@@ -7,6 +7,7 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include "render/outputs.h"
 #include "viewer/inspect.h"
 
 namespace kr::viewer {
@@ -101,6 +102,27 @@ void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
     if (on_publish_) on_publish_();
 }
 
+namespace {
+
+// The denoised radiance of `state`, developed as `render --denoise` and Save develop it
+// (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
+// state between passes (empty: made here).
+Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
+                        std::vector<float>& normal) {
+    DevelopOptions options;
+    options.denoise = Denoise::on;
+    options.sampling = job.settings;
+    RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
+    estimates.albedo = std::move(albedo);
+    estimates.normal = std::move(normal);
+    Developed developed = develop(*job.scene, std::move(estimates), options, kLayerRadiance | kLayerAlbedo | kLayerNormal);
+    albedo = std::move(developed.albedo);
+    normal = std::move(developed.normal);
+    return std::move(developed.radiance);
+}
+
+}  // namespace
+
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -114,6 +136,7 @@ void RenderWorker::run() {
     size_t next_preview = 0;
     double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
+    std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
 
     for (;;) {
         StopRule rule;
@@ -132,6 +155,8 @@ void RenderWorker::run() {
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
                 state.reset(w, h);
+                albedo.clear();
+                normal.clear();
                 driver.emplace(*job.scene, job.settings, state, rule_);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
@@ -152,6 +177,10 @@ void RenderWorker::run() {
             ++next_preview;
             frame->scale = scale;
             frame->radiance = preview.radiance();
+            if (denoise_.load()) {
+                std::vector<float> preview_albedo, preview_normal;
+                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal);
+            }
         } else {
             // A pass stopped early is always an edit's: the next turn starts the new job.
             if (!driver->pass(rule, &stop_)) continue;
@@ -160,6 +189,7 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = state.radiance();
+            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal);
         }
         frame->generation = job.generation;
         frame->spp = state.passes;

@@ -45,6 +45,9 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
     OutputRequest request;
     request.path = path;
     request.display = model.settings().tone;
+    // The display's denoiser, as `render --denoise` develops it.
+    request.develop.denoise = model.settings().denoise != DenoiseView::off ? Denoise::on : Denoise::off;
+    request.develop.sampling = model.settings().render;
     write_files_atomic(output_files(*model.prepared(), std::move(estimates), request));
 }
 
