@@ -5,11 +5,14 @@
 #include <cmath>
 #include <random>
 
+#include "core/image_hdr.h"
 #include "render/aov.h"
 #include "render/denoise.h"
 #include "render/outputs.h"
+#include "render/options.h"
 #include "render/progressive.h"
 #include "test_util.h"
+#include "viewer/status.h"
 
 namespace kr {
 namespace {
@@ -304,6 +307,64 @@ TEST(Denoise, DepthOfFieldKeepsTheFocusBoundary) {
     const PathTraced r = path_traced(scene, 48, 4, 512);
     EXPECT_LT(r.denoised_mse, 0.5 * r.raw_mse) << r.raw_mse << " " << r.denoised_mse;
     EXPECT_LT(r.denoised_edge_mse, r.raw_edge_mse) << r.raw_edge_mse << " " << r.denoised_edge_mse;
+}
+
+TEST(Denoise, FlagTakesANameOrStandsAlone) {
+    auto read = [](std::vector<std::string> words) {
+        std::vector<char*> argv{const_cast<char*>("keithray"), const_cast<char*>("render")};
+        for (std::string& w : words) argv.push_back(w.data());
+        RenderOptions options;
+        std::vector<std::string> rest;
+        for (ArgCursor args(int(argv.size()), argv.data()); args.next();)
+            if (!read_shared_flag(args, options)) rest.push_back(args.arg());
+        return std::pair{options.denoise, rest};
+    };
+    EXPECT_EQ(read({"--denoise", "scene.json"}), (std::pair{std::optional{Denoise::on}, std::vector<std::string>{"scene.json"}}));
+    EXPECT_EQ(read({"--denoise"}).first, Denoise::on);
+    EXPECT_EQ(read({"--denoise", "off"}).first, Denoise::off);
+    EXPECT_EQ(read({"--denoise", "on", "a.json"}).second, std::vector<std::string>{"a.json"});
+    EXPECT_FALSE(read({"a.json"}).first.has_value());
+}
+
+TEST(Denoise, ExrKeepsTheRawRadianceAndTheFeatureBuffers) {
+    const Scene scene = test::brief_scene(3, 16);
+    const RenderScene rs = prepare_scene(scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    RenderState state(16, 16);
+    StopRule rule;
+    rule.max_passes = 2;
+    render_until(rs, settings, state, rule);
+    DevelopOptions options;
+    options.denoise = Denoise::on;
+    options.sampling = settings;
+    const Developed d = develop(rs, render_estimates(state, kAllLayers), options, kAllLayers);
+    const HdrImage read = decode_exr(encode_exr(hdr_from_developed(d)), "test.exr");
+    ASSERT_EQ(read.raw.size(), 3u * 256);
+    ASSERT_EQ(read.albedo.size(), 3u * 256);
+    const Image raw = state.radiance();
+    for (size_t i = 0; i < 256; ++i) {
+        EXPECT_FLOAT_EQ(read.raw[3 * i + 1], float(raw.pixels[i].y));
+        EXPECT_FLOAT_EQ(read.rgb[3 * i + 1], float(d.radiance.pixels[i].y));
+    }
+    // Without the denoiser nothing changes: no raw layer.
+    const Developed plain = develop(rs, render_estimates(state, kAllLayers), DevelopOptions{}, kAllLayers);
+    EXPECT_TRUE(hdr_from_developed(plain).raw.empty());
+}
+
+TEST(Denoise, ViewerShowsRawDenoisedOrSplit) {
+    viewer::Snapshot frame;
+    frame.radiance = Image(4, 2);
+    frame.denoised = Image(4, 2);
+    for (Color& c : frame.denoised.pixels) c = Color(1.0);
+    using viewer::DenoiseView;
+    EXPECT_EQ(viewer::shown_radiance(frame, DenoiseView::off).at(3, 1).x, 0.0);
+    EXPECT_EQ(viewer::shown_radiance(frame, DenoiseView::on).at(0, 0).x, 1.0);
+    const Image split = viewer::shown_radiance(frame, DenoiseView::split);
+    EXPECT_EQ(split.at(1, 1).x, 0.0);
+    EXPECT_EQ(split.at(2, 1).x, 1.0);
+    EXPECT_EQ(viewer::shown_word(frame, DenoiseView::split), "split");
+    frame.denoised = Image();  // a frame the worker did not denoise shows raw
+    EXPECT_EQ(viewer::shown_word(frame, DenoiseView::on), "raw");
 }
 
 }  // namespace
