@@ -83,7 +83,8 @@ const std::array kFlags{
     name_flag<denoise_names, &O::denoise>(
         "--denoise", "%r: the edge-avoiding a-trous filter on the image, guided by albedo, normal and depth "
                      "(biased: compare --statistical tests raw images; an .exr keeps the raw radiance as raw.R/G/B; "
-                     "docs/denoising.md); given alone: on (default: off for render, on for view's display)",
+                     "docs/denoising.md); given alone (last, or before a flag or a .json): on (default: off for render, on for "
+                     "view's display)",
         "on"),
 };
 
@@ -130,10 +131,11 @@ std::span<const SharedFlag> shared_flags() { return kFlags; }
 bool read_shared_flag(ArgCursor& args, RenderOptions& options) {
     for (const SharedFlag& flag : kFlags)
         if (args.arg() == flag.name) {
-            // A flag with a bare value takes the next argument only where it is one of its names.
-            const bool named = args.peek() && (" | " + flag.range_text() + " | ").find(
-                                                  " | " + std::string(args.peek()) + " | ") != std::string::npos;
-            flag.read(flag, flag.bare.empty() || named ? args.value() : std::string(flag.bare), options);
+            // A flag with a bare value stands alone before another flag or a scene file (.json).
+            const char* peek = args.peek();
+            const std::string next = peek ? peek : "";
+            const bool alone = !peek || next.starts_with('-') || (next.size() > 5 && next.ends_with(".json"));
+            flag.read(flag, flag.bare.empty() || !alone ? args.value() : std::string(flag.bare), options);
             return true;
         }
     return false;

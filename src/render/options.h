@@ -49,8 +49,8 @@ struct SharedFlag {
     std::string_view help;
     // Reads `text` (already checked against the range) into its member of `options`.
     void (*read)(const SharedFlag& flag, const std::string& text, RenderOptions& options) = nullptr;
-    // Name flags: the value of the flag given alone (the next argument not one of its names);
-    // empty: the flag needs a value.
+    // Name flags: the value of the flag given alone (last, or before another flag or a scene
+    // file); empty: the flag needs a value.
     std::string_view bare = {};
 
     // "1..16777216", "(0, 1000000]", "wrt | pt | pt-naive".
