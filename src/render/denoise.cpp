@@ -25,16 +25,7 @@ inline float fast_exp_neg(float x) {
     return y * y;
 }
 
-// One plane per channel and feature, so that a tap's loop along a row reads each contiguously.
-struct Planes {
-    int w = 0, h = 0;
-    std::vector<float> c[3];         // demodulated radiance
-    std::vector<float> var;          // variance of its luminance (of the mean)
-    std::vector<float> demod[3];     // albedo + floor
-    std::vector<float> f[4];         // unit feature: normal and coverage by nothing
-    std::vector<float> z, zgrad;     // depth and its local gradient (per pixel step)
-    std::vector<float> raw_var;      // variance of the raw radiance's luminance
-};
+using Planes = DenoiseWorkspace;
 
 // Where a pixel's variance is unknown (one sample): the luminance's variance over its 3x3
 // neighbourhood, the variance of one sample where the neighbours are alike.
@@ -61,8 +52,8 @@ void fill_unknown_variance(int w, int h, const std::vector<float>& lum, std::vec
 
 // 3x3 binomial blur of a plane (borders renormalised): SVGF's prefilter of the variance
 // before it scales the luminance stop.
-std::vector<float> blur3(int w, int h, const std::vector<float>& v) {
-    std::vector<float> out(v.size());
+void blur3(int w, int h, const std::vector<float>& v, std::vector<float>& out) {
+    out.resize(v.size());
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
 #pragma omp parallel for schedule(static)
     for (int y = 0; y < h; ++y)
@@ -78,12 +69,10 @@ std::vector<float> blur3(int w, int h, const std::vector<float>& v) {
                 }
             out[size_t(y) * size_t(w) + size_t(x)] = s / ws;
         }
-    return out;
 }
 
-Planes prepare(const DenoiseInput& in) {
+void prepare(const DenoiseInput& in, Planes& p) {
     const Image& rad = *in.radiance;
-    Planes p;
     p.w = rad.width;
     p.h = rad.height;
     const size_t n = rad.pixels.size();
@@ -98,7 +87,9 @@ Planes prepare(const DenoiseInput& in) {
     p.raw_var.resize(n);
     p.z.resize(n);
     p.zgrad.resize(n);
-    std::vector<float> lum(n), raw_lum(n);
+    std::vector<float>&lum = p.lum, &raw_lum = p.lum_raw;
+    lum.resize(n);
+    raw_lum.resize(n);
     const long count = long(n);
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < count; ++li) {
@@ -151,7 +142,6 @@ Planes prepare(const DenoiseInput& in) {
             if (!std::isfinite(gy)) gy = 0;
             p.zgrad[i] = gx + gy;
         }
-    return p;
 }
 
 // One tap of an a-trous pass along a row: pixels [x0, x1) of the row at p, their taps at
@@ -187,16 +177,19 @@ void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float si
 
 }  // namespace
 
-Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params) {
-    Planes p = prepare(input);
+Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, DenoiseWorkspace* workspace) {
+    DenoiseWorkspace local;
+    Planes& p = workspace ? *workspace : local;
+    prepare(input, p);
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
     Image out(w, h);
     if (n == 0) return out;
-    std::vector<float> c2[3], var2(n), inv_l(n), inv_z(n), lum(n);
-    for (auto& c : c2) c.resize(n);
+    std::vector<float>(&c2)[3] = p.c2;
+    std::vector<float>&var2 = p.var2, &inv_l = p.inv_l, &inv_z = p.inv_z, &lum = p.lum, &var_blur = p.var_blur;
+    for (auto* plane : {&c2[0], &c2[1], &c2[2], &var2, &inv_l, &inv_z, &lum}) plane->resize(n);
     constexpr float kTap[3] = {0.25f, 0.5f, 0.25f};
-    const std::vector<float> var_blur = blur3(w, h, p.var);
+    blur3(w, h, p.var, var_blur);
     // One team of threads for every pass (each loop ends at a barrier).
 #pragma omp parallel
     {
@@ -268,7 +261,8 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params) {
     }
     // Remodulate, then fade towards the raw radiance as its relative standard error drops
     // (the 3x3-prefiltered raw variance against the filtered luminance).
-    const std::vector<float> raw_var = blur3(w, h, p.raw_var);
+    std::vector<float>& raw_var = p.var_blur;
+    blur3(w, h, p.raw_var, raw_var);
     const float t2 = params.fade_error * params.fade_error;
     const Image& raw = *input.radiance;
     const long count = long(n);

@@ -43,7 +43,20 @@ struct AtrousParams {
 // then blended towards the raw radiance as a pixel's relative standard error drops, so a
 // converged image is left as it is. Parallel over rows (OpenMP); the inner loops run along
 // rows over planes of floats, which the compiler vectorises.
-Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {});
+// The filter's working planes, one per channel and feature so that a tap's loop along a row
+// reads each contiguously. A caller that denoises often (the viewer's render thread) keeps
+// one between calls: fresh memory's page faults cost about as much as the filter.
+struct DenoiseWorkspace {
+    int w = 0, h = 0;
+    std::vector<float> c[3], c2[3];  // demodulated radiance (and the next pass's)
+    std::vector<float> var, var2;    // variance of its luminance (of the mean)
+    std::vector<float> demod[3];     // albedo + floor
+    std::vector<float> f[4];         // unit feature: normal and coverage by nothing
+    std::vector<float> z, zgrad;     // depth and its local gradient (per pixel step)
+    std::vector<float> raw_var;      // variance of the raw radiance's luminance
+    std::vector<float> lum, lum_raw, inv_l, inv_z, var_blur;  // per-pass scratch
+};
+Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
 
 // Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
 inline constexpr uint64_t kDenoiseBytesPerPixel = 40 * sizeof(float) + sizeof(Color);

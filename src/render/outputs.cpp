@@ -57,7 +57,7 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
         input.albedo = estimates.albedo;
         input.normal = estimates.normal;
         input.depth = estimates.depth;
-        Image denoised = denoise_atrous(input);
+        Image denoised = denoise_atrous(input, {}, options.workspace);
         out.raw = std::exchange(out.radiance, std::move(denoised));
         // An output with first-surface layers keeps the feature buffers the denoiser read.
         if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);

@@ -45,6 +45,8 @@ struct DevelopOptions {
     Denoise denoise = Denoise::off;
     // The render's settings: the feature buffers' camera samples are drawn as its are.
     RenderSettings sampling;
+    // The denoiser's planes, where the caller keeps them between develops (the viewer).
+    DenoiseWorkspace* workspace = nullptr;
 };
 // The feature buffers' camera samples per pixel (render/aov.h averaged_surface_layers).
 inline constexpr int kFeatureSamples = 8;

@@ -108,8 +108,9 @@ namespace {
 // (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
 // state between passes (empty: made here).
 Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
-                        std::vector<float>& normal) {
+                        std::vector<float>& normal, DenoiseWorkspace& workspace) {
     DevelopOptions options;
+    options.workspace = &workspace;
     options.denoise = Denoise::on;
     options.sampling = job.settings;
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
@@ -137,6 +138,7 @@ void RenderWorker::run() {
     double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
     std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
+    DenoiseWorkspace denoise_planes;    // kept between frames
 
     for (;;) {
         StopRule rule;
@@ -179,7 +181,7 @@ void RenderWorker::run() {
             frame->radiance = preview.radiance();
             if (denoise_.load()) {
                 std::vector<float> preview_albedo, preview_normal;
-                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal);
+                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal, denoise_planes);
             }
         } else {
             // A pass stopped early is always an edit's: the next turn starts the new job.
@@ -189,7 +191,7 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = state.radiance();
-            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal);
+            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
         }
         frame->generation = job.generation;
         frame->spp = state.passes;
