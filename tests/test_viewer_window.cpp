@@ -122,7 +122,8 @@ TEST_F(ViewerWindow, ScriptedEditsScreenshotMatchesHeadlessRender) {
 TEST_F(ViewerWindow, SaveImageWritesWhatRenderWritesForTheSameName) {
     for (const std::string ext : {"ppm", "png", "exr", "pfm"}) {
         const fs::path saved = dir / ("saved." + ext), rendered = dir / ("rendered." + ext);
-        const std::string flags = " --spp 2 --seed 5 --exposure 0.5";
+        // The viewer's Save develops as its display: denoised by default, as render --denoise.
+        const std::string flags = " --spp 2 --seed 5 --exposure 0.5 --denoise on";
         const ViewRun v = keithray("view '" + scene(6) + "'" + flags + " --save-image '" + saved.string() +
                                        "' --timeout 300",
                                    true);

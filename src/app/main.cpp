@@ -318,7 +318,7 @@ private:
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
         const std::string shortfall =
-            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0), "the render of a " + image_);
+            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off), "the render of a " + image_);
         if (!shortfall.empty())  // every rank holds the whole state: each checks its own machine
             std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
                          cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
@@ -328,6 +328,8 @@ private:
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }
+
+    Denoise denoise() const { return opt_.render.denoise.value_or(Denoise::off); }
 
     void set_stop_rule() {
         rule_ = render_stop_rule(opt_.render, settings_);
@@ -445,6 +447,8 @@ private:
             OutputRequest request;
             request.path = output_;
             request.develop.blur = opt_.blur;
+            request.develop.denoise = denoise();
+            request.develop.sampling = settings_;
             request.display = loaded_.scene.display;
             if (opt_.gl)
                 request.tone_map = [](const Image& radiance, const DisplaySettings& display) {

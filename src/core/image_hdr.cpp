@@ -81,6 +81,7 @@ void check_image(const HdrImage& image) {
     check_layer_size(image.normal.size(), 3 * n, "normal");
     check_layer_size(image.samples.size(), n, "samples");
     check_layer_size(image.variance.size(), 3 * n, "variance");
+    check_layer_size(image.raw.size(), 3 * n, "raw");
 }
 
 // OpenEXR's output stream into a string in memory (the file is then written atomically).
@@ -121,9 +122,10 @@ private:
 };
 
 // The layers of the EXR file, their names for messages and their channels per pixel.
-enum class ExrLayer { radiance, depth, albedo, normal, samples, variance };
-constexpr EnumNames<ExrLayer, 6> exr_layer_names{{"radiance", "depth", "albedo", "normal", "samples", "variance"}};
-constexpr std::array<int, 6> kLayerChannels{3, 1, 3, 3, 1, 3};
+enum class ExrLayer { radiance, depth, albedo, normal, samples, variance, raw };
+constexpr EnumNames<ExrLayer, 7> exr_layer_names{
+    {"radiance", "depth", "albedo", "normal", "samples", "variance", "raw"}};
+constexpr std::array<int, 7> kLayerChannels{3, 1, 3, 3, 1, 3, 3};
 int channels_of(ExrLayer layer) { return kLayerChannels[size_t(layer)]; }
 
 // Each EXR channel: its name, its layer and its place within the layer's pixel.
@@ -132,7 +134,7 @@ struct ExrChannel {
     ExrLayer layer;
     int offset;
 };
-constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", ExrLayer::radiance, 0},
+constexpr std::array<ExrChannel, 17> kExrChannels{{{"R", ExrLayer::radiance, 0},
                                                    {"G", ExrLayer::radiance, 1},
                                                    {"B", ExrLayer::radiance, 2},
                                                    {"depth.Z", ExrLayer::depth, 0},
@@ -145,7 +147,10 @@ constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", ExrLayer::radiance, 0},
                                                    {"samples", ExrLayer::samples, 0},
                                                    {"variance.R", ExrLayer::variance, 0},
                                                    {"variance.G", ExrLayer::variance, 1},
-                                                   {"variance.B", ExrLayer::variance, 2}}};
+                                                   {"variance.B", ExrLayer::variance, 2},
+                                                   {"raw.R", ExrLayer::raw, 0},
+                                                   {"raw.G", ExrLayer::raw, 1},
+                                                   {"raw.B", ExrLayer::raw, 2}}};
 
 // The vector holding a float layer (samples, the one 32-bit unsigned layer, has none).
 std::vector<float>* float_layer(HdrImage& image, ExrLayer layer) {
@@ -155,6 +160,7 @@ std::vector<float>* float_layer(HdrImage& image, ExrLayer layer) {
         case ExrLayer::albedo: return &image.albedo;
         case ExrLayer::normal: return &image.normal;
         case ExrLayer::variance: return &image.variance;
+        case ExrLayer::raw: return &image.raw;
         case ExrLayer::samples: return nullptr;
     }
     return nullptr;
@@ -175,7 +181,8 @@ std::string encode_exr(const HdrImage& image) {
     header.compression() = Imf::ZIP_COMPRESSION;
     Imf::addComments(header, "keithray render: mean radiance in R,G,B; depth.Z is the primary hit distance "
                              "(1e6 where the ray missed); albedo and normal of the first non-specular hit; "
-                             "samples per pixel; variance of the mean per channel");
+                             "samples per pixel; variance of the mean per channel" +
+                                 std::string(image.raw.empty() ? "" : "; R,G,B denoised, raw.R/G/B before"));
     Imf::FrameBuffer frame;
     const size_t width = size_t(image.width);
     for (const ExrChannel& ch : kExrChannels) {
@@ -232,7 +239,7 @@ HdrImage decode_exr(const std::string& bytes, const std::string& name) {
         out.height = int(h);
         const size_t n = out.pixel_count();
         const Imf::ChannelList& channels = file.header().channels();
-        std::array<int, 6> found{};  // channels present per layer
+        std::array<int, 7> found{};  // channels present per layer
         for (const ExrChannel& ch : kExrChannels)
             if (channels.findChannel(ch.name)) ++found[size_t(ch.layer)];
         if (found[size_t(ExrLayer::radiance)] != 3) fail(name, "expected the channels R, G and B of an RGB radiance image");

@@ -22,6 +22,7 @@ struct HdrImage {
     std::vector<float> normal;        // 3 per pixel: its unit normal facing the ray, world space
     std::vector<uint32_t> samples;    // samples accumulated per pixel
     std::vector<float> variance;      // 3 per pixel: variance of the mean radiance (inf: < 2 samples)
+    std::vector<float> raw;           // 3 per pixel: the radiance before denoising (rgb is denoised)
 
     size_t pixel_count() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
     Image radiance() const;  // rgb as an Image of doubles
@@ -46,7 +47,7 @@ std::vector<float> stored_floats(const std::vector<double>& values);
 HdrImage hdr_from_radiance(const Image& radiance);
 
 // OpenEXR bytes: R, G, B (32-bit float, ZIP compressed), then every present layer:
-// depth.Z, albedo.R/G/B, normal.X/Y/Z, samples (32-bit unsigned), variance.R/G/B.
+// depth.Z, albedo.R/G/B, normal.X/Y/Z, samples (32-bit unsigned), variance.R/G/B, raw.R/G/B.
 // Throws std::invalid_argument if a layer's size does not match the image.
 std::string encode_exr(const HdrImage& image);
 // Decodes an OpenEXR file's bytes; `name` (the file) starts every error. Needs R, G and B;

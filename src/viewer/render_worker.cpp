@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include "core/memory.h"
+#include "render/outputs.h"
 #include "viewer/inspect.h"
 
 namespace kr::viewer {
@@ -110,6 +111,28 @@ void RenderWorker::publish_error(uint64_t generation, std::string error) {
     publish(std::move(frame));
 }
 
+namespace {
+
+// The denoised radiance of `state`, developed as `render --denoise` and Save develop it
+// (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
+// state between passes (empty: made here).
+Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
+                        std::vector<float>& normal, DenoiseWorkspace& workspace) {
+    DevelopOptions options;
+    options.workspace = &workspace;
+    options.denoise = Denoise::on;
+    options.sampling = job.settings;
+    RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
+    estimates.albedo = std::move(albedo);
+    estimates.normal = std::move(normal);
+    Developed developed = develop(*job.scene, std::move(estimates), options, kLayerRadiance | kLayerAlbedo | kLayerNormal);
+    albedo = std::move(developed.albedo);
+    normal = std::move(developed.normal);
+    return std::move(developed.radiance);
+}
+
+}  // namespace
+
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -123,6 +146,8 @@ void RenderWorker::run() {
     size_t next_preview = 0;
     double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
+    std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
+    DenoiseWorkspace denoise_planes;    // kept between frames
 
     for (;;) {
         StopRule rule;
@@ -142,7 +167,7 @@ void RenderWorker::run() {
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
                 // The estimate render applies, before allocating (render_state.h).
                 const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
-                if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false), "the render of a " + image);
+                if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false, true), "the render of a " + image);
                     !shortfall.empty()) {
                     driver.reset();
                     lock.unlock();
@@ -157,6 +182,8 @@ void RenderWorker::run() {
                     publish_error(job.generation, "not enough memory for the render state of a " + image);
                     continue;
                 }
+                albedo.clear();
+                normal.clear();
                 driver.emplace(*job.scene, job.settings, state, rule_);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
@@ -180,6 +207,10 @@ void RenderWorker::run() {
             ++next_preview;
             frame->scale = scale;
             frame->radiance = preview.radiance();
+            if (denoise_.load()) {
+                std::vector<float> preview_albedo, preview_normal;
+                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal, denoise_planes);
+            }
         } else {
             // A pass stopped early is always an edit's: the next turn starts the new job.
             if (!driver->pass(rule, &stop_)) continue;
@@ -188,6 +219,7 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = state.radiance();
+            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
         }
         frame->generation = job.generation;
         frame->spp = state.passes;

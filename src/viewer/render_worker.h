@@ -35,6 +35,7 @@ struct Snapshot {
     uint64_t serial = 0;     // increases with every frame published
     int scale = 1;           // > 1: a preview rendered at 1/scale resolution, shown upscaled
     Image radiance;          // per-pixel mean radiance
+    Image denoised;          // the radiance developed with the denoiser (render/outputs.h); empty when off
     int spp = 0;             // full-resolution passes accumulated (0 for a preview)
     int max_passes = 1;      // the stop rule's pass limit (kUnlimitedPasses: none)
     double seconds = 0;      // render time of this generation so far (pauses excluded)
@@ -84,6 +85,8 @@ public:
     // going only to pixels above their share of it); or it stops (finished) if the new rule
     // is already met.
     void set_stop_rule(const StopRule& rule);
+    // Whether frames carry the denoised radiance (Snapshot::denoised), from the next frame on.
+    void set_denoise(bool on) { denoise_.store(on); }
 
     // The newest frame (null before the first).
     std::shared_ptr<const Snapshot> latest() const;
@@ -105,6 +108,7 @@ private:
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};
+    std::atomic<bool> denoise_{true};
     std::thread thread_;  // last: starts after every member above exists
 };
 

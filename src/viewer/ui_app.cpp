@@ -52,6 +52,7 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
         s.stop = options_.render.stop;
+        s.denoise = options_.render.denoise.value_or(Denoise::on) == Denoise::on ? DenoiseView::on : DenoiseView::off;
     });
     try {
         model_.load(options_.scene);
@@ -131,6 +132,7 @@ void ViewerApp::sync_worker() {
     const ViewerSettings& s = model_.settings();
     Submitted& sub = submitted_;
     if (s.paused != sub.paused) worker_->set_paused(sub.paused = s.paused);
+    if ((s.denoise != DenoiseView::off) != sub.denoise) worker_->set_denoise(sub.denoise = s.denoise != DenoiseView::off);
     const StopRule rule = s.stop_rule();
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
@@ -143,7 +145,8 @@ void ViewerApp::sync_worker() {
 
 bool ViewerApp::fetch_frame() {
     std::shared_ptr<const Snapshot> frame = worker_->latest();
-    if (!frame || frame->serial == ui_.shown_serial) return false;
+    const DenoiseView view = model_.settings().denoise;
+    if (!frame || (frame->serial == ui_.shown_serial && view == shown_view_)) return false;
     ui_.shown_serial = frame->serial;
     // A frame of an older generation shows an image the user already changed.
     if (frame->generation != model_.generation()) return false;
@@ -156,7 +159,7 @@ bool ViewerApp::fetch_frame() {
         }
         return false;
     }
-    display_->upload(frame->radiance);
+    display_->upload(shown_radiance(*frame, shown_view_ = view));
     ui_.shown = std::move(frame);
     return true;
 }

@@ -66,7 +66,9 @@ private:
         uint64_t generation = 0;
         bool paused = false;
         StopRule stop;
+        bool denoise = true;
     } submitted_;
+    DenoiseView shown_view_ = DenoiseView::on;  // the view of the frame in the texture
 
     // The window.
     bool fullscreen_ = false;
