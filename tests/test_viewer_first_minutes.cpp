@@ -677,7 +677,8 @@ TEST(SceneEdit, PickProjectAndDrag) {
     // The outline: just inside each of its points the click picks the sphere, just outside not.
     const auto outline = sphere_outline(cam, shape.centre, shape.radius, 24);
     ASSERT_EQ(outline.size(), 24u);
-    for (const auto& [ox, oy] : outline) {
+    for (const auto& point : outline) {
+        const double ox = point.first, oy = point.second;  // named, not bound: lambdas capture them
         auto at = [&](double k) { return pick_primitive(s, cam, c->fx + k * (ox - c->fx), c->fy + k * (oy - c->fy)); };
         EXPECT_EQ(at(0.98), ball);
         EXPECT_NE(at(1.02), ball);
