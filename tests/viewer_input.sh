@@ -25,6 +25,16 @@ wait_for() {
     return 1
 }
 field() { sed -E "s/.*\b$1=([^ ]*).*/\1/" "$status"; }
+# wait_changed FIELD VALUE: until the status line's FIELD is no longer VALUE.
+wait_changed() {
+    local end=$((SECONDS + limit))
+    while ((SECONDS < end)); do
+        [[ $(field "$1") != "$2" ]] && return 0
+        sleep 0.1
+    done
+    echo "error=timed out waiting for $1 to leave $2"
+    return 1
+}
 
 wid=$(xdotool search --sync --name '^keithray' | head -1)
 [[ -n $wid ]] || { echo "error=no window"; exit 1; }
@@ -217,6 +227,28 @@ select_edit)
     wait_for 'selected=none' || exit 1
     xdotool key F1
     wait_for 'help=1' || exit 1
+    ;;
+bookmarks)
+    # Orbit with a held arrow key, Ctrl+2 stores the view, Home resets it, Shift+2 recalls
+    # it, Ctrl+S saves the scene (a copy of the brief's, in the work folder).
+    xdotool keydown Right
+    wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
+    xdotool key ctrl+2
+    # Every key before F1 was handled once the help shows (events are handled in order).
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    xdotool key F1
+    wait_for 'help=0' || exit 1
+    g=$(field generation)
+    echo "generation_stored=$g"
+    xdotool key Home
+    wait_changed generation "$g" || exit 1
+    g=$(field generation)
+    xdotool key shift+2
+    wait_changed generation "$g" || exit 1
+    xdotool key ctrl+s
+    wait_for 'dirty=0' || exit 1
     ;;
 esc)
     xdotool key Escape

@@ -194,6 +194,7 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
     for (size_t i = 0; i < in.key_presses.size(); ++i) {
         const int key = in.key_presses[i];
         if (in.key_mods[i] & GLFW_MOD_CONTROL) continue;  // a Ctrl chord, not a zoom key
+        if ((in.key_mods[i] & GLFW_MOD_SHIFT) && key == GLFW_KEY_1) continue;  // Shift+1 recalls a bookmark
         acted = true;
         if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
         else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
@@ -278,6 +279,21 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         const bool redo = ctrl_pressed(GLFW_KEY_Y) || shift_with(GLFW_KEY_Z);
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
         return;
+    }
+    // Camera bookmarks: Ctrl+1..9 stores the view, Shift+1..9 recalls it (1 and 0 alone zoom).
+    for (size_t i = 0; i < in.key_presses.size(); ++i) {
+        const int n = in.key_presses[i] - GLFW_KEY_0, mods = in.key_mods[i];
+        if (n < 1 || n > 9 || !(mods & (GLFW_MOD_CONTROL | GLFW_MOD_SHIFT))) continue;
+        model.seal_undo_step();
+        const std::string name = bookmark_id(n);
+        if (mods & GLFW_MOD_CONTROL) {
+            if (ctx.edit(Edit::bookmark, [&](Scene& s, ViewerSettings&) { store_bookmark(s, n); }, name))
+                ctx.messages.show_status("stored the view as " + name + " (Shift+" + std::to_string(n) + " recalls it)");
+        } else if (find_bookmark(model.scene(), n) < 0) {
+            ctx.messages.show_status("no " + name + " yet (Ctrl+" + std::to_string(n) + " stores the view)");
+        } else {
+            ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { recall_bookmark(s, n); }, name);
+        }
     }
     if (pressed(GLFW_KEY_HOME) || pressed(GLFW_KEY_R)) {
         model.seal_undo_step();

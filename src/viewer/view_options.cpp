@@ -38,6 +38,8 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --aperture A          make the camera a thin lens of aperture radius A
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
   --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
+  --select X,Y          a click at image pixel (X, Y): selects the sphere there
+  --move-selection DX,DY  then drag the selection by (DX, DY) image pixels in the view plane
   --frames N            accumulate N full-resolution passes (at most the target spp)
   --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
   --save-scene OUT.json then save the edited scene
@@ -76,6 +78,8 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--aperture") o.aperture = parse_number(arg, value(), 0, 1e9);
         else if (arg == "--orbit") o.orbit = parse_pair(arg, value());
         else if (arg == "--click-focus") o.click_focus = parse_pair(arg, value());
+        else if (arg == "--select") o.select = parse_pair(arg, value());
+        else if (arg == "--move-selection") o.move_selection = parse_pair(arg, value());
         else if (arg == "--frames") o.frames = int(parse_integer(arg, value(), 1, kMaxSamples));
         else if (arg == "--screenshot") o.screenshot = value();
         else if (arg == "--save-scene") o.save_scene = value();

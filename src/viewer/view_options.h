@@ -20,6 +20,8 @@ struct ViewOptions {
     int frames = 0;  // full-resolution passes to accumulate before the screenshot
     std::optional<std::pair<double, double>> orbit;        // a left drag of (dx, dy) pixels
     std::optional<std::pair<double, double>> click_focus;  // Ctrl+click at image pixel (x, y)
+    std::optional<std::pair<double, double>> select;        // a click at image pixel (x, y): selects
+    std::optional<std::pair<double, double>> move_selection;  // then a drag of it by (dx, dy) image pixels
     std::optional<double> aperture;                        // thin lens with this radius
     std::optional<std::filesystem::path> screenshot;       // image region, read back from GL
     std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
