@@ -66,6 +66,7 @@ private:
         uint64_t generation = 0;
         bool paused = false;
         StopRule stop;
+        std::optional<PixelBox> region;
     } submitted_;
 
     // The window.
