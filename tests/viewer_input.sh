@@ -250,6 +250,27 @@ bookmarks)
     xdotool key ctrl+s
     wait_for 'dirty=0' || exit 1
     ;;
+region)
+    # B, then a left drag from image pixel (100, 120) to (300, 260): the render region; a
+    # drag then orbits again; Shift+B clears the region.
+    img=$(field image)  # left,top,[fit]scale
+    read -r x0 y0 x1 y1 < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d %d %d\n", $1 + 100 * s, $2 + 120 * s, $1 + 300 * s, $2 + 260 * s}')
+    xdotool key b
+    xdotool mousemove --window "$wid" $x0 $y0
+    wait_for "pointer=$x0,$y0" || exit 1
+    xdotool mousedown 1
+    xdotool mousemove --window "$wid" $((x0 + 50)) $((y0 + 30))
+    wait_for "pointer=$((x0 + 50)),$((y0 + 30))" || exit 1
+    xdotool mousemove --window "$wid" $x1 $y1
+    wait_for "pointer=$x1,$y1" || exit 1
+    xdotool mouseup 1
+    wait_for 'region=[0-9]' || exit 1
+    echo "region=$(field region)"
+    echo "generation_region=$(field generation)"
+    xdotool key shift+b
+    wait_for 'region=none' || exit 1
+    echo "region_cleared=$(field region)"
+    ;;
 esc)
     xdotool key Escape
     ;;

@@ -23,6 +23,7 @@ bool ScriptRun::start(PanelContext& ctx) {
     // The scripted edits go through the same functions as the mouse and the panels.
     const bool ok = apply_script_edits(options_, ctx.model, [&](Edit kind, const auto& change) { return ctx.edit(kind, change); });
     if (!ok) return false;
+    if (const auto& r = options_.region) ctx.ui.region = PixelBox{(*r)[0], (*r)[1], (*r)[2], (*r)[3]};
     if (options_.select) {
         // A click on the centre of the pixel, then a drag of the selection, as the mouse does.
         const Scene& s = ctx.model.scene();
