@@ -230,13 +230,18 @@ TEST(RenderThread, PreviewScalesFitTheBudget) {
     EXPECT_EQ(preview_scales(512, 512, 1e-4, 0.02).front(), 16);
 }
 
+// Brief scene n prepared at w x h pixels, for the render thread's tests.
+static std::shared_ptr<const RenderScene> small_scene(int n, int w, int h) {
+    Scene authored = load_scene_file(test::brief_scene_file(n)).scene;
+    authored.renderer.width = w;
+    authored.renderer.height = h;
+    return std::make_shared<const RenderScene>(prepare_scene(authored));
+}
+
 // The worker's published frames are the deterministic estimate: at the target spp they
 // equal plain render passes, whatever the thread timing, edits and previews before.
 TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
-    Scene authored = load_scene_file(test::brief_scene_file(8)).scene;
-    authored.renderer.width = 40;
-    authored.renderer.height = 30;
-    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    const auto scene = small_scene(8, 40, 30);
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 3;
 
@@ -269,10 +274,7 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
 // Missing item 2: a render region. Only its pixels refine; their samples and values are the
 // plain render's (the same pass plan, the others skipped), the rest keep theirs (none here).
 TEST(RenderThread, RegionRefinesOnlyItsPixels) {
-    Scene authored = load_scene_file(test::brief_scene_file(8)).scene;
-    authored.renderer.width = 40;
-    authored.renderer.height = 30;
-    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    const auto scene = small_scene(8, 40, 30);
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 3;
     const PixelBox box{5, 4, 17, 20};
