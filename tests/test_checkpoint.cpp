@@ -9,8 +9,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -166,6 +168,13 @@ TEST(Checkpoint, RefusesAnotherSceneSettingsSizeOrDamage) {
     StopRule noisier = rule;
     noisier.noise = 0.5;
     expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, noisier)), "noise=");
+    // The pass limit, an open-ended render's implicit cap included.
+    StopRule capped = rule;
+    capped.max_passes = 65536;
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, capped)), "passes=65536\" here");
+    StopRule timed = rule;
+    timed.seconds = 5;  // more or less time goes on to the same samples
+    EXPECT_EQ(refusal(bytes, checkpoint_key(authored, scene, settings, timed)), "(accepted)");
 
     Scene larger = authored;
     larger.renderer.width = 9;
@@ -256,4 +265,155 @@ TEST_F(CheckpointCli, FlagsAreChecked) {
     const test::CommandResult missing = cli_here("render '" + scene.string() + "' -q --resume nowhere.ckpt");
     EXPECT_EQ(missing.status, 1);
     EXPECT_NE(missing.err.find("nowhere.ckpt"), std::string::npos) << missing.err;
+}
+
+namespace {
+
+// keithray started in `dir` with KEITHRAY_TEST_STOP_BEFORE_RENAME=`hook` (core/file_write.cpp):
+// it stops itself inside the chosen write, every temporary whole and none renamed. Returns
+// the child, stopped there (or -1 if it ended first, `status` then holds how).
+pid_t start_stopped_in_write(const fs::path& dir, const std::string& args, const std::string& hook, int& status) {
+    const pid_t child = ::fork();
+    if (child == 0) {
+        ::setenv("KEITHRAY_TEST_STOP_BEFORE_RENAME", hook.c_str(), 1);
+        ::signal(SIGINT, SIG_DFL);  // whatever the test runner's dispositions
+        ::signal(SIGTERM, SIG_DFL);
+        const std::string cmd = "cd '" + dir.string() + "' && exec '" + std::string(KEITHRAY_EXE) + "' " + args +
+                                " >out.txt 2>err.txt";
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    if (::waitpid(child, &status, WUNTRACED) != child || !WIFSTOPPED(status)) return -1;
+    return child;
+}
+
+// Sends `signals` to the stopped child, lets it go on and returns its status.
+int signal_and_wait(pid_t child, std::initializer_list<int> signals) {
+    for (int sig : signals) ::kill(child, sig);
+    ::kill(child, SIGCONT);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    return status;
+}
+
+bool has_temporary(const fs::path& dir) {
+    for (const auto& entry : fs::directory_iterator(dir))
+        if (entry.path().filename().string().find(".tmp") != std::string::npos) return true;
+    return false;
+}
+
+}  // namespace
+
+// A signal while a checkpoint is being written: the write completes (the new checkpoint is
+// whole), the render stops as documented (exit 128 + signal, no image, "holds them") with no
+// "checkpoint not written" warning, and --resume finishes the uninterrupted render's bytes.
+TEST_F(CheckpointCli, SignalDuringACheckpointWriteKeepsItWholeAndStops) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.ppm").status, 0);
+    for (int sig : {SIGTERM, SIGINT}) {
+        fs::remove(dir / "r.ckpt");
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "r.ckpt:2", status);
+        ASSERT_GT(child, 0) << "ended before its second checkpoint: " << status << test::read_file(dir / "err.txt");
+        status = signal_and_wait(child, {sig});
+        const std::string err = test::read_file(dir / "err.txt");
+        ASSERT_TRUE(WIFEXITED(status)) << status << err;
+        EXPECT_EQ(WEXITSTATUS(status), 128 + sig) << err;
+        EXPECT_NE(err.find("stopped by a signal"), std::string::npos) << err;
+        EXPECT_NE(err.find("holds them (go on with --resume)"), std::string::npos) << err;
+        EXPECT_EQ(err.find("not written"), std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(dir / "cut.ppm"));
+        EXPECT_FALSE(has_temporary(dir));
+        const test::CommandResult resumed = cli_here(common + "-o cut.ppm --resume r.ckpt");
+        ASSERT_EQ(resumed.status, 0) << resumed.err;
+        EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
+        fs::remove(dir / "cut.ppm");
+        fs::remove(dir / "cut-depth.ppm");
+    }
+}
+
+// A second signal during that write ends the run at once: the temporary is removed and the
+// previous checkpoint stays whole (it resumes to the same bytes).
+TEST_F(CheckpointCli, SecondSignalDuringACheckpointWriteLeavesTheOldOneWhole) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.ppm").status, 0);
+    int status = 0;
+    const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "r.ckpt:3", status);
+    ASSERT_GT(child, 0) << status;
+    const std::string old = test::read_file(dir / "r.ckpt");
+    status = signal_and_wait(child, {SIGINT, SIGTERM});
+    EXPECT_TRUE(WIFSIGNALED(status)) << status;
+    EXPECT_FALSE(has_temporary(dir));
+    EXPECT_EQ(test::read_file(dir / "r.ckpt"), old);
+    EXPECT_FALSE(fs::exists(dir / "cut.ppm"));
+    const test::CommandResult resumed = cli_here(common + "-o cut.ppm --resume r.ckpt");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
+}
+
+// The image is written after checkpoints were: a signal inside that write still finds the
+// cleanup handler (the render's stop handling ended with its passes): no temporary, the old
+// image untouched, the checkpoint whole, the process ended by the signal.
+TEST_F(CheckpointCli, SignalDuringTheImageWriteAfterCheckpointsLeavesNoTemporary) {
+    const fs::path scene = small_scene(24);
+    const std::string common = "render '" + scene.string() + "' --spp 4 -q --threads 1 ";
+    for (int sig : {SIGTERM, SIGINT}) {
+        fs::remove(dir / "r.ckpt");
+        {
+            std::ofstream old(dir / "cut.ppm");
+            old << "old";
+        }
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, common + "-o cut.ppm --checkpoint r.ckpt --every 0", "cut.ppm:1", status);
+        ASSERT_GT(child, 0) << status;
+        status = signal_and_wait(child, {sig});
+        EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == sig) << status << test::read_file(dir / "err.txt");
+        EXPECT_FALSE(has_temporary(dir));
+        EXPECT_EQ(test::read_file(dir / "cut.ppm"), "old");
+        EXPECT_FALSE(fs::exists(dir / "cut-depth.ppm"));
+        const test::CommandResult resumed = cli_here(common + "-o done.ppm --resume r.ckpt");
+        EXPECT_EQ(resumed.status, 0) << resumed.err;
+    }
+}
+
+// An open-ended render (--time or --noise without --spp) runs up to the cap of 65536
+// passes: resumed plainly it would end at the scene's spp instead, another image. Refused,
+// naming the pass limit; resumed with its --noise it goes on.
+TEST_F(CheckpointCli, OpenEndedRenderResumedPlainlyIsRefused) {
+    const fs::path scene = small_scene(8);
+    const std::string common = "render '" + scene.string() + "' -q --threads 1 -o out.ppm ";
+    const test::CommandResult first = cli_here(common + "--noise 0.5 --checkpoint r.ckpt --every 0");
+    ASSERT_EQ(first.status, 0) << first.err;
+    const test::CommandResult refused = cli_here(common + "--resume r.ckpt");
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_NE(refused.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << refused.err;
+    // A --time render likewise (it may have stopped by its time or at the cap).
+    ASSERT_EQ(cli_here(common + "--time 0.2 --checkpoint t.ckpt --every 0").status, 0);
+    const test::CommandResult timed = cli_here(common + "--resume t.ckpt");
+    EXPECT_EQ(timed.status, 1);
+    EXPECT_NE(timed.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << timed.err;
+    const test::CommandResult again = cli_here(common + "--noise 0.5 --resume r.ckpt");
+    EXPECT_EQ(again.status, 0) << again.err;
+}
+
+// The checkpoint's target is checked before the render, like the images': a folder, a
+// device, a read-only file; one line, exit 1, nothing rendered or written.
+TEST_F(CheckpointCli, CheckpointTargetIsCheckedBeforeRendering) {
+    const fs::path scene = small_scene(8);
+    fs::create_directories(dir / "folder");
+    {
+        std::ofstream ro(dir / "ro.ckpt");
+        ro << "old";
+    }
+    fs::permissions(dir / "ro.ckpt", fs::perms::owner_read);
+    for (const std::string target : {"folder", "/dev/null", "ro.ckpt"}) {
+        const test::CommandResult r = cli_here("render scene.json -q -o out.ppm --spp 2 --checkpoint " + target);
+        EXPECT_EQ(r.status, 1) << target;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find("nothing rendered"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "out.ppm")) << target;
+    }
+    EXPECT_EQ(test::read_file(dir / "ro.ckpt"), "old");
 }

@@ -520,6 +520,46 @@ TEST_F(HdrCli, NonFiniteRadianceIsRefusedNeverAgreement) {
     EXPECT_EQ(run("compare black.pfm black.pfm --min-psnr 30").status, 0);
 }
 
+// Means that are finite but beyond a float's range (a point light of 1e45) are written as
+// float's largest value, variance included, never as infinity: the EXR and PFM hold finite
+// numbers, and `compare --statistical` of the render against itself agrees.
+TEST_F(HdrCli, HugeFiniteMeansStayFiniteInTheFiles) {
+    std::string text = test::read_file(write_scene("huge.json"));
+    const std::string power = "\"power\": [50, 50, 50]";
+    text.replace(text.find(power), power.size(), "\"power\": [1e45, 1e45, 1e45]");
+    std::ofstream(dir / "huge.json") << text;
+    ASSERT_EQ(run("render huge.json -q -o huge.exr").status, 0);
+    ASSERT_EQ(run("render huge.json -q -o huge.pfm").status, 0);
+    const HdrImage exr = read_hdr(dir / "huge.exr"), pfm = read_hdr(dir / "huge.pfm");
+    size_t saturated = 0;
+    for (const std::vector<float>* layer : {&exr.rgb, &exr.variance, &exr.depth, &pfm.rgb})
+        for (float v : *layer) {
+            ASSERT_TRUE(std::isfinite(v));
+            saturated += v == std::numeric_limits<float>::max();
+        }
+    EXPECT_GT(saturated, 0u);  // the test reaches beyond float's range
+    const test::CommandResult self = run("compare huge.exr huge.exr --statistical");
+    EXPECT_EQ(self.status, 0) << self.out << self.err;
+    EXPECT_EQ(run("compare huge.pfm huge.pfm --max-rmse 0").status, 0);
+}
+
+// The depth layer: a hit farther than the miss value (1e6) keeps its distance; a miss is 1e6.
+TEST_F(HdrCli, DepthOfAHitBeyondTheMissValueIsNotAMiss) {
+    std::ofstream(dir / "far.json") << R"({
+  "cameras": [{"id": "cam", "type": "pinhole", "fov": 30, "aspect": 1, "position": [0, 0, 0], "target": [0, 0, 1]}],
+  "materials": [{"id": "white", "type": "diffuse", "rho": [0.8, 0.8, 0.8]}],
+  "shapes": [{"id": "ball", "type": "sphere", "centre": [0, 0, 4e6], "radius": 1e6}],
+  "lights": [{"id": "lamp", "type": "point", "position": [0, 0, 0], "power": [1, 1, 1]}],
+  "scene": {"camera": "cam", "lights": ["lamp"],
+    "primitives": [{"id": "ball", "type": "geometric", "shape": "ball", "material": "white"}],
+    "renderer": {"type": "WRT", "dimensions": [9, 9], "samples": 1, "depth": 1, "output": "far.exr"}}
+})";
+    ASSERT_EQ(run("render far.json -q").status, 0);
+    const HdrImage image = read_hdr(dir / "far.exr");
+    EXPECT_NEAR(image.depth[4 * 9 + 4], 3e6, 1e5);  // the centre pixel hits the ball's near side
+    EXPECT_EQ(image.depth[0], 1e6f);               // a corner misses it
+}
+
 TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {
     write_scene("s.json");
     write_scene("wide.json", 20);

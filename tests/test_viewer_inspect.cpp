@@ -367,3 +367,15 @@ TEST(ConvergenceLog, SavedAsCsvBesideTheOutput) {
     EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator{}), 1);  // no temp file left
     fs::remove_all(dir);
 }
+
+// A file name that is not UTF-8 (image B's, from the command line) is escaped in the JSON,
+// never an exception from the JSON library.
+TEST(StatsJson, NameThatIsNotUtf8IsEscaped) {
+    StatsFigures s;
+    s.state = "done";
+    s.reference = std::string("b\xff\xfe.ppm");
+    std::string text;
+    ASSERT_NO_THROW(text = stats_json(s));
+    const auto j = nlohmann::json::parse(text);
+    EXPECT_EQ(j["reference"], "b\\xFF\\xFE.ppm");
+}

@@ -2,6 +2,7 @@
 // click-to-focus, exact accumulation, the render thread's determinism, the file watch.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -411,5 +412,27 @@ TEST(SceneWatch, BrokenFileKeepsTheLastGoodScene) {
     EXPECT_NO_THROW(m.load(file));
     EXPECT_EQ(m.generation(), g + 1);
     EXPECT_EQ(m.camera().position, Vec3(0, 0, -16));
+    fs::remove_all(dir);
+}
+
+// Opening a FIFO (from the Open list, a reload, the command line) would block the window
+// until something writes it: the model refuses anything but a regular file, by stat alone,
+// and keeps the scene it has.
+TEST(SceneWatch, FifoSceneIsRefusedWithoutBlocking) {
+    const fs::path dir = fs::temp_directory_path() / ("keithray_fifo_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    const fs::path fifo = dir / "pipe.json";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    ViewerModel m;
+    m.load(test::brief_scene_file(2));
+    const uint64_t g = m.generation();
+    try {
+        m.load(fifo);
+        ADD_FAILURE() << "a FIFO loaded";
+    } catch (const SceneError& e) {
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(m.generation(), g);
+    EXPECT_TRUE(m.has_scene());
     fs::remove_all(dir);
 }

@@ -167,12 +167,17 @@ TEST_F(SaveDialog, ImageFilesAreTheRenderOutputsOfTheSameState) {
     frame.radiance = state.radiance();
     record_pixel_statistics(state, frame);
 
+    // Raw and denoised (the display's denoiser, which Save develops with, as render --denoise).
+    for (const DenoiseView view : {DenoiseView::off, DenoiseView::on})
     for (const char* ext : {".ppm", ".png", ".exr", ".pfm"}) {
+        m.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.denoise = view; });
         const std::filesystem::path saved = dir / (std::string("saved") + ext), rendered = dir / (std::string("cli") + ext);
         save_output(image_save_kind(saved), saved, m, &frame);
         OutputRequest request;
         request.path = rendered;
         request.display = m.settings().tone;
+        request.develop.denoise = view == DenoiseView::on ? Denoise::on : Denoise::off;
+        request.develop.sampling = m.settings().render;
         write_files_atomic(output_files(*m.prepared(), state, request));
         const std::vector<std::filesystem::path> a = output_file_paths(saved), b = output_file_paths(rendered);
         ASSERT_EQ(a.size(), b.size()) << ext;

@@ -126,7 +126,8 @@ TEST_F(ViewerWindow, ScriptedEditsScreenshotMatchesHeadlessRender) {
 TEST_F(ViewerWindow, SaveImageWritesWhatRenderWritesForTheSameName) {
     for (const std::string ext : {"ppm", "png", "exr", "pfm"}) {
         const fs::path saved = dir / ("saved." + ext), rendered = dir / ("rendered." + ext);
-        const std::string flags = " --spp 2 --seed 5 --exposure 0.5";
+        // The viewer's Save develops as its display: denoised by default, as render --denoise.
+        const std::string flags = " --spp 2 --seed 5 --exposure 0.5 --denoise on";
         const ViewRun v = keithray("view '" + scene(6) + "'" + flags + " --save-image '" + saved.string() +
                                        "' --timeout 300",
                                    true);
@@ -564,4 +565,30 @@ TEST_F(ViewerWindow, RegionShowsOnlyItsPixelsRendered) {
         }
     EXPECT_LE(worst_in, 1);
     EXPECT_EQ(lit_out, 0);
+
+// The viewer applies render's memory estimate before it allocates a render state: a scene
+// too large for the machine is an error in the window (and a scripted run's exit 1), never
+// an abort of the viewer.
+TEST_F(ViewerWindow, RenderTooLargeForMemoryIsAnErrorNotAnAbort) {
+    std::string text = kr::test::read_file(scene(1));
+    const size_t at = text.find("\"dimensions\"");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, text.find(']', at) + 1 - at, "\"dimensions\": [32768, 32768]");
+    std::ofstream(dir / "huge.json") << text;
+    const ViewRun v = keithray("view '" + (dir / "huge.json").string() + "' --frames 1 --screenshot '" +
+                                   (dir / "x.ppm").string() + "' --timeout 120",
+                               true);
+    EXPECT_EQ(v.status, 1) << v.err;
+    EXPECT_NE(v.err.find("not enough memory for the render of a 32768x32768 image"), std::string::npos) << v.err;
+    EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+}
+
+// A status file that cannot be written fails the scripted run (once said, exit 1).
+TEST_F(ViewerWindow, StatusFileThatCannotBeWrittenFailsTheRun) {
+    fs::create_directories(dir / "folder");
+    const ViewRun v = keithray("view '" + scene(1) + "' --spp 1 --frames 1 --screenshot '" + (dir / "x.ppm").string() +
+                                   "' --status-file '" + (dir / "folder").string() + "' --timeout 120",
+                               true);
+    EXPECT_EQ(v.status, 1) << v.err;
+    EXPECT_NE(v.err.find("--status-file"), std::string::npos) << v.err;
 }

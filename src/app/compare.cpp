@@ -108,15 +108,9 @@ CompareOptions parse_compare(int argc, char** argv) {
         if (!format || format->hdr)
             throw UsageError{"--diff writes an 8-bit picture: give it a name ending in .png or .ppm"};
         // The picture never replaces an image being compared.
-        for (const std::string& input : files) {
-            std::error_code ec;
-            const auto resolved = [](const std::filesystem::path& p) {
-                std::error_code e;
-                return std::filesystem::weakly_canonical(std::filesystem::absolute(p, e), e);
-            };
-            if (std::filesystem::equivalent(*o.diff, input, ec) || resolved(*o.diff) == resolved(input))
+        for (const std::string& input : files)
+            if (same_file(*o.diff, input))
                 throw UsageError{"--diff " + quoted_path(*o.diff) + " would overwrite the input " + quoted_path(input)};
-        }
     }
     return o;
 }

@@ -75,7 +75,8 @@ constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map t
                         the radiance and OUT-depth.pfm the distances as float PFMs
   --checkpoint FILE     write the render state to FILE (atomically) at most every
                         --every seconds and on SIGINT/SIGTERM, which then end the
-                        render without an image (only with a single scene)
+                        render without an image (a second signal ends it at once;
+                        only with a single scene)
   --every SECONDS       seconds between checkpoints, 0..1e6 (default: 60; 0: every pass)
   --resume FILE         go on from checkpoint FILE: the image is byte for byte the one
                         of an uninterrupted render; refused for another scene, other
@@ -145,21 +146,6 @@ Options parse_options(int argc, char** argv) {
     return o;
 }
 
-// Whether writing path `a` would replace the existing file `b`: the same file under another
-// name (hard or symbolic links), or the same path once resolved, e.g. "x/../scene.json"
-// through a folder x that does not exist yet (the writer would create it).
-bool same_file(const fs::path& a, const fs::path& b) {
-    std::error_code ec;
-    if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
-    auto resolved = [](const fs::path& p) {
-        std::error_code e;
-        const fs::path absolute = fs::absolute(p, e);
-        const fs::path canonical = fs::weakly_canonical(absolute, e);
-        return e ? absolute.lexically_normal() : canonical;
-    };
-    return resolved(a) == resolved(b);
-}
-
 // A file path in a message: as it is, or quoted and escaped when it holds control
 // characters, bytes that are not UTF-8 or too many of them (core/text.h).
 std::string shown(const fs::path& path) { return show_user_text(path.string()); }
@@ -169,10 +155,6 @@ std::string shown(const fs::path& path) { return show_user_text(path.string()); 
 bool out_of_memory(const std::exception& e) {
     return dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e);
 }
-
-// The signal (SIGINT, SIGTERM) that asked a checkpointed render to stop, else 0.
-volatile std::sig_atomic_t g_stop_signal = 0;
-extern "C" void on_stop_signal(int sig) { g_stop_signal = sig; }
 
 // Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
 // why where it could not be written; the previous checkpoint then stays as it was.
@@ -221,31 +203,6 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
                 costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
                 costs.front().exchanges, between);
 }
-
-// A checkpointed render's SIGINT and SIGTERM handlers while it runs: they end the pass under
-// way, the checkpoint is written and the render stops. The previous handlers come back after.
-class StopSignals {
-public:
-    explicit StopSignals(bool install) : installed_(install) {
-        if (!installed_) return;
-        struct sigaction stop {};
-        stop.sa_handler = on_stop_signal;
-        sigemptyset(&stop.sa_mask);
-        ::sigaction(SIGINT, &stop, &previous_int_);
-        ::sigaction(SIGTERM, &stop, &previous_term_);
-    }
-    ~StopSignals() {
-        if (!installed_) return;
-        ::sigaction(SIGINT, &previous_int_, nullptr);
-        ::sigaction(SIGTERM, &previous_term_, nullptr);
-    }
-    StopSignals(const StopSignals&) = delete;
-    StopSignals& operator=(const StopSignals&) = delete;
-
-private:
-    bool installed_;
-    struct sigaction previous_int_ {}, previous_term_ {};
-};
 
 // One scene's render, in the order its steps run: load, check the outputs, check the memory,
 // resume, render with checkpoints, gather and report, write. Each step that fails prints why
@@ -342,6 +299,16 @@ private:
                                  shown(*opt_.checkpoint).c_str(), shown(other).c_str());
                     overwrites_input = true;
                 }
+        // Every file written later (the images after the render, the checkpoint during it)
+        // checked now, as the writer would: not after hours of rendering.
+        if (leader_ && !overwrites_input) try {
+                std::vector<fs::path> targets = outputs;
+                if (opt_.checkpoint) targets.push_back(*opt_.checkpoint);
+                check_output_targets(targets);
+            } catch (const std::runtime_error& e) {
+                std::fprintf(stderr, "error: %s: %s; nothing rendered\n", file_.c_str(), e.what());
+                overwrites_input = true;
+            }
         return !cluster_.broadcast(overwrites_input);
     }
 
@@ -350,20 +317,19 @@ private:
     bool check_memory() {
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
-        const uint64_t needed = render_memory_bytes(width, height, opt_.blur > 0);
-        const MemoryLimit limit = memory_limit();
-        if (needed > limit.bytes)  // every rank holds the whole state: each checks its own machine
-            std::fprintf(stderr,
-                         "error: %s: not enough memory for the render of a %s: it needs about %s, above %s (%s)%s\n",
-                         file_.c_str(), image_.c_str(), format_bytes(needed).c_str(), limit.what.c_str(),
-                         format_bytes(limit.bytes).c_str(),
+        const std::string shortfall =
+            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off), "the render of a " + image_);
+        if (!shortfall.empty())  // every rank holds the whole state: each checks its own machine
+            std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
                          cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
-        if (cluster_.any_flags(needed > limit.bytes)) return false;
+        if (cluster_.any_flags(!shortfall.empty())) return false;
         stage_ = "the render state of a " + image_;
         state_.reset(width, height);
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }
+
+    Denoise denoise() const { return opt_.render.denoise.value_or(Denoise::off); }
 
     void set_stop_rule() {
         rule_ = render_stop_rule(opt_.render, settings_);
@@ -402,18 +368,21 @@ private:
     }
 
     // The passes, with the checkpoints, the stop signals and the progress bar between them.
+    // With a checkpoint, SIGINT and SIGTERM during the passes end the pass under way, the
+    // checkpoint is written and the render stops without an image; once the passes are over a
+    // signal ends the run at once (the cleanup handler removes what was being written).
     StopReason render() {
         auto last_checkpoint = std::chrono::steady_clock::now();
         double last_draw = -1;
-        const StopSignals signals(opt_.checkpoint.has_value());
+        StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
         hooks_ = cluster_.deal_rows(open_ended_);
         stage_ = "rendering a " + image_;
-        return render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
+        StopReason reason = render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
             if (opt_.checkpoint) {
                 // One decision for every rank: rank 0's clock, any rank's signal.
                 const bool due = leader_ && std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                                           last_checkpoint).count() >= opt_.checkpoint_every;
-                const int flags = cluster_.any_flags((due ? 1 : 0) | (g_stop_signal ? 2 : 0));
+                const int flags = cluster_.any_flags((due ? 1 : 0) | (stop_signal() ? 2 : 0));
                 if (flags) {
                     checkpoint_written_ = write_checkpoint(cluster_, *opt_.checkpoint, key_, state_);
                     last_checkpoint = std::chrono::steady_clock::now();
@@ -434,6 +403,13 @@ private:
             }
             return true;
         }, hooks_.get());
+        // A signal after the last pass's check still stops the render, with its checkpoint.
+        stop_on_signal.release();
+        if (opt_.checkpoint && reason != StopReason::cancelled && cluster_.any_flags(stop_signal() ? 1 : 0)) {
+            checkpoint_written_ = write_checkpoint(cluster_, *opt_.checkpoint, key_, state_);
+            reason = StopReason::cancelled;
+        }
+        return reason;
     }
 
     // Every rank's costs, and the state gathered at rank 0 with the job's counts.
@@ -471,6 +447,8 @@ private:
             OutputRequest request;
             request.path = output_;
             request.develop.blur = opt_.blur;
+            request.develop.denoise = denoise();
+            request.develop.sampling = settings_;
             request.display = loaded_.scene.display;
             if (opt_.gl)
                 request.tone_map = [](const Image& radiance, const DisplaySettings& display) {
@@ -540,6 +518,7 @@ bool stdout_written() {
 }  // namespace
 
 int main(int argc, char** argv) {
+    install_signal_cleanup();  // one handler for every write of the run (core/file_write.h)
     const std::string command = argc > 1 ? argv[1] : "";
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(usage().c_str(), stdout);
@@ -566,7 +545,10 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (command == "view") return viewer::run_viewer(argc, argv);
+    if (command == "view") {
+        const int status = viewer::run_viewer(argc, argv);
+        return stdout_written() ? status : 1;
+    }
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
                      command.empty() ? "" : quote_user_text(command, 40).c_str(), usage().c_str());
@@ -621,10 +603,10 @@ int main(int argc, char** argv) {
             // The other ranks wait for this one in the next exchange: end the job.
             if (cluster.distributed()) cluster.abort(1);
         }
-        if (g_stop_signal) break;  // a checkpointed render stopped by a signal: no further scene
+        if (stop_signal()) break;  // a checkpointed render stopped by a signal: no further scene
     }
     // Every rank exits with the same status.
     ok = cluster.any_flags(!(stdout_written() && ok)) == 0;
-    if (g_stop_signal) return 128 + int(g_stop_signal);
+    if (stop_signal()) return 128 + stop_signal();
     return ok ? 0 : 1;
 }

@@ -29,6 +29,8 @@ public:
         return true;
     }
     const std::string& arg() const { return arg_; }
+    // The next argument, not taken (nullptr at the end).
+    const char* peek() const { return index_ + 1 < argc_ ? argv_[index_ + 1] : nullptr; }
     std::string value() {
         if (index_ + 1 >= argc_) throw UsageError{show_user_text(arg_, 40) + " needs a value"};
         return argv_[++index_];

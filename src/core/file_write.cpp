@@ -5,6 +5,7 @@
 #include <climits>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -38,6 +39,10 @@ TempSlot g_temp_slots[kTempSlots];
 constexpr int kCleanupSignals[] = {SIGINT, SIGTERM, SIGHUP, SIGXFSZ};
 constexpr int kSignalCount = sizeof(kCleanupSignals) / sizeof(kCleanupSignals[0]);
 struct sigaction g_previous_action[kSignalCount];
+std::atomic<bool> g_stop_mode{false};  // a StopOnSignal is active
+std::atomic<int> g_stop_signal{0};     // the signal it recorded
+static_assert(std::atomic<int>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
+              "read and written by a signal handler");
 
 void remove_live_temps() {
     for (TempSlot& slot : g_temp_slots) {
@@ -50,6 +55,10 @@ void remove_live_temps() {
 // default action (re-raised with it restored, so the exit status still says "killed by
 // SIGTERM") or the program's own handler.
 void on_cleanup_signal(int sig, siginfo_t* info, void* context) {
+    if (g_stop_mode.load() && (sig == SIGINT || sig == SIGTERM)) {
+        int none = 0;
+        if (g_stop_signal.compare_exchange_strong(none, sig)) return;  // the first: a request to stop
+    }
     remove_live_temps();
     for (int i = 0; i < kSignalCount; ++i) {
         if (kCleanupSignals[i] != sig) continue;
@@ -65,7 +74,9 @@ void on_cleanup_signal(int sig, siginfo_t* info, void* context) {
     }
 }
 
-void install_cleanup_handlers() {
+}  // namespace
+
+void install_signal_cleanup() {
     static std::once_flag once;
     std::call_once(once, [] {
         for (int i = 0; i < kSignalCount; ++i) {
@@ -82,6 +93,21 @@ void install_cleanup_handlers() {
         }
     });
 }
+
+StopOnSignal::StopOnSignal(bool active) : active_(active) {
+    if (!active_) return;
+    install_signal_cleanup();
+    g_stop_mode.store(true);
+}
+
+void StopOnSignal::release() {
+    if (active_) g_stop_mode.store(false);
+    active_ = false;
+}
+
+int stop_signal() { return g_stop_signal.load(); }
+
+namespace {
 
 int register_temp(const std::string& path) {
     if (path.size() >= PATH_MAX) return -1;
@@ -238,7 +264,41 @@ struct Undo {
     }
 };
 
+// For tests of signals inside a write: KEITHRAY_TEST_STOP_BEFORE_RENAME=NAME:N stops the
+// process (SIGSTOP) once, in the Nth write whose targets include a file named NAME, with
+// every temporary whole and none renamed yet; the test then sends its signals and SIGCONT.
+void stop_before_rename_for_tests(const std::vector<Target>& targets) {
+    const char* hook = std::getenv("KEITHRAY_TEST_STOP_BEFORE_RENAME");
+    if (!hook) return;
+    const std::string spec = hook;
+    const size_t colon = spec.rfind(':');
+    const std::string name = spec.substr(0, colon);
+    const long nth = colon == std::string::npos ? 1 : std::atol(spec.c_str() + colon + 1);
+    static std::atomic<long> seen{0};
+    for (const Target& t : targets)
+        if (t.path.filename() == name) {
+            if (seen.fetch_add(1) + 1 == nth) ::raise(SIGSTOP);
+            return;
+        }
+}
+
 }  // namespace
+
+void check_output_targets(const std::vector<fs::path>& paths) {
+    for (const fs::path& path : paths) check_target(path);
+}
+
+bool same_file(const fs::path& a, const fs::path& b) {
+    std::error_code ec;
+    if (fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec)) return true;
+    auto resolved = [](const fs::path& p) {
+        std::error_code e;
+        const fs::path absolute = fs::absolute(p, e);
+        const fs::path canonical = fs::weakly_canonical(absolute, e);
+        return e ? absolute.lexically_normal() : canonical;
+    };
+    return resolved(a) == resolved(b);
+}
 
 std::string quoted_path(const fs::path& path) {
     const std::string& text = path.native();
@@ -264,7 +324,7 @@ void write_files_atomic(const std::vector<FileOutput>& files) {
                                                        quoted_path(targets[j].shown) + ")");
         }
 
-    install_cleanup_handlers();
+    install_signal_cleanup();
     Undo undo;
     undo.temps.reserve(targets.size());
     // 2. Missing folders.
@@ -297,6 +357,7 @@ void write_files_atomic(const std::vector<FileOutput>& files) {
         }
         if (::close(fd) != 0) throw file_error(t.shown, "cannot write: " + errno_text(errno));
     }
+    stop_before_rename_for_tests(targets);
     // 4. All renames together.
     for (size_t i = 0; i < targets.size(); ++i) {
         if (::rename(targets[i].temp.c_str(), targets[i].path.c_str()) != 0)

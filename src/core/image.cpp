@@ -139,7 +139,7 @@ Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height)
     Rgb8Image out{width, height, std::vector<uint8_t>(depth.size() * 3)};
     for (size_t i = 0; i < depth.size(); ++i) {
         const double d = std::max(0.0, depth[i]);
-        const uint8_t g = quantize_unit(1.0 - d / (1.0 + d));
+        const uint8_t g = std::isinf(d) ? 0 : quantize_unit(1.0 - d / (1.0 + d));  // inf / inf is NaN
         out.bytes[3 * i] = out.bytes[3 * i + 1] = out.bytes[3 * i + 2] = g;
     }
     return out;

@@ -83,8 +83,8 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
             if (!std::isfinite(image->variance[i]) || image->variance[i] < 0)
                 throw std::runtime_error(show_user_text(*name) + ": pixel (" + std::to_string(i / 3 % size_t(image->width)) + ", " +
                                          std::to_string(i / 3 / size_t(image->width)) +
-                                         ") has no variance estimate (fewer than 2 samples); --statistical needs "
-                                         "at least 2 per pixel");
+                                         ") has no variance estimate (fewer than 2 samples, or squares beyond a double's range); "
+                                         "--statistical needs at least 2 per pixel");
     // Degrees of freedom of a pixel's variance: its sample count less one (a file without the
     // samples layer is taken as large-sample).
     auto dof = [](const HdrImage& image, size_t i) {

@@ -37,10 +37,12 @@ std::vector<std::filesystem::path> output_file_paths(const std::filesystem::path
 }
 
 ImageFile read_image_file(const std::filesystem::path& path) {
+    // Read once, then told apart by the first bytes: a pipe or FIFO cannot be opened twice.
+    const std::string bytes = read_image_bytes(path, std::max<uint64_t>(kMaxHdrFileBytes, kMaxImageFileBytes));
     ImageFile file;
-    file.hdr = is_hdr_file(path);
+    file.hdr = is_hdr_bytes(bytes);
     if (file.hdr) {
-        file.radiance = read_hdr(path);
+        file.radiance = decode_hdr(bytes, path.string());
         // A NaN or an infinity is no radiance: compared, it would pass as agreement with anything.
         const std::vector<float>& rgb = file.radiance.rgb;
         const auto bad = std::find_if(rgb.begin(), rgb.end(), [](float v) { return !std::isfinite(v); });
@@ -53,7 +55,7 @@ ImageFile read_image_file(const std::filesystem::path& path) {
                                      "); expected finite numbers");
         }
     } else {
-        file.rgb8 = read_image(path);
+        file.rgb8 = decode_image(path, bytes);
     }
     return file;
 }

@@ -21,6 +21,7 @@
 #include <omp.h>
 
 #include "core/file_write.h"
+#include "core/image_io.h"
 #include "core/text.h"
 
 namespace kr {
@@ -39,7 +40,13 @@ HdrImage hdr_from_radiance(const Image& radiance) {
     out.height = radiance.height;
     out.rgb.resize(radiance.pixels.size() * 3);
     for (size_t i = 0; i < radiance.pixels.size(); ++i)
-        for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<float>(radiance.pixels[i][k]);
+        for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = stored_float(radiance.pixels[i][k]);
+    return out;
+}
+
+std::vector<float> stored_floats(const std::vector<double>& values) {
+    std::vector<float> out(values.size());
+    for (size_t i = 0; i < values.size(); ++i) out[i] = stored_float(values[i]);
     return out;
 }
 
@@ -74,6 +81,7 @@ void check_image(const HdrImage& image) {
     check_layer_size(image.normal.size(), 3 * n, "normal");
     check_layer_size(image.samples.size(), n, "samples");
     check_layer_size(image.variance.size(), 3 * n, "variance");
+    check_layer_size(image.raw.size(), 3 * n, "raw");
 }
 
 // OpenEXR's output stream into a string in memory (the file is then written atomically).
@@ -114,9 +122,10 @@ private:
 };
 
 // The layers of the EXR file, their names for messages and their channels per pixel.
-enum class ExrLayer { radiance, depth, albedo, normal, samples, variance };
-constexpr EnumNames<ExrLayer, 6> exr_layer_names{{"radiance", "depth", "albedo", "normal", "samples", "variance"}};
-constexpr std::array<int, 6> kLayerChannels{3, 1, 3, 3, 1, 3};
+enum class ExrLayer { radiance, depth, albedo, normal, samples, variance, raw };
+constexpr EnumNames<ExrLayer, 7> exr_layer_names{
+    {"radiance", "depth", "albedo", "normal", "samples", "variance", "raw"}};
+constexpr std::array<int, 7> kLayerChannels{3, 1, 3, 3, 1, 3, 3};
 int channels_of(ExrLayer layer) { return kLayerChannels[size_t(layer)]; }
 
 // Each EXR channel: its name, its layer and its place within the layer's pixel.
@@ -125,7 +134,7 @@ struct ExrChannel {
     ExrLayer layer;
     int offset;
 };
-constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", ExrLayer::radiance, 0},
+constexpr std::array<ExrChannel, 17> kExrChannels{{{"R", ExrLayer::radiance, 0},
                                                    {"G", ExrLayer::radiance, 1},
                                                    {"B", ExrLayer::radiance, 2},
                                                    {"depth.Z", ExrLayer::depth, 0},
@@ -138,7 +147,10 @@ constexpr std::array<ExrChannel, 14> kExrChannels{{{"R", ExrLayer::radiance, 0},
                                                    {"samples", ExrLayer::samples, 0},
                                                    {"variance.R", ExrLayer::variance, 0},
                                                    {"variance.G", ExrLayer::variance, 1},
-                                                   {"variance.B", ExrLayer::variance, 2}}};
+                                                   {"variance.B", ExrLayer::variance, 2},
+                                                   {"raw.R", ExrLayer::raw, 0},
+                                                   {"raw.G", ExrLayer::raw, 1},
+                                                   {"raw.B", ExrLayer::raw, 2}}};
 
 // The vector holding a float layer (samples, the one 32-bit unsigned layer, has none).
 std::vector<float>* float_layer(HdrImage& image, ExrLayer layer) {
@@ -148,6 +160,7 @@ std::vector<float>* float_layer(HdrImage& image, ExrLayer layer) {
         case ExrLayer::albedo: return &image.albedo;
         case ExrLayer::normal: return &image.normal;
         case ExrLayer::variance: return &image.variance;
+        case ExrLayer::raw: return &image.raw;
         case ExrLayer::samples: return nullptr;
     }
     return nullptr;
@@ -168,7 +181,8 @@ std::string encode_exr(const HdrImage& image) {
     header.compression() = Imf::ZIP_COMPRESSION;
     Imf::addComments(header, "keithray render: mean radiance in R,G,B; depth.Z is the primary hit distance "
                              "(1e6 where the ray missed); albedo and normal of the first non-specular hit; "
-                             "samples per pixel; variance of the mean per channel");
+                             "samples per pixel; variance of the mean per channel" +
+                                 std::string(image.raw.empty() ? "" : "; R,G,B denoised, raw.R/G/B before"));
     Imf::FrameBuffer frame;
     const size_t width = size_t(image.width);
     for (const ExrChannel& ch : kExrChannels) {
@@ -195,8 +209,19 @@ std::string encode_exr(const HdrImage& image) {
     return stream.take();
 }
 
+namespace {
+
+std::runtime_error out_of_memory(const std::string& name, int64_t width, int64_t height) {
+    return std::runtime_error("not enough memory for " + quoted_path(name) + ", a " + std::to_string(width) + "x" +
+                              std::to_string(height) + " image");
+}
+
+}  // namespace
+
 HdrImage decode_exr(const std::string& bytes, const std::string& name) {
     HdrImage out;
+    // OpenEXR passes an allocation failure on inside its own exceptions, with the name in the text.
+    auto allocation_failed = [](const std::string& what) { return what.find("bad_alloc") != std::string::npos; };
     try {
         StringIStream stream(bytes);
         Imf::InputFile file(stream);
@@ -214,7 +239,7 @@ HdrImage decode_exr(const std::string& bytes, const std::string& name) {
         out.height = int(h);
         const size_t n = out.pixel_count();
         const Imf::ChannelList& channels = file.header().channels();
-        std::array<int, 6> found{};  // channels present per layer
+        std::array<int, 7> found{};  // channels present per layer
         for (const ExrChannel& ch : kExrChannels)
             if (channels.findChannel(ch.name)) ++found[size_t(ch.layer)];
         if (found[size_t(ExrLayer::radiance)] != 3) fail(name, "expected the channels R, G and B of an RGB radiance image");
@@ -240,11 +265,15 @@ HdrImage decode_exr(const std::string& bytes, const std::string& name) {
         file.setFrameBuffer(frame);
         if (!file.isComplete()) fail(name, "the file is truncated (pixel data missing)");
         file.readPixels(window.min.y, window.max.y);
+    } catch (const std::bad_alloc&) {
+        throw out_of_memory(name, out.width, out.height);
     } catch (const std::runtime_error& e) {
         const std::string what = e.what();
         if (what.rfind(name + ": ", 0) == 0) throw;
+        if (allocation_failed(what)) throw out_of_memory(name, out.width, out.height);
         fail(name, "not a readable OpenEXR image: " + one_line(what));
     } catch (const std::exception& e) {
+        if (allocation_failed(e.what())) throw out_of_memory(name, out.width, out.height);
         fail(name, "not a readable OpenEXR image: " + one_line(e.what()));
     }
     return out;
@@ -320,16 +349,20 @@ HdrImage decode_pfm(const std::string& bytes, const std::string& name) {
     out.width = int(w);
     out.height = int(h);
     const size_t n = out.pixel_count();
-    std::vector<float> values(row * size_t(h));
-    for (long long y = 0; y < h; ++y)  // bottom row first in the file
-        std::memcpy(values.data() + size_t(y) * row, bytes.data() + pos + size_t(h - 1 - y) * row * sizeof(float),
-                    row * sizeof(float));
-    if (channels == 3) {
-        out.rgb = std::move(values);
-    } else {
-        out.rgb.resize(3 * n);
-        for (size_t i = 0; i < n; ++i) out.rgb[3 * i] = out.rgb[3 * i + 1] = out.rgb[3 * i + 2] = values[i];
-        out.depth = std::move(values);
+    try {
+        std::vector<float> values(row * size_t(h));
+        for (long long y = 0; y < h; ++y)  // bottom row first in the file
+            std::memcpy(values.data() + size_t(y) * row, bytes.data() + pos + size_t(h - 1 - y) * row * sizeof(float),
+                        row * sizeof(float));
+        if (channels == 3) {
+            out.rgb = std::move(values);
+        } else {
+            out.rgb.resize(3 * n);
+            for (size_t i = 0; i < n; ++i) out.rgb[3 * i] = out.rgb[3 * i + 1] = out.rgb[3 * i + 2] = values[i];
+            out.depth = std::move(values);
+        }
+    } catch (const std::bad_alloc&) {
+        throw out_of_memory(name, w, h);
     }
     return out;
 }
@@ -338,36 +371,21 @@ namespace {
 
 constexpr char kExrMagic[4] = {0x76, 0x2f, 0x31, 0x01};
 
-std::string read_whole_file(const std::filesystem::path& path) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) throw std::runtime_error(quoted_path(path) + ": not a readable file");
-    const uintmax_t size = std::filesystem::file_size(path, ec);
-    // The largest file an image within the limits could need, with room for headers.
-    if (ec || size > kMaxHdrPixels * 64 + (1u << 20))
-        throw std::runtime_error(quoted_path(path) + ": not a readable file of a plausible image size");
-    std::ifstream f(path, std::ios::binary);
-    if (!f) throw std::runtime_error(quoted_path(path) + ": cannot open");
-    std::string bytes(size_t(size), '\0');
-    f.read(bytes.data(), std::streamsize(size));
-    if (f.gcount() != std::streamsize(size)) throw std::runtime_error(quoted_path(path) + ": cannot read");
-    return bytes;
-}
-
 }  // namespace
 
-bool is_hdr_file(const std::filesystem::path& path) {
-    std::ifstream f(path, std::ios::binary);
-    char magic[4] = {};
-    if (!f.read(magic, 4)) return false;
-    return std::memcmp(magic, kExrMagic, 4) == 0 || (magic[0] == 'P' && (magic[1] == 'F' || magic[1] == 'f'));
+bool is_hdr_bytes(const std::string& bytes) {
+    return bytes.size() >= 4 && (std::memcmp(bytes.data(), kExrMagic, 4) == 0 ||
+                                 (bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f')));
 }
 
 HdrImage read_hdr(const std::filesystem::path& path) {
-    const std::string bytes = read_whole_file(path);
-    if (bytes.size() >= 4 && std::memcmp(bytes.data(), kExrMagic, 4) == 0) return decode_exr(bytes, path.string());
-    if (bytes.size() >= 2 && bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f'))
-        return decode_pfm(bytes, path.string());
-    throw std::runtime_error(quoted_path(path) + ": not an OpenEXR or PFM image");
+    return decode_hdr(read_image_bytes(path, kMaxHdrFileBytes), path.string());
+}
+
+HdrImage decode_hdr(const std::string& bytes, const std::string& name) {
+    if (bytes.size() >= 4 && std::memcmp(bytes.data(), kExrMagic, 4) == 0) return decode_exr(bytes, name);
+    if (bytes.size() >= 2 && bytes[0] == 'P' && (bytes[1] == 'F' || bytes[1] == 'f')) return decode_pfm(bytes, name);
+    throw std::runtime_error(quoted_path(name) + ": not an OpenEXR or PFM image");
 }
 
 }  // namespace kr

@@ -53,9 +53,11 @@ void check_dimensions(const fs::path& path, uint64_t width, uint64_t height) {
                                    " pixels are read");
 }
 
-// The whole file, at most kMaxImageFileBytes of it. Pipes and other streams are read up to
+}  // namespace
+
+// The whole file, at most `limit` bytes of it. Pipes and other streams are read once, up to
 // the same limit.
-std::string read_bounded(const fs::path& path) {
+std::string read_image_bytes(const fs::path& path, uint64_t limit) {
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw read_error(path, std::error_code(errno, std::generic_category()).message());
     struct Closer {
@@ -64,9 +66,9 @@ std::string read_bounded(const fs::path& path) {
     } closer{fd};
     struct stat st {};
     if (::fstat(fd, &st) != 0 || S_ISDIR(st.st_mode)) throw read_error(path, "expected an image file, got a folder");
-    if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > kMaxImageFileBytes)
+    if (S_ISREG(st.st_mode) && uint64_t(st.st_size) > limit)
         throw read_error(path, "the file is " + std::to_string(st.st_size) + " bytes; at most " +
-                                   std::to_string(kMaxImageFileBytes) + " are read");
+                                   std::to_string(limit) + " are read");
     std::string bytes;
     try {
         if (S_ISREG(st.st_mode)) bytes.reserve(size_t(st.st_size));
@@ -76,16 +78,19 @@ std::string read_bounded(const fs::path& path) {
             if (n < 0 && errno == EINTR) continue;
             if (n < 0) throw read_error(path, std::error_code(errno, std::generic_category()).message());
             if (n == 0) break;
-            if (bytes.size() + size_t(n) > kMaxImageFileBytes)
-                throw read_error(path, "more than " + std::to_string(kMaxImageFileBytes) + " bytes; that many are read at most");
+            if (bytes.size() + size_t(n) > limit)
+                throw read_error(path, "more than " + std::to_string(limit) + " bytes; that many are read at most");
             bytes.append(chunk, size_t(n));
         }
     } catch (const std::bad_alloc&) {
-        throw std::runtime_error("not enough memory for " + quoted_path(path) + " (" + std::to_string(st.st_size) +
+        throw std::runtime_error("not enough memory for " + quoted_path(path) + " (" +
+                                 std::to_string(S_ISREG(st.st_mode) ? uint64_t(st.st_size) : uint64_t(bytes.size())) +
                                  " bytes)");
     }
     return bytes;
 }
+
+namespace {
 
 Rgb8Image decode_ppm(const fs::path& path, const std::string& file) {
     // Header: magic, width, height, maxval, separated by whitespace and comments; then one
@@ -207,11 +212,15 @@ void write_ppm(const fs::path& path, const Rgb8Image& image) { write_file_atomic
 void write_png(const fs::path& path, const Rgb8Image& image) { write_file_atomic(path, encode_png(image)); }
 void write_image(const fs::path& path, const Rgb8Image& image) { write_file_atomic(path, encode_image(path, image)); }
 
-Rgb8Image read_ppm(const fs::path& path) { return decode_ppm(path, read_bounded(path)); }
+Rgb8Image read_ppm(const fs::path& path) { return decode_ppm(path, read_image_bytes(path)); }
 
-Rgb8Image read_image(const fs::path& path) {
+Rgb8Image read_image(const fs::path& path) { return decode_image(path, read_image_bytes(path)); }
+
+Rgb8Image decode_image(const fs::path& path, const std::string& file) {
     // By content, not by name: a binary PPM starts with "P6", a PNG with its signature.
-    const std::string file = read_bounded(path);
+    if (file.size() > kMaxImageFileBytes)
+        throw read_error(path, "the file is " + std::to_string(file.size()) + " bytes; at most " +
+                                   std::to_string(kMaxImageFileBytes) + " are read");
     if (file.compare(0, 2, "P6") == 0) return decode_ppm(path, file);
     if (file.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0) return decode_png(path, file);
     throw read_error(path, "not a binary PPM (P6) or PNG image");

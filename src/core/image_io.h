@@ -38,5 +38,9 @@ void write_image(const std::filesystem::path& path, const Rgb8Image& image);  //
 // the file's name. Throw std::runtime_error naming the file.
 Rgb8Image read_ppm(const std::filesystem::path& path);
 Rgb8Image read_image(const std::filesystem::path& path);
+// The two steps of read_image: the file's bytes, read once (a pipe or FIFO too, up to
+// `limit`; a regular file larger than it is refused by its size), and the image they hold.
+std::string read_image_bytes(const std::filesystem::path& path, uint64_t limit = kMaxImageFileBytes);
+Rgb8Image decode_image(const std::filesystem::path& path, const std::string& bytes);
 
 }  // namespace kr

@@ -66,6 +66,13 @@ MemoryLimit memory_limit() {
     return limit;
 }
 
+std::string memory_shortfall(uint64_t needed, const std::string& what) {
+    const MemoryLimit limit = memory_limit();
+    if (needed <= limit.bytes) return "";
+    return "not enough memory for " + what + ": it needs about " + format_bytes(needed) + ", above " + limit.what +
+           " (" + format_bytes(limit.bytes) + ")";
+}
+
 std::string format_bytes(uint64_t bytes) {
     const char* units[] = {"B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
     double value = double(bytes);

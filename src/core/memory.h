@@ -18,6 +18,11 @@ struct MemoryLimit {
 // machine may wait for it.
 MemoryLimit memory_limit();
 
+// "" when `needed` bytes fit within memory_limit(), else the one message render and the
+// viewer give: "not enough memory for WHAT: it needs about 274.0 GiB, above physical
+// memory (15.5 GiB)".
+std::string memory_shortfall(uint64_t needed, const std::string& what);
+
 // "512 B", "3.2 MiB", "47.9 GiB".
 std::string format_bytes(uint64_t bytes);
 

@@ -43,6 +43,23 @@ bool needs_escape(uint32_t c) {
 
 }  // namespace
 
+std::string utf8_escaped(std::string_view text) {
+    std::string out;
+    for (size_t i = 0; i < text.size();) {
+        uint32_t c = 0;
+        const size_t length = utf8_length(text, i, c);
+        if (length) {
+            out.append(text.substr(i, length));
+            i += length;
+            continue;
+        }
+        char escape[8];
+        std::snprintf(escape, sizeof escape, "\\x%02X", static_cast<unsigned char>(text[i++]));
+        out += escape;
+    }
+    return out;
+}
+
 std::string quote_user_text(std::string_view text, size_t max_bytes) {
     std::string out = "\"";
     size_t i = 0;

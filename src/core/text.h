@@ -23,4 +23,8 @@ std::string quote_user_text(std::string_view text, size_t max_bytes = kQuotedTex
 // JSON pointer reads as it always did), else quote_user_text(text, max_bytes).
 std::string show_user_text(std::string_view text, size_t max_bytes = 2 * kQuotedTextBytes);
 
+// `text` as valid UTF-8 for a file that must hold it (a JSON string): every byte that is not
+// part of well-formed UTF-8 written as the four characters \xHH, the rest kept as it is.
+std::string utf8_escaped(std::string_view text);
+
 }  // namespace kr

@@ -1,12 +1,52 @@
 #include "render/aov.h"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "render/material.h"
 #include "render/path.h"
 #include "render/trace.h"
 
 namespace kr {
+
+FirstSurface first_surface(const RenderScene& scene, Ray ray, int max_chain) {
+    FirstSurface out;
+    Color tint(1.0);
+    for (int chain = 0; chain <= max_chain; ++chain) {
+        Hit hit;
+        if (!scene.intersects(ray, hit)) break;
+        const Material& m = scene.materials[size_t(scene.sphere_material[size_t(hit.sphere)])];
+        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
+        // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
+        // unless it totally reflects (by the material's lobes, vertex.inc).
+        const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
+        if (!lobes.smooth && !lobes.rough) {
+            Vec3 next;
+            if (!lobes.fresnel_split) {
+                next = ray.d - 2 * dot(ray.d, sp.ns()) * sp.ns();
+                tint *= m.rho;
+            } else {
+                const DielectricSplit split = split_dielectric(m, sp, ray.d);
+                const bool reflect = split.reflectance >= 1;
+                next = reflect ? split.reflected : split.transmitted;
+                tint *= reflect ? m.rho_r : m.rho_t;
+            }
+            respawn(ray, hit, normalize(next));
+            continue;
+        }
+        Color albedo = m.rho;
+        if (lobes.fresnel_split) {
+            const double r = split_dielectric(m, sp, ray.d).reflectance;
+            albedo = m.rho_r * r + m.rho_t * (1 - r);
+        }
+        out.albedo = tint * albedo;
+        out.normal = sp.ns();
+        out.hit = true;
+        break;
+    }
+    return out;
+}
 
 SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int height, int max_chain) {
     SurfaceLayers out;
@@ -22,40 +62,49 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
             Ray ray;
             ray.o = cr.origin;
             ray.d = cr.direction;
-            Color tint(1.0);
-            for (int chain = 0; chain <= max_chain; ++chain) {
-                Hit hit;
-                if (!scene.intersects(ray, hit)) break;
-                const Material& m = scene.materials[size_t(scene.sphere_material[size_t(hit.sphere)])];
-                const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
-                const size_t i = size_t(y) * size_t(width) + size_t(x);
-                // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
-                // unless it totally reflects (by the material's lobes, vertex.inc).
-                const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
-                if (!lobes.smooth && !lobes.rough) {
-                    Vec3 next;
-                    if (!lobes.fresnel_split) {
-                        next = ray.d - 2 * dot(ray.d, sp.ns()) * sp.ns();
-                        tint *= m.rho;
-                    } else {
-                        const DielectricSplit split = split_dielectric(m, sp, ray.d);
-                        const bool reflect = split.reflectance >= 1;
-                        next = reflect ? split.reflected : split.transmitted;
-                        tint *= reflect ? m.rho_r : m.rho_t;
-                    }
-                    respawn(ray, hit, normalize(next));
-                    continue;
-                }
-                Color albedo = m.rho;
-                if (lobes.fresnel_split) {
-                    const double r = split_dielectric(m, sp, ray.d).reflectance;
-                    albedo = m.rho_r * r + m.rho_t * (1 - r);
-                }
-                out.albedo[i] = tint * albedo;
-                out.normal[i] = sp.ns();
-                break;
-            }
+            const FirstSurface s = first_surface(scene, ray, max_chain);
+            const size_t i = size_t(y) * size_t(width) + size_t(x);
+            out.albedo[i] = s.albedo;
+            out.normal[i] = s.normal;
         }
+    return out;
+}
+
+SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                                      int samples) {
+    SurfaceLayers out;
+    const size_t n = size_t(width) * size_t(height);
+    out.albedo.assign(n, Color());
+    out.normal.assign(n, Color());
+    samples = std::clamp(samples, 1, kSampleBatch);
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int y = 0; y < height; ++y) {
+        std::optional<Sampler> samplers[kSampleBatch];
+        Sampler* pointers[kSampleBatch];
+        int xs[kSampleBatch], ys[kSampleBatch];
+        Ray rays[kSampleBatch];
+        for (int x = 0; x < width; ++x) {
+            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+            // The pixel's first camera samples, made as render_pass makes them.
+            for (int k = 0; k < samples; ++k) {
+                pointers[k] = settings.estimator == Estimator::sobol
+                                  ? &samplers[k].emplace(Sampler::pixel_key(settings.seed, pixel), uint32_t(k))
+                                  : &samplers[k].emplace(settings.estimator, settings.seed, pixel, uint32_t(k),
+                                                         settings.target_spp);
+                xs[k] = x;
+                ys[k] = y;
+            }
+            camera_rays(scene, settings, width, height, xs, ys, pointers, samples, rays);
+            Color albedo, normal;
+            for (int k = 0; k < samples; ++k) {
+                const FirstSurface s = first_surface(scene, rays[k]);
+                albedo += s.albedo;
+                normal += s.normal;
+            }
+            out.albedo[pixel] = albedo / double(samples);
+            out.normal[pixel] = normal / double(samples);
+        }
+    }
     return out;
 }
 

@@ -1,24 +1,41 @@
-// The first-surface layers (AOVs) of an HDR output: albedo and normal of the first
-// non-specular hit. The other layers come from the render's state (render/outputs.h).
+// The first-surface layers (AOVs): albedo and normal of the first non-specular hit, for an
+// HDR output and as the denoiser's feature buffers. The other layers come from the render's
+// state (render/outputs.h).
 #pragma once
 
 #include <vector>
 
 #include "core/math.h"
 #include "render/render_scene.h"
+#include "render/settings.h"
 
 namespace kr {
 
-// Albedo and unit normal of the first non-specular surface each pixel's centre sees (its
-// camera ray through the lens centre): perfect mirrors and sharp dielectrics are followed,
-// up to `max_chain` of them, reflecting or (where it does not totally reflect) refracting,
-// and their tint multiplies the albedo. A diffuse or glossy surface gives its rho, a
-// translucent (rough) dielectric its Fresnel-weighted rhoR and rhoT. The normal faces the
-// incoming ray, in world space. Misses (and chains cut off) give zero for both.
-// One ray chain per pixel, parallel over rows: a small fraction of one render pass.
+// Albedo and unit normal of the first non-specular surface a ray meets: perfect mirrors and
+// sharp dielectrics are followed, up to `max_chain` of them, reflecting or (where it does not
+// totally reflect) refracting, and their tint multiplies the albedo. A diffuse or glossy
+// surface gives its rho, a translucent (rough) dielectric its Fresnel-weighted rhoR and rhoT.
+// The normal faces the incoming ray, in world space. A miss (or a chain cut off) gives zero
+// for both and hit = false.
+struct FirstSurface {
+    Color albedo, normal;
+    bool hit = false;
+};
+FirstSurface first_surface(const RenderScene& scene, Ray ray, int max_chain = 16);
+
+// The layers of every pixel: first_surface of the pixel centre's camera ray through the lens
+// centre. One ray chain per pixel, parallel over rows: a small fraction of one render pass.
 struct SurfaceLayers {
     std::vector<Color> albedo, normal;
 };
 SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int height, int max_chain = 16);
+
+// The layers averaged over `samples` camera rays per pixel, drawn as the pixel's first
+// `samples` camera samples are (settings' estimator and seed: the same sub-pixel and lens
+// positions), so anti-aliased edges and depth of field come out as in the radiance. The
+// normals are averaged, not renormalised: a pixel half on a sphere and half on nothing has a
+// normal of length 1/2. The denoiser's feature buffers; parallel over rows.
+SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                                      int samples);
 
 }  // namespace kr

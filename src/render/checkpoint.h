@@ -27,8 +27,10 @@ inline constexpr uint32_t kCheckpointVersion = 2;
 
 // What a checkpoint must match to be resumed: the scene (a fingerprint of its canonical JSON
 // without the output path and display block, which do not change the samples), the settings
-// and stop rule that shape the samples (as "name=value" words, so a refusal names the one that
-// differs), and the image size.
+// and stop rule that shape the samples, the pass limit included (an open-ended render's
+// implicit cap too, so one resumed without its --time or --noise is refused rather than
+// ending elsewhere), as "name=value" words so that a refusal names the one that differs,
+// and the image size. The time limit is not in it: more time goes on to the same samples.
 struct CheckpointKey {
     uint64_t scene = 0;
     std::string settings;

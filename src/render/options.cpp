@@ -45,8 +45,9 @@ constexpr SharedFlag number_flag(std::string_view name, std::string_view value, 
 }
 
 template <const auto& Names, auto Member>
-constexpr SharedFlag name_flag(std::string_view name, std::string_view help) {
-    return {name, "NAME", FlagKind::name, 0, 0, false, name_choices<Names>, help, read_name<Names, Member>};
+constexpr SharedFlag name_flag(std::string_view name, std::string_view help, std::string_view bare = {}) {
+    return {name, bare.empty() ? "NAME" : "[NAME]", FlagKind::name, 0, 0, false, name_choices<Names>, help,
+            read_name<Names, Member>, bare};
 }
 
 using O = RenderOptions;
@@ -79,6 +80,12 @@ const std::array kFlags{
     number_flag<&O::exposure>("--exposure", "EV", -kMaxExposureStops, kMaxExposureStops, false,
                               "exposure in stops, in %r: radiance x 2^EV before the tone map (default: the "
                               "scene's \"display\" block, else 0)"),
+    name_flag<denoise_names, &O::denoise>(
+        "--denoise", "%r: the edge-avoiding a-trous filter on the image, guided by albedo, normal and depth "
+                     "(biased: compare --statistical tests raw images; an .exr keeps the raw radiance as raw.R/G/B; "
+                     "docs/denoising.md); given alone (last, or before a flag or a .json): on (default: off for render, on for "
+                     "view's display)",
+        "on"),
 };
 
 // Help lines: the flag and its value in a 22-column field, the text wrapped at 90 columns.
@@ -124,7 +131,11 @@ std::span<const SharedFlag> shared_flags() { return kFlags; }
 bool read_shared_flag(ArgCursor& args, RenderOptions& options) {
     for (const SharedFlag& flag : kFlags)
         if (args.arg() == flag.name) {
-            flag.read(flag, args.value(), options);
+            // A flag with a bare value stands alone before another flag or a scene file (.json).
+            const char* peek = args.peek();
+            const std::string next = peek ? peek : "";
+            const bool alone = !peek || next.starts_with('-') || (next.size() > 5 && next.ends_with(".json"));
+            flag.read(flag, flag.bare.empty() || !alone ? args.value() : std::string(flag.bare), options);
             return true;
         }
     return false;

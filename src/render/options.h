@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "core/args.h"
+#include "render/denoise.h"
 #include "render/settings.h"
 #include "render/stop_rule.h"
 #include "scene/scene.h"
@@ -28,6 +29,7 @@ struct RenderOptions {
     std::optional<LightSampling> light_sampling;
     std::optional<ToneMap> tonemap;
     std::optional<double> exposure;  // EV stops
+    std::optional<Denoise> denoise;  // the develop step's denoiser (render/denoise.h)
     // --time and --noise (0: off); the pass limit comes from --spp or the file.
     StopRule stop;
 };
@@ -47,6 +49,9 @@ struct SharedFlag {
     std::string_view help;
     // Reads `text` (already checked against the range) into its member of `options`.
     void (*read)(const SharedFlag& flag, const std::string& text, RenderOptions& options) = nullptr;
+    // Name flags: the value of the flag given alone (last, or before another flag or a scene
+    // file); empty: the flag needs a value.
+    std::string_view bare = {};
 
     // "1..16777216", "(0, 1000000]", "wrt | pt | pt-naive".
     std::string range_text() const;

@@ -14,7 +14,7 @@ namespace {
 std::vector<float> floats(const std::vector<Color>& values) {
     std::vector<float> out(3 * values.size());
     for (size_t i = 0; i < values.size(); ++i)
-        for (int k = 0; k < 3; ++k) out[3 * i + size_t(k)] = float(values[i][k]);
+        for (int k = 0; k < 3; ++k) out[3 * i + size_t(k)] = stored_float(values[i][k]);
     return out;
 }
 
@@ -35,16 +35,39 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
     return out;
 }
 
+unsigned develop_reads(const DevelopOptions& options) {
+    return options.denoise != Denoise::off ? unsigned(kLayerDepth | kLayerVariance) : 0u;
+}
+
 Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,
                   unsigned layers) {
     Developed out;
     const int width = estimates.radiance.width, height = estimates.radiance.height;
     out.radiance = options.blur > 0 ? box_blur(estimates.radiance, options.blur) : std::move(estimates.radiance);
+    if (options.denoise != Denoise::off) {
+        if (estimates.albedo.empty() || estimates.normal.empty()) {
+            const SurfaceLayers features =
+                averaged_surface_layers(scene, options.sampling, width, height, kFeatureSamples);
+            estimates.albedo = floats(features.albedo);
+            estimates.normal = floats(features.normal);
+        }
+        DenoiseInput input;
+        input.radiance = &out.radiance;
+        input.variance = estimates.variance;
+        input.albedo = estimates.albedo;
+        input.normal = estimates.normal;
+        input.depth = estimates.depth;
+        Image denoised = denoise_atrous(input, {}, options.workspace);
+        out.raw = std::exchange(out.radiance, std::move(denoised));
+        // An output with first-surface layers keeps the feature buffers the denoiser read.
+        if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);
+        if (layers & kLayerNormal) out.normal = std::move(estimates.normal);
+    }
     if (layers & kLayerDepth) out.depth = std::move(estimates.depth);
     if (layers & kLayerSamples) out.samples = std::move(estimates.samples);
     // The variance belongs to the mean, not to its blurred picture.
     if ((layers & kLayerVariance) && options.blur == 0) out.variance = std::move(estimates.variance);
-    if (layers & (kLayerAlbedo | kLayerNormal)) {
+    if ((layers & (kLayerAlbedo | kLayerNormal)) && options.denoise == Denoise::off) {
         const SurfaceLayers surface = first_surface_layers(scene, width, height);
         if (layers & kLayerAlbedo) out.albedo = floats(surface.albedo);
         if (layers & kLayerNormal) out.normal = floats(surface.normal);
@@ -54,11 +77,12 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
 
 HdrImage hdr_from_developed(Developed image) {
     HdrImage out = hdr_from_radiance(image.radiance);
-    out.depth.assign(image.depth.begin(), image.depth.end());
+    out.depth = stored_floats(image.depth);
     out.albedo = std::move(image.albedo);
     out.normal = std::move(image.normal);
     out.samples = std::move(image.samples);
     out.variance = std::move(image.variance);
+    if (!image.raw.pixels.empty()) out.raw = floats(image.raw.pixels);
     return out;
 }
 
@@ -85,7 +109,7 @@ std::vector<FileOutput> encode_outputs(const std::filesystem::path& path, Develo
         break;
     case ImageFormat::pfm:
         files.push_back({path, encode_pfm_rgb(hdr_from_radiance(image.radiance))});
-        files.push_back({depth_file, encode_pfm_gray(std::vector<float>(image.depth.begin(), image.depth.end()),
+        files.push_back({depth_file, encode_pfm_gray(stored_floats(image.depth),
                                                      width, height)});
         break;
     }
@@ -98,7 +122,7 @@ std::vector<FileOutput> output_files(const RenderScene& scene, RenderEstimates e
 }
 
 std::vector<FileOutput> output_files(const RenderScene& scene, const RenderState& state, const OutputRequest& request) {
-    return output_files(scene, render_estimates(state, layers_for(request)), request);
+    return output_files(scene, render_estimates(state, layers_for(request) | develop_reads(request.develop)), request);
 }
 
 }  // namespace kr

@@ -13,6 +13,7 @@
 #include "core/file_write.h"
 #include "core/image.h"
 #include "core/image_formats.h"
+#include "render/denoise.h"
 #include "render/progressive.h"
 #include "render/render_scene.h"
 #include "scene/scene.h"
@@ -27,6 +28,10 @@ struct RenderEstimates {
     std::vector<double> depth;      // the mean primary hit distance
     std::vector<uint32_t> samples;  // samples per pixel
     std::vector<float> variance;    // 3 per pixel: the variance of the mean radiance
+    // The denoiser's feature buffers (render/aov.h averaged_surface_layers), where the caller
+    // keeps them (the viewer's render thread makes them once per edit); develop makes them
+    // when it denoises and they are empty.
+    std::vector<float> albedo, normal;  // 3 per pixel
 };
 // The estimates of `state` for the layers `layers` asks for (RenderLayer bits).
 RenderEstimates render_estimates(const RenderState& state, unsigned layers);
@@ -35,7 +40,18 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers);
 // normal layers) is one more option here and one more step in develop().
 struct DevelopOptions {
     int blur = 0;  // box blur radius of the radiance (0: none)
+    // The denoiser (render/denoise.h), after the blur; it reads the depth and the variance and
+    // the feature buffers.
+    Denoise denoise = Denoise::off;
+    // The render's settings: the feature buffers' camera samples are drawn as its are.
+    RenderSettings sampling;
+    // The denoiser's planes, where the caller keeps them between develops (the viewer).
+    DenoiseWorkspace* workspace = nullptr;
 };
+// The feature buffers' camera samples per pixel (render/aov.h averaged_surface_layers).
+inline constexpr int kFeatureSamples = 8;
+// The layers develop reads for `options` besides those of its output.
+unsigned develop_reads(const DevelopOptions& options);
 
 // A developed render: the images an output's files are encoded from. Empty layers are absent.
 struct Developed {
@@ -45,9 +61,11 @@ struct Developed {
     std::vector<float> normal;     // 3 per pixel
     std::vector<uint32_t> samples;
     std::vector<float> variance;   // 3 per pixel; left out when blurred (not the blurred mean's)
+    Image raw;                     // denoised: the radiance before the denoiser (after the blur)
 };
 // Develops `estimates` of a render of `scene` into `layers` (RenderLayer bits): blurs the
-// radiance, traces the first-surface layers where asked, and drops the variance of a
+// radiance, denoises it, traces the first-surface layers where asked (when denoised: the
+// feature buffers, averaged over each pixel's camera samples), and drops the variance of a
 // blurred radiance.
 Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,
                   unsigned layers = kAllLayers);

@@ -22,7 +22,9 @@ bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* canc
     const auto start = std::chrono::steady_clock::now();
     state_.plan_pass(settings_);
     if (hooks_) hooks_->before_pass(state_);
+    state_.begin_half_pass();
     if (!render_pass(scene_, settings_, state_, cancel)) return false;
+    state_.end_half_pass();
     const bool noise_check = noise_check_due(rule, state_.passes);
     if (hooks_) hooks_->after_pass(state_, noise_check || plan_reads_statistics(settings_, state_));
     if (noise_check) noise_met_ = noise_target_met(state_, rule);

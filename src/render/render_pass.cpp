@@ -58,7 +58,7 @@ struct PixelSums {
         double* lost = &compensation[i].x;
         store_pair(lost, load_pair(lost) + two_sum_error(sum_xy, x_xy, t_xy));
         lost[2] += two_sum_error(sum_z, x_z, t_z);
-        depth[i] += std::min(r.primary_distance, kMissDepth);
+        depth[i] += r.primary_distance;  // kMissDepth for a miss; a farther hit stays farther
         const double lum = luminance(r.radiance);
         luminance_sq[i] += lum * lum;
         double* sq = &radiance_sq[i].x;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/denoise.h"
 #include "render/trace.h"
 
 namespace kr {
@@ -26,11 +27,47 @@ void RenderState::reset(int w, int h) {
     px_.sample_credit.clear();
     for (auto& scratch : px_.allocation_scratch) scratch.clear();
     px_.sobol_keys.clear();
+    if (tracks_halves()) track_halves();
 }
 
-uint64_t render_memory_bytes(int width, int height, bool blurred) {
+void RenderState::track_halves() {
+    const size_t n = px_.sample_count.size();
+    px_.half_sum.assign(n, Color());
+    px_.half_count.assign(n, 0);
+}
+
+void RenderState::add_sums_to_half(int sign) {
+    if (!tracks_halves()) return;
+    const long n = long(px_.half_sum.size());
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) {
+        px_.half_sum[size_t(i)] += double(sign) * (px_.radiance_sum[size_t(i)] + px_.radiance_compensation[size_t(i)]);
+        px_.half_count[size_t(i)] += uint32_t(sign) * px_.sample_count[size_t(i)];  // modulo 2^32, exact
+    }
+}
+
+RenderState::Halves RenderState::halves() const {
+    Halves out;
+    for (int h = 0; h < 2; ++h) {
+        out.mean[h] = Image(width, height);
+        out.count[h].assign(px_.sample_count.size(), 0);
+    }
+    if (!tracks_halves()) return out;
+    for (size_t i = 0; i < px_.sample_count.size(); ++i) {
+        const uint32_t odd = std::min(px_.half_count[i], px_.sample_count[i]), even = px_.sample_count[i] - odd;
+        const Color total = px_.radiance_sum[i] + px_.radiance_compensation[i];
+        out.count[0][i] = even;
+        out.count[1][i] = odd;
+        if (odd) out.mean[1].pixels[i] = px_.half_sum[i] / double(odd);
+        if (even) out.mean[0].pixels[i] = (total - px_.half_sum[i]) / double(even);
+    }
+    return out;
+}
+
+uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised) {
     const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
-    const uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
+    uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
+    if (denoised) output += sizeof(Color) + sizeof(uint32_t) + kDenoiseBytesPerPixel;
     return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
 }
 

@@ -39,6 +39,11 @@ struct PixelBuffers {
     // every pass, so render_pass works them out once (empty until a Sobol pass).
     std::vector<uint32_t> sobol_keys;
     uint64_t sobol_keys_seed = 0;
+    // The denoiser's split of each pixel's samples into two independent halves (empty unless
+    // RenderState::track_halves): the compensated radiance sums and the counts of the samples
+    // of odd-numbered passes; the other half is the rest of the pixel's sums.
+    std::vector<Color> half_sum;
+    std::vector<uint32_t> half_count;
 };
 
 class RenderState {
@@ -98,7 +103,27 @@ public:
     // Samples every pixel again (no adaptive mask).
     void clear_adaptive() { px_.active.clear(); }
 
+    // Keeps the two halves of each pixel's samples from the next pass on (PixelBuffers::half_sum).
+    void track_halves();
+    bool tracks_halves() const { return !px_.half_sum.empty(); }
+    // Around a pass (ProgressiveDriver): the samples of a pass after an odd number of passes
+    // go to the half, as the difference of the sums after and before it. A no-op unless
+    // tracking, or for the other passes.
+    void begin_half_pass() {
+        if (passes % 2 == 1) add_sums_to_half(-1);
+    }
+    void end_half_pass() {
+        if (passes % 2 == 0) add_sums_to_half(+1);
+    }
+    // The mean radiance of each half (zero where a half has no sample) and their counts.
+    struct Halves {
+        Image mean[2];
+        std::vector<uint32_t> count[2];
+    };
+    Halves halves() const;
+
 private:
+    void add_sums_to_half(int sign);
     PixelBuffers px_;
 };
 
@@ -113,7 +138,9 @@ inline constexpr uint64_t kRenderStateBytesPerPixel =
 // RenderState, then at the end the mean radiance (and, when blurred, two more radiance images),
 // the mean depth, and the larger output stage: the two 8-bit images and their encoded bytes,
 // or an EXR's 14 float layers and its encoded bytes.
-uint64_t render_memory_bytes(int width, int height, bool blurred);
+// A denoised render adds its halves (render_state), its feature buffers and the denoiser's
+// working images (render/denoise.h: kDenoiseBytesPerPixel).
+uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised = false);
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
 inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean

@@ -13,7 +13,8 @@
 
 namespace kr {
 
-// Distance recorded in the depth map for a primary ray that hits nothing.
+// Distance recorded in the depth map for a primary ray that hits nothing (a hit farther
+// away keeps its own distance, so it is never taken for a miss).
 inline constexpr double kMissDepth = 1e6;
 
 // The camera's image coordinates in [0,1]^2 of a point (x, y) of the raster, where pixel

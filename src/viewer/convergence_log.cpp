@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
+#include "core/text.h"
 
 namespace kr::viewer {
 
@@ -51,7 +52,7 @@ std::string stats_json(const StatsFigures& s) {
     j["elapsed_seconds"] = s.elapsed;
     j["mrays_per_second"] = s.mrays_per_second;
     j["noise"] = s.noise >= 0 && std::isfinite(s.noise) ? nlohmann::ordered_json(s.noise) : nlohmann::ordered_json();
-    if (s.reference) j["reference"] = *s.reference;
+    if (s.reference) j["reference"] = utf8_escaped(*s.reference);  // a file name need not be UTF-8
     if (s.figures) {
         j["psnr"] = s.figures->psnr;
         j["rmse"] = s.figures->rmse;

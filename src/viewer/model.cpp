@@ -73,6 +73,13 @@ void ViewerModel::load_keeping_view(const std::filesystem::path& file) {
 }
 
 void ViewerModel::load(const std::filesystem::path& file) {
+    // The viewer re-reads and watches its scene, and opening a FIFO would block the window:
+    // only a regular file (stat never blocks).
+    std::error_code ec;
+    const std::filesystem::file_status status = std::filesystem::status(file, ec);
+    if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+        throw SceneError(file.string(), "", "not a regular file (a FIFO, a device or a folder); the viewer reads "
+                                            "and watches a regular scene file");
     LoadedScene loaded = load_scene_file(file);
     set_scene(std::move(loaded.scene), std::move(loaded.warnings));
 }

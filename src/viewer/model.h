@@ -24,12 +24,18 @@
 
 namespace kr::viewer {
 
+// The display of the denoiser (render/denoise.h): the raw estimate, the denoised one, or
+// the raw left half beside the denoised right half.
+enum class DenoiseView { off, on, split };
+inline constexpr EnumNames<DenoiseView, 3> denoise_view_names{{"off", "on", "split"}};
+
 struct ViewerSettings {
     RenderSettings render;    // integrator, estimator, light sampling, depth, target spp, seed
     bool unlimited = false;   // keep refining past target_spp
     StopRule stop;            // its time and noise rules (0: off); stop_rule() adds the pass limit
     bool paused = false;
     ToneSettings tone;
+    DenoiseView denoise = DenoiseView::on;  // what the image shows (a display setting, as tone)
 
     // When the estimate stops refining: after target_spp passes (none when unlimited), or
     // by the time or noise rule.

@@ -7,6 +7,8 @@
 #include <sys/syscall.h>
 #include <unistd.h>
 
+#include "core/memory.h"
+#include "render/outputs.h"
 #include "viewer/inspect.h"
 
 namespace kr::viewer {
@@ -130,6 +132,36 @@ void RenderWorker::publish(std::shared_ptr<Snapshot> frame) {
     if (on_publish_) on_publish_();
 }
 
+void RenderWorker::publish_error(uint64_t generation, std::string error) {
+    auto frame = std::make_shared<Snapshot>();
+    frame->generation = generation;
+    frame->finished = true;
+    frame->error = std::move(error);
+    publish(std::move(frame));
+}
+
+namespace {
+
+// The denoised radiance of `state`, developed as `render --denoise` and Save develop it
+// (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
+// state between passes (empty: made here).
+Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
+                        std::vector<float>& normal, DenoiseWorkspace& workspace) {
+    DevelopOptions options;
+    options.workspace = &workspace;
+    options.denoise = Denoise::on;
+    options.sampling = job.settings;
+    RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
+    estimates.albedo = std::move(albedo);
+    estimates.normal = std::move(normal);
+    Developed developed = develop(*job.scene, std::move(estimates), options, kLayerRadiance | kLayerAlbedo | kLayerNormal);
+    albedo = std::move(developed.albedo);
+    normal = std::move(developed.normal);
+    return std::move(developed.radiance);
+}
+
+}  // namespace
+
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
     // window. Linux nice values are per thread, and the team's threads, created by this
@@ -144,6 +176,8 @@ void RenderWorker::run() {
     size_t next_preview = 0;
     double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
+    std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
+    DenoiseWorkspace denoise_planes;    // kept between frames
 
     for (;;) {
         StopRule rule;
@@ -161,7 +195,25 @@ void RenderWorker::run() {
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
-                state.reset(w, h);
+                // The estimate render applies, before allocating (render_state.h).
+                const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
+                if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false, true), "the render of a " + image);
+                    !shortfall.empty()) {
+                    driver.reset();
+                    lock.unlock();
+                    publish_error(job.generation, std::move(shortfall));
+                    continue;
+                }
+                try {
+                    state.reset(w, h);
+                } catch (const std::bad_alloc&) {
+                    driver.reset();
+                    lock.unlock();
+                    publish_error(job.generation, "not enough memory for the render state of a " + image);
+                    continue;
+                }
+                albedo.clear();
+                normal.clear();
                 driver.emplace(*job.scene, job.settings, state, rule_, &region);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
@@ -175,6 +227,9 @@ void RenderWorker::run() {
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
         const auto start = Clock::now();
         auto frame = std::make_shared<Snapshot>();
+        // An allocation that fails here (a preview, a pass's buffers, the frame's copies) is
+        // the window's error, not an abort of the viewer; the job is dropped.
+        try {
         if (next_preview < previews.size()) {
             const int scale = previews[next_preview];
             RenderState preview(scaled(w, scale), scaled(h, scale));
@@ -183,6 +238,10 @@ void RenderWorker::run() {
             ++next_preview;
             frame->scale = scale;
             frame->radiance = preview.radiance();
+            if (denoise_.load()) {
+                std::vector<float> preview_albedo, preview_normal;
+                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal, denoise_planes);
+            }
         } else {
             // A pass stopped early is always an edit's: the next turn starts the new job.
             if (!driver->pass(rule, &stop_)) continue;
@@ -191,6 +250,7 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = state.radiance();
+            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
         }
         frame->generation = job.generation;
         frame->spp = state.passes;
@@ -200,6 +260,12 @@ void RenderWorker::run() {
         frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
         frame->nonfinite_samples = state.nonfinite_samples;
         if (frame->scale == 1) record_pixel_statistics(state, *frame);
+        } catch (const std::bad_alloc&) {
+            driver.reset();
+            publish_error(job.generation, "not enough memory for rendering a " + std::to_string(w) + "x" +
+                                              std::to_string(h) + " image");
+            continue;
+        }
         {
             std::lock_guard lock(mutex_);
             frame->max_passes = rule_.max_passes;

@@ -57,6 +57,7 @@ struct Snapshot {
     uint64_t serial = 0;     // increases with every frame published
     int scale = 1;           // > 1: a preview rendered at 1/scale resolution, shown upscaled
     Image radiance;          // per-pixel mean radiance
+    Image denoised;          // the radiance developed with the denoiser (render/outputs.h); empty when off
     int spp = 0;             // full-resolution passes accumulated (0 for a preview)
     int max_passes = 1;      // the stop rule's pass limit (kUnlimitedPasses: none)
     double seconds = 0;      // render time of this generation so far (pauses excluded)
@@ -74,6 +75,9 @@ struct Snapshot {
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished
+    // Not empty: the job could not be rendered (its state does not fit in memory); the frame
+    // has no image and the worker waits for the next job.
+    std::string error;
 };
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
@@ -106,6 +110,8 @@ public:
     // A render region for the running estimate and the next ones (none: the whole image):
     // only its pixels refine from the next full pass on; the others keep their samples.
     void set_region(std::optional<PixelBox> region);
+    // Whether frames carry the denoised radiance (Snapshot::denoised), from the next frame on.
+    void set_denoise(bool on) { denoise_.store(on); }
 
     // The newest frame (null before the first).
     std::shared_ptr<const Snapshot> latest() const;
@@ -115,6 +121,7 @@ public:
 private:
     void run();
     void publish(std::shared_ptr<Snapshot> frame);
+    void publish_error(uint64_t generation, std::string error);  // a frame with only the error
 
     std::function<void()> on_publish_;
     mutable std::mutex mutex_;
@@ -127,6 +134,7 @@ private:
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};
+    std::atomic<bool> denoise_{true};
     std::thread thread_;  // last: starts after every member above exists
 };
 

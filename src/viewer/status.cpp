@@ -64,4 +64,19 @@ std::optional<std::vector<double>> TypedFields::take(unsigned id) {
     return values;
 }
 
+Image shown_radiance(const Snapshot& frame, DenoiseView view) {
+    const Image& denoised = frame.denoised;
+    if (view == DenoiseView::off || denoised.pixels.size() != frame.radiance.pixels.size()) return frame.radiance;
+    if (view == DenoiseView::on) return denoised;
+    Image out = frame.radiance;
+    for (int y = 0; y < out.height; ++y)
+        for (int x = out.width / 2; x < out.width; ++x) out.at(x, y) = denoised.at(x, y);
+    return out;
+}
+
+std::string_view shown_word(const Snapshot& frame, DenoiseView view) {
+    if (view == DenoiseView::off || frame.denoised.pixels.size() != frame.radiance.pixels.size()) return "raw";
+    return view == DenoiseView::on ? "denoised" : "split";
+}
+
 }  // namespace kr::viewer

@@ -41,6 +41,12 @@ std::string format_noise(double noise);
 // scene has unsaved edits.
 std::string window_title(std::string_view scene_name, const RunStatus& status, bool dirty);
 
+// The image the display shows of `frame` under `view`: its radiance, its denoised radiance
+// (where the worker made one), or the raw left half beside the denoised right half.
+Image shown_radiance(const Snapshot& frame, DenoiseView view);
+// The status bar's word for it: "raw", "denoised" or "split".
+std::string_view shown_word(const Snapshot& frame, DenoiseView view);
+
 // A number being typed into a panel field: keystrokes only change the held value; it is
 // applied once, when the field is left (Enter or focus loss), so typing -20 never applies -2.
 class TypedFields {

@@ -52,6 +52,7 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
         s.stop = options_.render.stop;
+        s.denoise = options_.render.denoise.value_or(Denoise::on) == Denoise::on ? DenoiseView::on : DenoiseView::off;
     });
     try {
         model_.load(options_.scene);
@@ -131,6 +132,7 @@ void ViewerApp::sync_worker() {
     const ViewerSettings& s = model_.settings();
     Submitted& sub = submitted_;
     if (s.paused != sub.paused) worker_->set_paused(sub.paused = s.paused);
+    if ((s.denoise != DenoiseView::off) != sub.denoise) worker_->set_denoise(sub.denoise = s.denoise != DenoiseView::off);
     const StopRule rule = s.stop_rule();
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
@@ -145,11 +147,21 @@ void ViewerApp::sync_worker() {
 
 bool ViewerApp::fetch_frame() {
     std::shared_ptr<const Snapshot> frame = worker_->latest();
-    if (!frame || frame->serial == ui_.shown_serial) return false;
+    const DenoiseView view = model_.settings().denoise;
+    if (!frame || (frame->serial == ui_.shown_serial && view == shown_view_)) return false;
     ui_.shown_serial = frame->serial;
     // A frame of an older generation shows an image the user already changed.
     if (frame->generation != model_.generation()) return false;
-    display_->upload(frame->radiance);
+    if (!frame->error.empty()) {  // the render could not go on (memory): the window says so
+        messages_.show_error(frame->error);
+        if (options_.scripted()) {  // its passes will never come
+            std::fprintf(stderr, "error: %s: %s\n", options_.scene.string().c_str(), frame->error.c_str());
+            failed_ = true;
+            glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        }
+        return false;
+    }
+    display_->upload(shown_radiance(*frame, shown_view_ = view));
     ui_.shown = std::move(frame);
     return true;
 }
@@ -256,12 +268,15 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region);
-    if (line == status_line_) return;
+    if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
         status_line_ = line;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        // Said once; a script waiting on the file would wait in vain, so a scripted run ends.
+        std::fprintf(stderr, "error: --status-file: %s\n", e.what());
+        failed_ = status_file_failed_ = true;
+        if (options_.scripted()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
     }
 }
 
@@ -397,7 +412,7 @@ int ViewerApp::run() {
         }
         glfwPollEvents();
     }
-    return script_.status();
+    return failed_ ? 1 : script_.status();
 }
 
 }  // namespace kr::viewer

@@ -67,13 +67,17 @@ private:
         bool paused = false;
         StopRule stop;
         std::optional<PixelBox> region;
+        bool denoise = true;
     } submitted_;
+    DenoiseView shown_view_ = DenoiseView::on;  // the view of the frame in the texture
 
     // The window.
     bool fullscreen_ = false;
     int windowed_x_ = 0, windowed_y_ = 0, windowed_w_ = 0, windowed_h_ = 0;
     std::string title_;
     std::string status_line_;  // last written to --status-file
+    bool failed_ = false;              // a write of --status-file or a render failed: the run exits 1
+    bool status_file_failed_ = false;  // said once, not tried again
     bool quit_asked_ = false;  // the quit question is wanted
     uint64_t inside_checked_generation_ = 0;  // ui_.inside_sphere is this generation's
     int settle_frames_ = 0;   // frames still to draw after input, so ImGui settles

@@ -19,7 +19,11 @@ int run_viewer(int argc, char** argv) {
     }
     if (options.help) {
         std::fputs(view_usage().c_str(), stdout);
-        return 0;
+        return 0;  // the caller checks that standard output took it
+    }
+    if (const std::string problem = view_files_problem(options); !problem.empty()) {
+        std::fprintf(stderr, "error: %s; nothing opened or written\n", problem.c_str());
+        return 1;
     }
     try {
         ViewerApp app(std::move(options));

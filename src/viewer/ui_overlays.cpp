@@ -76,8 +76,9 @@ void draw_status_bar(PanelContext& ctx) {
     ImGui::AlignTextToFramePadding();
     ImGui::TextColored(kStateColours[size_t(st.state)], "%-9s", std::string(run_state_names.name(st.state)).c_str());
     ImGui::SameLine(90);
-    if (st.unlimited) ImGui::Text("%d spp (unlimited)", st.spp);
-    else ImGui::Text("%d / %d spp", st.spp, st.target);
+    const std::string shown(current ? shown_word(*current, ctx.model.settings().denoise) : "");
+    if (st.unlimited) ImGui::Text("%d spp (unlimited) %s", st.spp, shown.c_str());
+    else ImGui::Text("%d / %d spp %s", st.spp, st.target, shown.c_str());
     ImGui::SameLine(240);
     char overlay[64] = "";
     if (st.progress >= 0) {

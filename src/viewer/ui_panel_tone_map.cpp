@@ -13,6 +13,10 @@ void panel_tone_map(PanelContext& ctx) {
     changed |= field(ctx, "exposure (EV)", &tone.exposure, 1, 0.02f, -kMaxExposureStops, kMaxExposureStops, "%.2f");
     if (tone.tonemap == ToneMap::linear) ImGui::TextDisabled("linear: 2^EV I / max(I)");
     if (changed) ctx.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.tone = tone; }, "tone map", "tone map");
+    // The denoiser's display: raw, denoised, or the two side by side (render/denoise.h).
+    DenoiseView denoise = ctx.model.settings().denoise;
+    if (combo("denoise", denoise, denoise_view_names))
+        ctx.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.denoise = denoise; }, "denoise", "denoise");
 }
 
 }  // namespace kr::viewer

@@ -18,7 +18,8 @@ ScriptRun::ScriptRun(const ViewOptions& options)
     : options_(options), latency_(options.measure_latency), idle_(options.measure_idle), start_(UiClock::now()) {}
 
 bool ScriptRun::start(PanelContext& ctx) {
-    start_ = UiClock::now();
+    // The --timeout clock started with this object, before the scene was loaded and the
+    // window opened: whatever is slow there counts.
     if (!options_.scripted() || !ctx.model.has_scene()) return true;
     // The scripted edits go through the same functions as the mouse and the panels.
     const bool ok = apply_script_edits(options_, ctx.model, [&](Edit kind, const auto& change) { return ctx.edit(kind, change); });

@@ -1,7 +1,9 @@
 #include "viewer/view_options.h"
 
 #include <cmath>
+#include <vector>
 
+#include "core/file_write.h"
 #include "core/image_formats.h"
 #include "core/limits.h"
 #include "viewer/image_view.h"
@@ -126,6 +128,35 @@ ViewOptions parse_view_options(int argc, char** argv) {
 #endif
     }
     return o;
+}
+
+std::string view_files_problem(const ViewOptions& o) {
+    namespace fs = std::filesystem;
+    std::vector<std::pair<const char*, fs::path>> inputs{{"the scene", o.scene}};
+    if (o.reference) inputs.push_back({"--reference", *o.reference});
+    for (const auto& [what, path] : inputs) {
+        std::error_code ec;
+        const fs::file_status status = fs::status(path, ec);  // stat: never blocks, not even on a FIFO
+        if (!ec && fs::exists(status) && !fs::is_regular_file(status))
+            return quoted_path(path) + ": " + what + " is " +
+                   (fs::is_directory(status) ? "a folder" : fs::is_fifo(status) ? "a FIFO" : "not a regular file") +
+                   "; the viewer reads a regular file";
+    }
+    std::vector<std::pair<const char*, fs::path>> outputs;
+    if (o.screenshot) outputs.push_back({"--screenshot", *o.screenshot});
+    if (o.window_shot) outputs.push_back({"--window-shot", *o.window_shot});
+    if (o.save_image)
+        for (const fs::path& file : output_file_paths(*o.save_image)) outputs.push_back({"--save-image", file});
+    if (o.stats_json) outputs.push_back({"--stats-json", *o.stats_json});
+    if (o.status_file) outputs.push_back({"--status-file", *o.status_file});
+    for (const auto& [flag, output] : outputs)
+        for (const auto& [what, input] : inputs)
+            if (same_file(output, input))
+                return std::string(flag) + " " + quoted_path(output) + " would overwrite " + what + " " + quoted_path(input);
+    // Saving the edited scene onto its own file is what Save does; onto the reference it is not.
+    if (o.save_scene && o.reference && same_file(*o.save_scene, *o.reference))
+        return "--save-scene " + quoted_path(*o.save_scene) + " would overwrite --reference " + quoted_path(*o.reference);
+    return "";
 }
 
 std::string view_usage() { return kViewUsageHead + shared_flags_help() + kViewOnlyOptions; }

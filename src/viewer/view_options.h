@@ -49,6 +49,13 @@ struct ViewOptions {
 // A flag only view takes is one line here, one in view_usage() and a member above.
 ViewOptions parse_view_options(int argc, char** argv);
 
+// What makes the files of a run unusable, checked before anything is opened, or "" if
+// nothing: a scene or --reference that is not a regular file (the viewer re-reads and
+// watches its scene, and opening a FIFO would block before the --timeout clock could end
+// the run), or an output (--screenshot, --window-shot, --save-image and its depth file,
+// --stats-json, --status-file; --save-scene onto the reference) that would replace an input.
+std::string view_files_problem(const ViewOptions& options);
+
 // `keithray view --help`: the shared flags from their table, then the viewer's own.
 std::string view_usage();
 

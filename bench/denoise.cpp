@@ -1,0 +1,165 @@
+// docs/denoising.md's figures: the denoiser's error against a converged reference, raw and
+// denoised, at several sample counts, and its cost.
+//   keithray_bench_denoise cost [ROUNDS]
+//       the a-trous filter alone on scene 3's 4 spp estimates at 512x512 and 1920x1080
+//       (medians of ROUNDS runs; OMP_NUM_THREADS sets the threads)
+//   keithray_bench_denoise error SIZE REFERENCE_SPP SPP,SPP,... SCENE.json...
+//       each scene at SIZE x SIZE: a reference at REFERENCE_SPP (seed 99, exact light
+//       sampling), then renders at each SPP (seed 1) raw and denoised: relMSE (luminance,
+//       over ref^2 + 0.01) and PSNR of the sRGB-tone-mapped 8-bit images against the reference's
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+#include "render/aov.h"
+#include "render/outputs.h"
+#include "render/progressive.h"
+#include "scene/load.h"
+
+using namespace kr;
+
+namespace {
+
+struct Prepared {
+    Scene scene;
+    RenderScene rs;
+    RenderSettings settings;
+};
+
+Prepared prepare(const std::string& file, int width, int height, bool exact_lights) {
+    Prepared p;
+    p.scene = load_scene_file(file).scene;
+    p.scene.renderer.width = width;
+    p.scene.renderer.height = height;
+    p.rs = prepare_scene(p.scene);
+    p.settings = RenderSettings::from_scene(p.scene.renderer);
+    if (exact_lights) p.settings.light_sampling = LightSampling::cone;
+    p.settings.allocation = Allocation::uniform;
+    return p;
+}
+
+RenderState render(const Prepared& p, int spp, uint64_t seed) {
+    RenderSettings s = p.settings;
+    s.seed = seed;
+    RenderState state(p.scene.renderer.width, p.scene.renderer.height);
+    StopRule rule;
+    rule.max_passes = spp;
+    render_until(p.rs, s, state, rule);
+    return state;
+}
+
+double rel_mse(const Image& a, const Image& ref) {
+    double sum = 0;
+    for (size_t i = 0; i < ref.pixels.size(); ++i) {
+        const double r = luminance(ref.pixels[i]), d = luminance(a.pixels[i]) - r;
+        sum += d * d / (r * r + 0.01);
+    }
+    return sum / double(ref.pixels.size());
+}
+
+double psnr_srgb(const Image& a, const Image& ref) {
+    return psnr(tonemap(a, ToneMap::srgb, 1.0), tonemap(ref, ToneMap::srgb, 1.0));
+}
+
+// CPU seconds of the whole process (every thread): what the filter costs apart from waiting
+// for a core on a shared machine.
+double cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
+int cost(int rounds, const std::string& scene_file) {
+    for (const auto [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
+        const Prepared p = prepare(scene_file, w, h, false);
+        const RenderState state = render(p, 4, 1);
+        RenderEstimates est = render_estimates(state, kAllLayers);
+        const SurfaceLayers features = averaged_surface_layers(p.rs, p.settings, w, h, kFeatureSamples);
+        std::vector<float> albedo, normal, variance = est.variance;
+        for (size_t i = 0; i < features.albedo.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                albedo.push_back(float(features.albedo[i][k]));
+                normal.push_back(float(features.normal[i][k]));
+            }
+        DenoiseInput in;
+        in.radiance = &est.radiance;
+        in.variance = variance;
+        in.albedo = albedo;
+        in.normal = normal;
+        in.depth = est.depth;
+        std::vector<double> ms, cpu_ms, feature_ms;
+        DenoiseWorkspace workspace;  // as the viewer keeps it
+        for (int r = 0; r < rounds; ++r) {
+            const double c0 = cpu_seconds();
+            auto t0 = std::chrono::steady_clock::now();
+            const Image out = denoise_atrous(in, {}, &workspace);
+            auto t1 = std::chrono::steady_clock::now();
+            cpu_ms.push_back(1e3 * (cpu_seconds() - c0));
+            ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+            if (out.pixels.empty()) return 1;
+            if (r < 3) {
+                t0 = std::chrono::steady_clock::now();
+                (void)averaged_surface_layers(p.rs, p.settings, w, h, kFeatureSamples);
+                t1 = std::chrono::steady_clock::now();
+                feature_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+            }
+        }
+        std::printf("%dx%d: a-trous filter %.1f ms wall (median of %d; min %.1f), %.1f ms CPU (all threads; min %.1f); "
+                    "feature buffers at %d samples %.1f ms wall\n",
+                    w, h, median(ms), rounds, *std::min_element(ms.begin(), ms.end()), median(cpu_ms),
+                    *std::min_element(cpu_ms.begin(), cpu_ms.end()), kFeatureSamples, median(feature_ms));
+    }
+    return 0;
+}
+
+int error(int size, int reference_spp, const std::vector<int>& spps, const std::vector<std::string>& scenes) {
+    std::printf("scene | spp | relMSE raw | relMSE denoised | PSNR raw | PSNR denoised\n");
+    for (const std::string& file : scenes) {
+        const Prepared p = prepare(file, size, size, true);
+        const Image reference = render(p, reference_spp, 99).radiance();
+        for (const int spp : spps) {
+            const RenderState state = render(p, spp, 1);
+            DevelopOptions options;
+            options.denoise = Denoise::on;
+            options.sampling = p.settings;
+            options.sampling.seed = 1;
+            const Developed d = develop(p.rs, render_estimates(state, kAllLayers), options, kLayerRadiance);
+            std::printf("%s | %d | %.5f | %.5f | %.2f | %.2f\n", file.substr(file.find_last_of('/') + 1).c_str(), spp,
+                        rel_mse(d.raw, reference), rel_mse(d.radiance, reference), psnr_srgb(d.raw, reference),
+                        psnr_srgb(d.radiance, reference));
+            std::fflush(stdout);
+        }
+    }
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const std::string mode = argc > 1 ? argv[1] : "";
+    if (mode == "cost") return cost(argc > 2 ? std::stoi(argv[2]) : 15, argc > 3 ? argv[3] : "res/scenes/assignment_03.json");
+    if (mode == "error" && argc > 5) {
+        std::vector<int> spps;
+        for (size_t at = 0; at < std::string(argv[4]).size();) {
+            const std::string list = argv[4];
+            size_t end = list.find(',', at);
+            if (end == std::string::npos) end = list.size();
+            spps.push_back(std::stoi(list.substr(at, end - at)));
+            at = end + 1;
+        }
+        return error(std::stoi(argv[2]), std::stoi(argv[3]), spps, std::vector<std::string>(argv + 5, argv + argc));
+    }
+    std::fprintf(stderr,
+                 "usage: keithray_bench_denoise cost [ROUNDS [SCENE]] | error SIZE REFERENCE_SPP SPP,SPP,... SCENE...\n");
+    return 2;
+}

@@ -1,0 +1,371 @@
+// The denoiser (render/denoise.h) on synthetic images with known answers, its feature
+// buffers and halves, and on path-traced scenes against a high-spp reference.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/image_hdr.h"
+#include "render/aov.h"
+#include "render/denoise.h"
+#include "render/outputs.h"
+#include "render/options.h"
+#include "render/progressive.h"
+#include "test_util.h"
+#include "viewer/status.h"
+
+namespace kr {
+namespace {
+
+// A synthetic render: per pixel, the true radiance `truth`, its features, and Gaussian noise
+// of standard deviation `sigma` (given to the filter as the variance of the mean).
+struct Synthetic {
+    int w, h;
+    Image truth, noisy;
+    std::vector<float> variance, albedo, normal;
+    std::vector<double> depth;
+
+    Synthetic(int w_, int h_) : w(w_), h(h_), truth(w_, h_), noisy(w_, h_) {
+        const size_t n = size_t(w) * size_t(h);
+        variance.assign(3 * n, 0.f);
+        albedo.assign(3 * n, 1.f);
+        normal.assign(3 * n, 0.f);
+        for (size_t i = 0; i < n; ++i) normal[3 * i + 2] = -1;
+        depth.assign(n, 10.0);
+    }
+    size_t at(int x, int y) const { return size_t(y) * size_t(w) + size_t(x); }
+    void set(int x, int y, double radiance, double albedo_value, Vec3 n, double z) {
+        const size_t i = at(x, y);
+        truth.pixels[i] = Color(radiance);
+        for (int k = 0; k < 3; ++k) albedo[3 * i + size_t(k)] = float(albedo_value);
+        normal[3 * i] = float(n.x);
+        normal[3 * i + 1] = float(n.y);
+        normal[3 * i + 2] = float(n.z);
+        depth[i] = z;
+    }
+    void add_noise(double sigma, uint32_t seed = 1) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<double> g(0, sigma);
+        for (size_t i = 0; i < truth.pixels.size(); ++i) {
+            noisy.pixels[i] = truth.pixels[i] + Color(g(rng), g(rng), g(rng));
+            for (int k = 0; k < 3; ++k) variance[3 * i + size_t(k)] = float(sigma * sigma);
+        }
+    }
+    Image denoise(const AtrousParams& params = {}) const {
+        DenoiseInput in;
+        in.radiance = &noisy;
+        in.variance = variance;
+        in.albedo = albedo;
+        in.normal = normal;
+        in.depth = depth;
+        return denoise_atrous(in, params);
+    }
+};
+
+// Mean of the green channel over a column's interior rows.
+double column_mean(const Image& img, int x, int margin) {
+    double s = 0;
+    for (int y = margin; y < img.height - margin; ++y) s += img.at(x, y).y;
+    return s / (img.height - 2 * margin);
+}
+
+TEST(Denoise, ConstantStaysConstant) {
+    Synthetic s(64, 48);
+    for (int y = 0; y < s.h; ++y)
+        for (int x = 0; x < s.w; ++x) s.set(x, y, 0.37, 0.5, {0, 0, -1}, 7);
+    s.noisy = s.truth;
+    for (float& v : s.variance) v = 0.01f;
+    AtrousParams no_fade;
+    no_fade.fade_error = 0;
+    for (const AtrousParams& params : {AtrousParams{}, no_fade}) {
+        const Image out = s.denoise(params);
+        for (const Color& c : out.pixels)
+            for (int k = 0; k < 3; ++k) ASSERT_NEAR(c[k], 0.37, 1e-5);
+    }
+}
+
+// With every edge stop at one (flat features, no luminance stop, no fade) the filter is the
+// linear a-trous cascade of [1/4 1/2 1/4]^2 kernels at steps 1, 2, 4, 8, 16: i.i.d. noise's
+// variance drops to the sum of the squared weights of their convolution.
+TEST(Denoise, NoiseOnAConstantDropsByTheCascadesFactor) {
+    Synthetic s(400, 400);
+    for (int y = 0; y < s.h; ++y)
+        for (int x = 0; x < s.w; ++x) s.set(x, y, 1.0, 1.0, {0, 0, -1}, 10);
+    s.add_noise(0.1);
+    AtrousParams linear;
+    linear.sigma_luminance = 0;
+    linear.fade_error = 0;
+    // The 1-D cascade's weights (the 2-D kernel is their outer product).
+    std::vector<double> kernel{1.0};
+    for (int it = 0; it < linear.iterations; ++it) {
+        const int step = 1 << it;
+        std::vector<double> next(kernel.size() + 2 * size_t(step), 0.0);
+        for (size_t i = 0; i < kernel.size(); ++i) {
+            next[i] += 0.25 * kernel[i];
+            next[i + size_t(step)] += 0.5 * kernel[i];
+            next[i + 2 * size_t(step)] += 0.25 * kernel[i];
+        }
+        kernel = next;
+    }
+    double sum_sq = 0;
+    for (double k : kernel) sum_sq += k * k;
+    const double expected_factor = sum_sq * sum_sq;  // 2-D: the product of the axes' sums
+    const int margin = 32;                           // beyond the cascade's reach of 31 pixels
+    for (const bool with_luminance_stop : {false, true}) {
+        AtrousParams params = linear;
+        if (with_luminance_stop) params.sigma_luminance = AtrousParams{}.sigma_luminance;
+        const Image out = s.denoise(params);
+        double sum = 0, sq = 0;
+        int n = 0;
+        for (int y = margin; y < s.h - margin; ++y)
+            for (int x = margin; x < s.w - margin; ++x) {
+                const double v = out.at(x, y).y;
+                sum += v;
+                sq += v * v;
+                ++n;
+            }
+        const double mean = sum / n, var = sq / n - mean * mean;
+        EXPECT_NEAR(mean, 1.0, 0.005);
+        const double factor = var / (0.1 * 0.1);
+        if (!with_luminance_stop) {
+            // One realisation of correlated output: about 10 % spread.
+            EXPECT_GT(factor, 0.7 * expected_factor) << expected_factor;
+            EXPECT_LT(factor, 1.3 * expected_factor) << expected_factor;
+        } else {
+            // The luminance stop keeps part of the noise, but at least 1/20 of the variance goes.
+            EXPECT_LT(factor, 0.05) << "linear cascade: " << expected_factor;
+        }
+    }
+}
+
+// A vertical edge at x = w/2 between two sides, noise of 0.3 on both: the columns next to the
+// edge keep their side's value. `side(left)` sets a pixel of one side.
+template <class Side>
+void expect_edge_kept(Side side, double left_value, double right_value, double tolerance) {
+    Synthetic s(96, 64);
+    for (int y = 0; y < s.h; ++y)
+        for (int x = 0; x < s.w; ++x) side(s, x, y, x < s.w / 2);
+    s.add_noise(0.3);
+    const Image out = s.denoise();
+    const int margin = 4;
+    // Noise went down away from the edge (the filter did something) ...
+    double raw_err = 0, err = 0;
+    for (int y = margin; y < s.h - margin; ++y) {
+        raw_err += std::pow(s.noisy.at(10, y).y - left_value, 2);
+        err += std::pow(out.at(10, y).y - left_value, 2);
+    }
+    EXPECT_LT(err, 0.2 * raw_err);
+    // ... and nothing leaked across it: the columns beside it keep their side's mean.
+    EXPECT_NEAR(column_mean(out, s.w / 2 - 1, margin), left_value, tolerance);
+    EXPECT_NEAR(column_mean(out, s.w / 2, margin), right_value, tolerance);
+    EXPECT_NEAR(column_mean(out, s.w / 2 - 3, margin), left_value, tolerance);
+    EXPECT_NEAR(column_mean(out, s.w / 2 + 2, margin), right_value, tolerance);
+}
+
+TEST(Denoise, AlbedoEdgeIsKept) {
+    // The same light on albedo 0.2 and 0.8: the radiance is the albedo.
+    expect_edge_kept([](Synthetic& s, int x, int y, bool left) { s.set(x, y, left ? 0.2 : 0.8, left ? 0.2 : 0.8, {0, 0, -1}, 10); },
+                     0.2, 0.8, 0.03);
+}
+
+TEST(Denoise, NormalEdgeIsKept) {
+    // A crease: the same albedo and depth, faces at right angles lit 0.2 and 0.8.
+    expect_edge_kept(
+        [](Synthetic& s, int x, int y, bool left) {
+            s.set(x, y, left ? 0.2 : 0.8, 0.5, left ? Vec3{-0.7071, 0, -0.7071} : Vec3{0.7071, 0, -0.7071}, 10);
+        },
+        0.2, 0.8, 0.03);
+}
+
+TEST(Denoise, DepthEdgeIsKept) {
+    // A silhouette: the same albedo and normal, a near surface lit 0.2 before a far one lit 0.8.
+    expect_edge_kept([](Synthetic& s, int x, int y, bool left) { s.set(x, y, left ? 0.2 : 0.8, 0.5, {0, 0, -1}, left ? 5 : 50); },
+                     0.2, 0.8, 0.03);
+}
+
+TEST(Denoise, ConvergedImageIsLeftAsItIs) {
+    // A relative standard error far below the fade's: the output is the input.
+    Synthetic s(48, 48);
+    for (int y = 0; y < s.h; ++y)
+        for (int x = 0; x < s.w; ++x) s.set(x, y, 0.1 + 0.8 * ((x / 3 + y / 5) % 2), 0.5, {0, 0, -1}, 10);
+    s.add_noise(1e-5);
+    const Image out = s.denoise();
+    for (size_t i = 0; i < out.pixels.size(); ++i) ASSERT_NEAR(out.pixels[i].y, s.noisy.pixels[i].y, 2e-5);
+}
+
+TEST(Denoise, FeatureBuffersAverageTheCameraSamples) {
+    // Scene 3 at 24x24: the averaged albedo lies between the centre ray's on edge pixels, and
+    // equals it on flat ones; normals are unit inside surfaces, shorter nowhere else than at
+    // silhouettes against nothing.
+    const Scene scene = test::brief_scene(3, 24);
+    const RenderScene rs = prepare_scene(scene);
+    const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    const SurfaceLayers centre = first_surface_layers(rs, 24, 24);
+    const SurfaceLayers one = averaged_surface_layers(rs, settings, 24, 24, 1);
+    const SurfaceLayers many = averaged_surface_layers(rs, settings, 24, 24, 16);
+    int differ = 0, same = 0;
+    for (size_t i = 0; i < centre.albedo.size(); ++i) {
+        EXPECT_LE(length(many.normal[i]), 1 + 1e-9);
+        if (length(many.albedo[i] - centre.albedo[i]) > 1e-6) ++differ;
+        else ++same;
+        // One sample is one camera ray's first surface: a unit normal or nothing.
+        const double l = length(one.normal[i]);
+        EXPECT_TRUE(std::abs(l - 1) < 1e-9 || l == 0) << l;
+    }
+    EXPECT_GT(differ, 10);  // edges are anti-aliased
+    EXPECT_GT(same, 200);   // flat areas are not changed
+}
+
+TEST(Denoise, HalvesSplitTheSamplesIntoTwoIndependentSets) {
+    const Scene scene = test::brief_scene(3, 16);
+    const RenderScene rs = prepare_scene(scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.allocation = Allocation::uniform;
+    RenderState state(16, 16);
+    state.track_halves();
+    StopRule rule;
+    rule.max_passes = 7;
+    render_until(rs, settings, state, rule);
+    const RenderState::Halves halves = state.halves();
+    const Image mean = state.radiance();
+    for (size_t i = 0; i < mean.pixels.size(); ++i) {
+        ASSERT_EQ(halves.count[0][i], 4u);  // passes 1, 3, 5, 7
+        ASSERT_EQ(halves.count[1][i], 3u);  // passes 2, 4, 6
+        const Color joined = (halves.mean[0].pixels[i] * 4.0 + halves.mean[1].pixels[i] * 3.0) / 7.0;
+        ASSERT_LT(length(joined - mean.pixels[i]), 1e-9 * (1 + length(mean.pixels[i])));
+    }
+    // The halves differ (independent samples), where the image is noisy.
+    double diff = 0;
+    for (size_t i = 0; i < mean.pixels.size(); ++i) diff += length(halves.mean[0].pixels[i] - halves.mean[1].pixels[i]);
+    EXPECT_GT(diff, 0);
+}
+
+// Path-traced: scene `n` at `size` px and `spp`, developed raw and denoised, against a
+// high-spp reference of the same settings (another seed), as relMSE of the luminance.
+struct PathTraced {
+    double raw_mse = 0, denoised_mse = 0, raw_edge_mse = 0, denoised_edge_mse = 0;
+};
+
+PathTraced path_traced(Scene scene, int size, int spp, int reference_spp) {
+    scene.renderer.width = scene.renderer.height = size;
+    const RenderScene rs = prepare_scene(scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    auto render = [&](int passes, uint64_t seed) {
+        RenderSettings s = settings;
+        s.seed = seed;
+        s.allocation = Allocation::uniform;
+        RenderState state(size, size);
+        StopRule rule;
+        rule.max_passes = passes;
+        render_until(rs, s, state, rule);
+        return state;
+    };
+    const Image reference = render(reference_spp, 99).radiance();
+    const RenderState state = render(spp, 1);
+    RenderEstimates estimates = render_estimates(state, kAllLayers);
+    DevelopOptions options;
+    options.denoise = Denoise::on;
+    options.sampling = settings;
+    options.sampling.seed = 1;
+    const Developed developed = develop(rs, estimates, options, kLayerRadiance);
+    PathTraced out;
+    // Edge pixels: where the reference's luminance changes by more than 20 % to a neighbour.
+    for (int y = 1; y < size - 1; ++y)
+        for (int x = 1; x < size - 1; ++x) {
+            const double ref = luminance(reference.at(x, y));
+            const double raw = luminance(developed.raw.at(x, y)) - ref, den = luminance(developed.radiance.at(x, y)) - ref;
+            // relMSE: the squared error over the reference's square (plus 0.01), so that the
+            // light's pixels do not decide it.
+            const double scale = 1 / (ref * ref + 0.01);
+            out.raw_mse += raw * raw * scale;
+            out.denoised_mse += den * den * scale;
+            bool edge = false;
+            for (const auto [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}})
+                edge |= std::abs(luminance(reference.at(x + dx, y + dy)) - ref) > 0.2 * std::max(ref, 1e-3);
+            if (edge) {
+                out.raw_edge_mse += raw * raw * scale;
+                out.denoised_edge_mse += den * den * scale;
+            }
+        }
+    return out;
+}
+
+TEST(Denoise, PathTracedSceneIsCloserToTheReferenceThanRaw) {
+    const PathTraced r = path_traced(load_scene_file(test::brief_scene_file(3)).scene, 48, 4, 512);
+    // The reference's own error (512 spp) is 1/128 of the raw 4 spp's: it does not decide.
+    EXPECT_LT(r.denoised_mse, 0.5 * r.raw_mse) << r.raw_mse << " " << r.denoised_mse;
+    EXPECT_LT(r.denoised_edge_mse, r.raw_edge_mse) << r.raw_edge_mse << " " << r.denoised_edge_mse;
+}
+
+TEST(Denoise, DepthOfFieldKeepsTheFocusBoundary) {
+    // Scene 3 through its lens camera (aperture 1, focus at 14): blurred spheres over the
+    // focused wall. Edge pixels include the blurred silhouettes.
+    Scene scene = load_scene_file(test::brief_scene_file(3)).scene;
+    for (size_t c = 0; c < scene.cameras.size(); ++c)
+        if (scene.cameras[c].type == CameraType::lens) scene.camera = int(c);
+    ASSERT_EQ(scene.cameras[size_t(scene.camera)].type, CameraType::lens);
+    const PathTraced r = path_traced(scene, 48, 4, 512);
+    EXPECT_LT(r.denoised_mse, 0.5 * r.raw_mse) << r.raw_mse << " " << r.denoised_mse;
+    EXPECT_LT(r.denoised_edge_mse, r.raw_edge_mse) << r.raw_edge_mse << " " << r.denoised_edge_mse;
+}
+
+TEST(Denoise, FlagTakesANameOrStandsAlone) {
+    auto read = [](std::vector<std::string> words) {
+        std::vector<char*> argv{const_cast<char*>("keithray"), const_cast<char*>("render")};
+        for (std::string& w : words) argv.push_back(w.data());
+        RenderOptions options;
+        std::vector<std::string> rest;
+        for (ArgCursor args(int(argv.size()), argv.data()); args.next();)
+            if (!read_shared_flag(args, options)) rest.push_back(args.arg());
+        return std::pair{options.denoise, rest};
+    };
+    EXPECT_EQ(read({"--denoise", "scene.json"}), (std::pair{std::optional{Denoise::on}, std::vector<std::string>{"scene.json"}}));
+    EXPECT_EQ(read({"--denoise"}).first, Denoise::on);
+    EXPECT_EQ(read({"--denoise", "off"}).first, Denoise::off);
+    EXPECT_EQ(read({"--denoise", "on", "a.json"}).second, std::vector<std::string>{"a.json"});
+    EXPECT_FALSE(read({"a.json"}).first.has_value());
+}
+
+TEST(Denoise, ExrKeepsTheRawRadianceAndTheFeatureBuffers) {
+    const Scene scene = test::brief_scene(3, 16);
+    const RenderScene rs = prepare_scene(scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    RenderState state(16, 16);
+    StopRule rule;
+    rule.max_passes = 2;
+    render_until(rs, settings, state, rule);
+    DevelopOptions options;
+    options.denoise = Denoise::on;
+    options.sampling = settings;
+    const Developed d = develop(rs, render_estimates(state, kAllLayers), options, kAllLayers);
+    const HdrImage read = decode_exr(encode_exr(hdr_from_developed(d)), "test.exr");
+    ASSERT_EQ(read.raw.size(), 3u * 256);
+    ASSERT_EQ(read.albedo.size(), 3u * 256);
+    const Image raw = state.radiance();
+    for (size_t i = 0; i < 256; ++i) {
+        EXPECT_FLOAT_EQ(read.raw[3 * i + 1], float(raw.pixels[i].y));
+        EXPECT_FLOAT_EQ(read.rgb[3 * i + 1], float(d.radiance.pixels[i].y));
+    }
+    // Without the denoiser nothing changes: no raw layer.
+    const Developed plain = develop(rs, render_estimates(state, kAllLayers), DevelopOptions{}, kAllLayers);
+    EXPECT_TRUE(hdr_from_developed(plain).raw.empty());
+}
+
+TEST(Denoise, ViewerShowsRawDenoisedOrSplit) {
+    viewer::Snapshot frame;
+    frame.radiance = Image(4, 2);
+    frame.denoised = Image(4, 2);
+    for (Color& c : frame.denoised.pixels) c = Color(1.0);
+    using viewer::DenoiseView;
+    EXPECT_EQ(viewer::shown_radiance(frame, DenoiseView::off).at(3, 1).x, 0.0);
+    EXPECT_EQ(viewer::shown_radiance(frame, DenoiseView::on).at(0, 0).x, 1.0);
+    const Image split = viewer::shown_radiance(frame, DenoiseView::split);
+    EXPECT_EQ(split.at(1, 1).x, 0.0);
+    EXPECT_EQ(split.at(2, 1).x, 1.0);
+    EXPECT_EQ(viewer::shown_word(frame, DenoiseView::split), "split");
+    frame.denoised = Image();  // a frame the worker did not denoise shows raw
+    EXPECT_EQ(viewer::shown_word(frame, DenoiseView::on), "raw");
+}
+
+}  // namespace
+}  // namespace kr
