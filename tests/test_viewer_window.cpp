@@ -565,6 +565,7 @@ TEST_F(ViewerWindow, RegionShowsOnlyItsPixelsRendered) {
         }
     EXPECT_LE(worst_in, 1);
     EXPECT_EQ(lit_out, 0);
+}
 
 // The viewer applies render's memory estimate before it allocates a render state: a scene
 // too large for the machine is an error in the window (and a scripted run's exit 1), never
