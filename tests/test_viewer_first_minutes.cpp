@@ -751,3 +751,70 @@ TEST(Resolution, ScaleOfTheFilesOrTheWindowsSize) {
     move_camera_x(m, 1);
     EXPECT_FALSE(m.view_as_loaded());
 }
+
+// Missing item 2: camera bookmarks are cameras of the file's list ("bookmark N"), outside
+// the scene block: storing one keeps the image and is undoable, recalling puts its view on
+// the active camera (the lens stays), and they survive a save and load.
+TEST(Bookmarks, StoreRecallUndoAndSaveWithTheCameras) {
+    ViewerModel m = test::brief_model(3);
+    const Scene before = m.scene();
+    const Camera file_camera = m.camera();
+    EXPECT_EQ(find_bookmark(m.scene(), 2), -1);
+    Scene unmarked = before;
+    EXPECT_FALSE(recall_bookmark(unmarked, 2));
+    move_camera_x(m, 3);
+    const Camera moved = m.camera();
+    const uint64_t generation = m.generation();
+    ASSERT_TRUE(m.edit(Edit::bookmark, [](Scene& s, ViewerSettings&) { store_bookmark(s, 2); }));
+    EXPECT_EQ(m.generation(), generation);  // the image keeps its samples
+    ASSERT_EQ(m.scene().cameras.size(), before.cameras.size() + 1);
+    EXPECT_EQ(m.scene().cameras[size_t(find_bookmark(m.scene(), 2))].id, "bookmark 2");
+    EXPECT_TRUE(m.dirty());
+    // Storing again replaces it.
+    ASSERT_TRUE(m.edit(Edit::bookmark, [](Scene& s, ViewerSettings&) { store_bookmark(s, 2); }));
+    EXPECT_EQ(m.scene().cameras.size(), before.cameras.size() + 1);
+    // Back to the file's view, a lens opened, then the bookmark recalled: its view, our lens.
+    ASSERT_TRUE(m.reset_view());
+    ASSERT_TRUE(m.edit(Edit::lens, [](Scene& s, ViewerSettings&) {
+        s.cameras[size_t(s.camera)].type = CameraType::lens;
+        s.cameras[size_t(s.camera)].alpha = 0.2;
+    }));
+    ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { EXPECT_TRUE(recall_bookmark(s, 2)); }));
+    EXPECT_EQ(m.camera().position, moved.position);
+    EXPECT_EQ(m.camera().target, moved.target);
+    EXPECT_EQ(m.camera().type, CameraType::lens);
+    EXPECT_EQ(m.camera().alpha, 0.2);
+    // Saved and loaded: the bookmark is in the cameras list, the scene block's camera unchanged.
+    const fs::path file = fs::temp_directory_path() / ("kr-bookmark-" + std::to_string(::getpid()) + ".json");
+    save_scene_json(m.scene_for_saving(), file);
+    Scene back = load_scene_file(file).scene;
+    fs::remove(file);
+    ASSERT_GE(find_bookmark(back, 2), 0);
+    EXPECT_EQ(back.cameras[size_t(back.camera)].id, file_camera.id);
+    EXPECT_EQ(back.cameras[size_t(find_bookmark(back, 2))].position, moved.position);
+    ASSERT_TRUE(recall_bookmark(back, 2));
+    EXPECT_EQ(back.cameras[size_t(back.camera)].position, moved.position);
+    // Undone step by step: the file's scene, no bookmark.
+    while (m.can_undo()) ASSERT_TRUE(m.undo());
+    EXPECT_EQ(scene_to_json(m.scene()), scene_to_json(before));
+    EXPECT_EQ(find_bookmark(m.scene(), 2), -1);
+}
+
+// Missing item 3: a light's power is shown as a colour (largest component 1) times a
+// strength; joining them gives the file's power back.
+TEST(LightColour, PowerIsColourTimesStrength) {
+    for (const Color power : {Color(12, 6, 3), Color(0.5), Color(0, 2, 0), Color(0)}) {
+        const ColourStrength cs = split_power(power);
+        EXPECT_DOUBLE_EQ(std::max({cs.colour.x, cs.colour.y, cs.colour.z}), 1.0);
+        const Color back = join_power(cs);
+        EXPECT_NEAR(back.x, power.x, 1e-12);
+        EXPECT_NEAR(back.y, power.y, 1e-12);
+        EXPECT_NEAR(back.z, power.z, 1e-12);
+    }
+    EXPECT_EQ(split_power(Color(12, 6, 3)).strength, 12);
+    EXPECT_EQ(split_power(Color(12, 6, 3)).colour, Color(1, 0.5, 0.25));
+    // A new strength keeps the colour: twice the strength, twice the power.
+    ColourStrength cs = split_power(Color(12, 6, 3));
+    cs.strength *= 2;
+    EXPECT_EQ(join_power(cs), Color(24, 12, 6));
+}

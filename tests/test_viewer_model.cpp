@@ -231,13 +231,18 @@ TEST(RenderThread, PreviewScalesFitTheBudget) {
     EXPECT_EQ(preview_scales(512, 512, 1e-4, 0.02).front(), 16);
 }
 
+// Brief scene n prepared at w x h pixels, for the render thread's tests.
+static std::shared_ptr<const RenderScene> small_scene(int n, int w, int h) {
+    Scene authored = load_scene_file(test::brief_scene_file(n)).scene;
+    authored.renderer.width = w;
+    authored.renderer.height = h;
+    return std::make_shared<const RenderScene>(prepare_scene(authored));
+}
+
 // The worker's published frames are the deterministic estimate: at the target spp they
 // equal plain render passes, whatever the thread timing, edits and previews before.
 TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
-    Scene authored = load_scene_file(test::brief_scene_file(8)).scene;
-    authored.renderer.width = 40;
-    authored.renderer.height = 30;
-    auto scene = std::make_shared<const RenderScene>(prepare_scene(authored));
+    const auto scene = small_scene(8, 40, 30);
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
     settings.target_spp = 3;
 
@@ -265,6 +270,47 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
     // It stops at the target: no newer frame comes.
     const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
     EXPECT_EQ(more->serial, f->serial);
+}
+
+// Missing item 2: a render region. Only its pixels refine; their samples and values are the
+// plain render's (the same pass plan, the others skipped), the rest keep theirs (none here).
+TEST(RenderThread, RegionRefinesOnlyItsPixels) {
+    const auto scene = small_scene(8, 40, 30);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 3;
+    const PixelBox box{5, 4, 17, 20};
+    RenderWorker worker;
+    worker.set_region(box);
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
+    std::shared_ptr<const Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->finished);
+    ASSERT_EQ(f->sample_count.size(), 40u * 30u);
+    RenderState plain(40, 30);
+    for (int i = 0; i < 3; ++i) render_pass(*scene, settings, plain);
+    const Image expected = plain.radiance();
+    int inside = 0;
+    for (int y = 0; y < 30; ++y)
+        for (int x = 0; x < 40; ++x) {
+            const size_t i = size_t(y) * 40 + size_t(x);
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            inside += in;
+            ASSERT_EQ(f->sample_count[i], in ? 3u : 0u) << x << "," << y;
+            if (in)
+                for (int k = 0; k < 3; ++k) ASSERT_EQ(f->radiance.pixels[i][k], expected.pixels[i][k]) << x << "," << y;
+        }
+    EXPECT_EQ(inside, 12 * 16);
+    // The whole image again: the others refine from the next pass on.
+    worker.set_region(std::nullopt);
+    StopRule more{6};
+    worker.set_stop_rule(more);
+    while (!(f && f->finished && f->spp == 6) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->spp == 6);
+    EXPECT_EQ(f->sample_count[0], 3u);
+    EXPECT_EQ(f->sample_count[size_t(box.y0) * 40 + size_t(box.x0)], 6u);
 }
 
 TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {

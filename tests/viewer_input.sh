@@ -25,6 +25,16 @@ wait_for() {
     return 1
 }
 field() { sed -E "s/.*\b$1=([^ ]*).*/\1/" "$status"; }
+# wait_changed FIELD VALUE: until the status line's FIELD is no longer VALUE.
+wait_changed() {
+    local end=$((SECONDS + limit))
+    while ((SECONDS < end)); do
+        [[ $(field "$1") != "$2" ]] && return 0
+        sleep 0.1
+    done
+    echo "error=timed out waiting for $1 to leave $2"
+    return 1
+}
 
 wid=$(xdotool search --sync --name '^keithray' | head -1)
 [[ -n $wid ]] || { echo "error=no window"; exit 1; }
@@ -217,6 +227,49 @@ select_edit)
     wait_for 'selected=none' || exit 1
     xdotool key F1
     wait_for 'help=1' || exit 1
+    ;;
+bookmarks)
+    # Orbit with a held arrow key, Ctrl+2 stores the view, Home resets it, Shift+2 recalls
+    # it, Ctrl+S saves the scene (a copy of the brief's, in the work folder).
+    xdotool keydown Right
+    wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
+    xdotool key ctrl+2
+    # Every key before F1 was handled once the help shows (events are handled in order).
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    xdotool key F1
+    wait_for 'help=0' || exit 1
+    g=$(field generation)
+    echo "generation_stored=$g"
+    xdotool key Home
+    wait_changed generation "$g" || exit 1
+    g=$(field generation)
+    xdotool key shift+2
+    wait_changed generation "$g" || exit 1
+    xdotool key ctrl+s
+    wait_for 'dirty=0' || exit 1
+    ;;
+region)
+    # B, then a left drag from image pixel (100, 120) to (300, 260): the render region; a
+    # drag then orbits again; Shift+B clears the region.
+    img=$(field image)  # left,top,[fit]scale
+    read -r x0 y0 x1 y1 < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d %d %d\n", $1 + 100 * s, $2 + 120 * s, $1 + 300 * s, $2 + 260 * s}')
+    xdotool key b
+    xdotool mousemove --window "$wid" $x0 $y0
+    wait_for "pointer=$x0,$y0" || exit 1
+    xdotool mousedown 1
+    xdotool mousemove --window "$wid" $((x0 + 50)) $((y0 + 30))
+    wait_for "pointer=$((x0 + 50)),$((y0 + 30))" || exit 1
+    xdotool mousemove --window "$wid" $x1 $y1
+    wait_for "pointer=$x1,$y1" || exit 1
+    xdotool mouseup 1
+    wait_for 'region=[0-9]' || exit 1
+    echo "region=$(field region)"
+    echo "generation_region=$(field generation)"
+    xdotool key shift+b
+    wait_for 'region=none' || exit 1
+    echo "region_cleared=$(field region)"
     ;;
 esc)
     xdotool key Escape

@@ -20,6 +20,7 @@ enum class Edit {
     object,     // a primitive: selected and moved, resized, given a material, made emissive, added, removed
     renderer,   // integrator, depth, estimator, light sampling, seed
     scene,      // another file, a reload, a watched file that changed
+    bookmark,   // a camera bookmark stored: the file changes, the image does not
     tone_map,   // operator, exposure: re-display only
     run_control // pause, unlimited, target spp, stop rules: how long the same estimate refines
 };
@@ -34,6 +35,7 @@ constexpr bool edit_resets(Edit e) {
         case Edit::object:
         case Edit::renderer:
         case Edit::scene: return true;
+        case Edit::bookmark:
         case Edit::tone_map:
         case Edit::run_control: return false;
     }

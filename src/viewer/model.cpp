@@ -9,6 +9,7 @@
 #include "scene/load.h"
 #include "scene/save.h"
 #include "viewer/navigation.h"
+#include "viewer/scene_edit.h"
 
 namespace kr::viewer {
 
@@ -37,13 +38,6 @@ std::string without_view(Scene scene) {
     }
     scene.camera = 0;
     return scene_to_json(scene);
-}
-
-void copy_view(const Camera& from, Camera& to) {
-    to.position = from.position;
-    to.target = from.target;
-    to.fov = from.fov;
-    to.aspect = from.aspect;
 }
 
 }  // namespace

@@ -73,6 +73,35 @@ void RenderWorker::set_paused(bool paused) {
     changed_.notify_all();
 }
 
+void RegionHooks::before_pass(RenderState& state) {
+    applied_ = false;
+    if (!region) return;
+    const int w = state.width, h = state.height;
+    std::vector<uint8_t>& active = state.buffers().active;
+    saved_.swap(active);  // empty: every pixel, else the noise rule's mask
+    active.assign(size_t(w) * size_t(h), 0);
+    for (int y = std::max(0, region->y0); y < std::min(h, region->y1); ++y)
+        for (int x = std::max(0, region->x0); x < std::min(w, region->x1); ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            active[i] = saved_.empty() ? 1 : saved_[i];
+        }
+    applied_ = true;
+}
+
+void RegionHooks::after_pass(RenderState& state, bool) {
+    if (applied_) state.buffers().active.swap(saved_);
+    saved_.clear();
+    applied_ = false;
+}
+
+void RenderWorker::set_region(std::optional<PixelBox> region) {
+    {
+        std::lock_guard lock(mutex_);
+        region_ = region;
+    }
+    changed_.notify_all();
+}
+
 void RenderWorker::set_stop_rule(const StopRule& rule) {
     {
         std::lock_guard lock(mutex_);
@@ -141,6 +170,7 @@ void RenderWorker::run() {
     constexpr double kPreviewBudget = 0.010;  // seconds for the first preview pass
     RenderJob job;
     RenderState state;  // the estimate of `job`, at full resolution
+    RegionHooks region;  // before the driver, which holds it
     std::optional<ProgressiveDriver> driver;
     std::vector<int> previews;
     size_t next_preview = 0;
@@ -184,13 +214,14 @@ void RenderWorker::run() {
                 }
                 albedo.clear();
                 normal.clear();
-                driver.emplace(*job.scene, job.settings, state, rule_);
+                driver.emplace(*job.scene, job.settings, state, rule_, &region);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
                 seconds = 0;
                 if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
             rule = rule_;
+            region.region = region_;
         }
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;

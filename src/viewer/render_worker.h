@@ -29,6 +29,28 @@ struct RenderJob {
     StopRule stop;
 };
 
+// A render region: the image pixels [x0, x1) x [y0, y1) that full passes refine.
+struct PixelBox {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool operator==(const PixelBox& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+    bool operator!=(const PixelBox& o) const { return !(*this == o); }
+};
+
+// Narrows each full pass to a region's pixels (AND the noise rule's mask), through the
+// driver's pass hooks: render_pass skips the pixels whose active entry is 0, so the others
+// keep their samples and their image. No region: the pass is untouched.
+class RegionHooks : public PassHooks {
+public:
+    std::optional<PixelBox> region;
+    void before_pass(RenderState& state) override;
+    void after_pass(RenderState& state, bool statistics) override;
+    bool any(bool stop) override { return stop; }
+
+private:
+    std::vector<uint8_t> saved_;  // the noise rule's mask while the region's is in place
+    bool applied_ = false;
+};
+
 // One published snapshot of the estimate.
 struct Snapshot {
     uint64_t generation = 0;
@@ -85,6 +107,9 @@ public:
     // going only to pixels above their share of it); or it stops (finished) if the new rule
     // is already met.
     void set_stop_rule(const StopRule& rule);
+    // A render region for the running estimate and the next ones (none: the whole image):
+    // only its pixels refine from the next full pass on; the others keep their samples.
+    void set_region(std::optional<PixelBox> region);
     // Whether frames carry the denoised radiance (Snapshot::denoised), from the next frame on.
     void set_denoise(bool on) { denoise_.store(on); }
 
@@ -105,6 +130,7 @@ private:
     std::optional<RenderJob> pending_;
     bool paused_ = false, quit_ = false;
     StopRule rule_;  // the job's, until set_stop_rule
+    std::optional<PixelBox> region_;  // set_region's, read before each pass
     std::shared_ptr<const Snapshot> latest_;
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};

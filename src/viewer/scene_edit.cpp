@@ -200,4 +200,43 @@ void set_emissive(Scene& scene, int p, bool emissive, const Color& power) {
     set_light_on(scene, prim.light, true);
 }
 
+void copy_view(const Camera& from, Camera& to) {
+    to.position = from.position;
+    to.target = from.target;
+    to.fov = from.fov;
+    to.aspect = from.aspect;
+}
+
+std::string bookmark_id(int n) { return "bookmark " + std::to_string(n); }
+
+int find_bookmark(const Scene& scene, int n) {
+    const std::string id = bookmark_id(n);
+    for (size_t i = 0; i < scene.cameras.size(); ++i)
+        if (scene.cameras[i].id == id) return int(i);
+    return -1;
+}
+
+void store_bookmark(Scene& scene, int n) {
+    Camera mark = scene.cameras[size_t(scene.camera)];
+    mark.id = bookmark_id(n);
+    const int at = find_bookmark(scene, n);
+    // The active camera itself may be a bookmark: then it stays as it is.
+    if (at == scene.camera) return;
+    if (at >= 0) scene.cameras[size_t(at)] = mark;
+    else scene.cameras.push_back(mark);
+}
+
+bool recall_bookmark(Scene& scene, int n) {
+    const int at = find_bookmark(scene, n);
+    if (at < 0) return false;
+    copy_view(scene.cameras[size_t(at)], scene.cameras[size_t(scene.camera)]);
+    return true;
+}
+
+ColourStrength split_power(const Color& power) {
+    const double strength = std::max({power.x, power.y, power.z});
+    if (!(strength > 0)) return {Color(1), 0};
+    return {power / strength, strength};
+}
+
 }  // namespace kr::viewer

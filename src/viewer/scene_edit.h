@@ -68,4 +68,26 @@ void new_material_for(Scene& scene, int p);
 // (its light goes out of the scene block).
 void set_emissive(Scene& scene, int p, bool emissive, const Color& power = Color(5));
 
+// The view of a camera (position, target, fov, aspect), copied onto another; its lens stays.
+void copy_view(const Camera& from, Camera& to);
+
+// Camera bookmarks 1..9: cameras of the file's list with the id "bookmark N", outside the
+// scene block (the format keeps unreferenced cameras, and they render nothing).
+std::string bookmark_id(int n);
+// Index of bookmark `n` in Scene::cameras, or -1.
+int find_bookmark(const Scene& scene, int n);
+// Stores the active camera (its view and lens) as bookmark `n`, replacing an older one.
+void store_bookmark(Scene& scene, int n);
+// Puts bookmark `n`'s view on the active camera (its lens stays); false when there is none.
+bool recall_bookmark(Scene& scene, int n);
+
+// A light's power (the file's value: a point light's intensity, an area light's radiance)
+// shown as a colour whose largest component is 1 times a strength: colour x strength = power.
+struct ColourStrength {
+    Color colour{1};
+    double strength = 0;
+};
+ColourStrength split_power(const Color& power);
+inline Color join_power(const ColourStrength& cs) { return cs.colour * cs.strength; }
+
 }  // namespace kr::viewer

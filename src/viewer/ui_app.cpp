@@ -141,6 +141,8 @@ void ViewerApp::sync_worker() {
     }
     // A new rule (target, unlimited, time, noise) keeps the samples taken (the reset rule: run control).
     if (rule != sub.stop) worker_->set_stop_rule(sub.stop = rule);
+    // A render region keeps the samples too: only its pixels refine from the next pass on.
+    if (ui_.region != sub.region) worker_->set_region(sub.region = ui_.region);
 }
 
 bool ViewerApp::fetch_frame() {
@@ -252,17 +254,20 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // selected: the selected primitive's index in the scene block's list ("none").
     const auto sel = ctx_.selection();
     const std::string selected = sel ? std::to_string(*sel) : "none";
-    char line[640];
+    // region: the render region's image pixels x0,y0,x1,y1 ("none": the whole image).
+    char region[64] = "none";
+    if (ui_.region) std::snprintf(region, sizeof region, "%d,%d,%d,%d", ui_.region->x0, ui_.region->y0, ui_.region->x1, ui_.region->y1);
+    char line[704];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
-                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0));
+                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region);
     if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);

@@ -66,6 +66,7 @@ private:
         uint64_t generation = 0;
         bool paused = false;
         StopRule stop;
+        std::optional<PixelBox> region;
         bool denoise = true;
     } submitted_;
     DenoiseView shown_view_ = DenoiseView::on;  // the view of the frame in the texture

@@ -199,6 +199,13 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
             draw->PopClipRect();
         }
     }
+    // The render region (cyan), or the box being drawn (white).
+    for (const auto& [box, colour] : {std::pair{ctx.ui.region, IM_COL32(0, 220, 255, 255)},
+                                      std::pair{ctx.ui.region_draft, IM_COL32(255, 255, 255, 255)}})
+        if (box)
+            draw->AddRect(ImVec2(float(rect.x + box->x0 * scale) * to_points, float(rect.y + box->y0 * scale) * to_points),
+                          ImVec2(float(rect.x + box->x1 * scale) * to_points, float(rect.y + box->y1 * scale) * to_points),
+                          colour, 0.0f, 0, 1.0f);
     // Which view the image shows, on the image (the render needs no label).
     const ViewMode mode = tool.comparison.settings.mode;
     if (mode != ViewMode::render) {

@@ -124,6 +124,9 @@ struct UiState {
     NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
     std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
     int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
+    bool drawing_region = false;             // B: the next left drag draws the render region
+    std::optional<PixelBox> region;          // only these image pixels refine (none: all)
+    std::optional<PixelBox> region_draft;    // the box being drawn
     std::optional<std::string> inside_sphere;  // the camera is inside this sphere
     double ui_fps = 0, ui_work = 0;          // UI frames per second, seconds of work each (smoothed)
     SceneFiles files;

@@ -37,6 +37,13 @@ bool InputState::moving() const {
 
 namespace {
 
+// The image pixels covered by the box between two window points, clamped to the image.
+PixelBox region_box(double ax, double ay, double bx, double by, const PixelRect& rect, int w, int h) {
+    auto px = [&](double x) { return std::clamp(int(std::lround((x - rect.x) / rect.width * w)), 0, w); };
+    auto py = [&](double y) { return std::clamp(int(std::lround((y - rect.y) / rect.height * h)), 0, h); };
+    return {std::min(px(ax), px(bx)), std::min(py(ay), py(by)), std::max(px(ax), px(bx)), std::max(py(ay), py(by))};
+}
+
 void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     ViewerModel& model = ctx.model;
     CompareTool& tool = ctx.ui.compare;
@@ -54,6 +61,13 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         ctx.ui.selected = in.press_pick;
         ctx.ui.axis_lock = -1;
     }
+    if (ctx.ui.region_draft && !io.MouseDown[0]) {
+        // The drawn box becomes the render region (an empty one: none).
+        const PixelBox box = *ctx.ui.region_draft;
+        ctx.ui.region = box.x1 > box.x0 && box.y1 > box.y0 ? std::optional<PixelBox>(box) : std::nullopt;
+        ctx.ui.region_draft.reset();
+        ctx.ui.drawing_region = false;
+    }
     for (int b = 0; b < 3; ++b)
         if (!io.MouseDown[b]) in.drags[b].release();
     if (!io.MouseDown[0]) in.divider_drag = false;
@@ -63,6 +77,9 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
         if (!io.WantCaptureMouse && inside(area) && !io.KeyShift && io.MouseWheel != 0)
             tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+    } else if (ctx.ui.drawing_region && (ImGui::IsMouseClicked(ImGuiMouseButton_Left) || ctx.ui.region_draft)) {
+        // B, then a left drag: the box from the press to the pointer, in image pixels.
+        ctx.ui.region_draft = region_box(io.MouseClickedPos[0].x * to_fb, io.MouseClickedPos[0].y * to_fb, mx, my, rect, w, h);
     } else {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b))
@@ -194,6 +211,7 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
     for (size_t i = 0; i < in.key_presses.size(); ++i) {
         const int key = in.key_presses[i];
         if (in.key_mods[i] & GLFW_MOD_CONTROL) continue;  // a Ctrl chord, not a zoom key
+        if ((in.key_mods[i] & GLFW_MOD_SHIFT) && key == GLFW_KEY_1) continue;  // Shift+1 recalls a bookmark
         acted = true;
         if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
         else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
@@ -279,6 +297,21 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         if (redo ? model.redo() : model.undo()) ctx.messages.error.clear();
         return;
     }
+    // Camera bookmarks: Ctrl+1..9 stores the view, Shift+1..9 recalls it (1 and 0 alone zoom).
+    for (size_t i = 0; i < in.key_presses.size(); ++i) {
+        const int n = in.key_presses[i] - GLFW_KEY_0, mods = in.key_mods[i];
+        if (n < 1 || n > 9 || !(mods & (GLFW_MOD_CONTROL | GLFW_MOD_SHIFT))) continue;
+        model.seal_undo_step();
+        const std::string name = bookmark_id(n);
+        if (mods & GLFW_MOD_CONTROL) {
+            if (ctx.edit(Edit::bookmark, [&](Scene& s, ViewerSettings&) { store_bookmark(s, n); }, name))
+                ctx.messages.show_status("stored the view as " + name + " (Shift+" + std::to_string(n) + " recalls it)");
+        } else if (find_bookmark(model.scene(), n) < 0) {
+            ctx.messages.show_status("no " + name + " yet (Ctrl+" + std::to_string(n) + " stores the view)");
+        } else {
+            ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { recall_bookmark(s, n); }, name);
+        }
+    }
     if (pressed(GLFW_KEY_HOME) || pressed(GLFW_KEY_R)) {
         model.seal_undo_step();
         model.reset_view();
@@ -290,6 +323,11 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
     if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
+    // B: the next left drag draws the render region; Shift+B: the whole image again.
+    if (pressed(GLFW_KEY_B)) {
+        if (shift_with(GLFW_KEY_B)) ui.region.reset(), ui.drawing_region = false;
+        else ui.drawing_region = !ui.drawing_region;
+    }
     if (!io.KeyCtrl) zoom_keys(ctx, in);  // (zoom_keys skips presses made with Ctrl)
     if (pressed(GLFW_KEY_SPACE))
         ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });

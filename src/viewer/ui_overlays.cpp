@@ -34,6 +34,8 @@ constexpr const char* kHelpRows[][2] = {
     {"W / S", "dolly in / out (fly mode: forward / back)"},
     {"A / D / Q / E", "pan left / right / down / up (fly mode: fly)"},
     {"Home or R", "reset the view to the file's camera (the lens stays)"},
+    {"Ctrl+1..9 / Shift+1..9", "store the view as bookmark N (saved with the cameras) / go to it"},
+    {"B, then a left drag / Shift+B", "render region: only its pixels refine / the whole image"},
     {"Ctrl+D / Delete", "duplicate / delete the selection"},
     {"Ctrl+S", "save the scene over its file"},
     {"[ / ]", "halve / double the target spp (keeps the samples taken)"},

@@ -4,8 +4,8 @@
 
 #include <imgui.h>
 
-#include "viewer/ui_panels.h"
 #include "viewer/scene_edit.h"
+#include "viewer/ui_panels.h"
 #include "viewer/ui_widgets.h"
 
 namespace kr::viewer {
@@ -30,13 +30,13 @@ void panel_lights(PanelContext& ctx) {
         if (light.type == LightType::point) {
             bool changed = field(ctx, "position", &edited.position.x, 3, 0.02f, -kHuge, kHuge);
             // "power" as the file says it: a point light's intensity, an area light's radiance.
-            changed |= field(ctx, "power", &edited.power.x, 3, 0.5f, 0.0, kHuge);
+            changed |= power_fields(ctx, edited.power, 0.5f);
             if (changed) ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = edited; }, name, name);
         } else {
             Shape shape = scene.shapes[size_t(light.shape)];
             bool changed = field(ctx, "position", &shape.centre.x, 3, 0.02f, -kHuge, kHuge);
             changed |= field(ctx, "radius", &shape.radius, 1, 0.005f, 1e-4, kHuge);
-            changed |= field(ctx, "power", &edited.power.x, 3, 0.1f, 0.0, kHuge);
+            changed |= power_fields(ctx, edited.power);
             if (changed)
                 ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) {
                     s.lights[size_t(index)] = edited;

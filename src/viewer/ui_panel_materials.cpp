@@ -22,8 +22,12 @@ void panel_materials(PanelContext& ctx) {
             // The type's parameters as the file has them (scene.h's material_params).
             for (const MaterialParam& param : material_params(m.type)) {
                 const std::string label(param.name);
-                if (param.colour) changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
-                else
+                if (param.colour) {
+                    // A picker, then the numbers as the file has them.
+                    changed |= colour_picker(label.c_str(), m.*param.colour);
+                    ImGui::SameLine();
+                    changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
+                } else
                     changed |= field(ctx, label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo,
                                      param.edit_hi);
             }

@@ -70,7 +70,7 @@ void panel_selection(PanelContext& ctx) {
         Light light = scene.lights[size_t(prim.light)];
         ImGui::SameLine();
         ImGui::TextDisabled("light %s", light.id.c_str());
-        if (field(ctx, "power", &light.power.x, 3, 0.1f, 0.0, kHuge))
+        if (power_fields(ctx, light.power))
             ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(prim.light)] = light; }, name, name);
     }
 }

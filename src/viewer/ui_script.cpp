@@ -9,6 +9,7 @@
 #include "scene/save.h"
 #include "viewer/save_dialog.h"
 #include "viewer/navigation.h"
+#include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
 
 namespace kr::viewer {
@@ -23,6 +24,26 @@ bool ScriptRun::start(PanelContext& ctx) {
     // The scripted edits go through the same functions as the mouse and the panels.
     const bool ok = apply_script_edits(options_, ctx.model, [&](Edit kind, const auto& change) { return ctx.edit(kind, change); });
     if (!ok) return false;
+    if (const auto& r = options_.region) ctx.ui.region = PixelBox{(*r)[0], (*r)[1], (*r)[2], (*r)[3]};
+    if (options_.select) {
+        // A click on the centre of the pixel, then a drag of the selection, as the mouse does.
+        const Scene& s = ctx.model.scene();
+        const CameraModel& camera = ctx.model.prepared()->camera;
+        const int w = s.renderer.width, h = s.renderer.height;
+        ctx.ui.selected = pick_primitive(s, camera, (options_.select->first + 0.5) / w, (options_.select->second + 0.5) / h);
+        if (!ctx.ui.selected) {
+            std::fprintf(stderr, "error: --select: no sphere at that pixel\n");
+            return false;
+        }
+        std::printf("selected: %d\n", *ctx.ui.selected);
+        if (options_.move_selection) {
+            const int p = *ctx.ui.selected;
+            const Vec3 from = s.shapes[size_t(s.primitives[size_t(p)].shape)].centre;
+            const Vec3 to = from + drag_offset(camera, from, options_.move_selection->first,
+                                               options_.move_selection->second, h, -1);
+            ctx.edit(Edit::object, [&](Scene& sc, ViewerSettings&) { own_shape(sc, p).centre = to; });
+        }
+    }
     if (options_.reference && !ctx.ui.compare.comparison.reference()) {
         std::fprintf(stderr, "error: %s\n", ctx.messages.error.c_str());
         return false;
@@ -65,10 +86,11 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
             const double y1 = std::min(rect.y + rect.height, area.y + area.height);
             write_image(*options_.screenshot, read({x0, y0, x1 - x0, y1 - y0}));
             const double scale = rect.width / model.scene().renderer.width;
-            std::printf("screenshot: %s (%d spp, generation %llu; image pixel %.6g,%.6g at %g screen pixels each)\n",
+            std::printf("screenshot: %s (%d spp, generation %llu; image pixel %.6g,%.6g at %g screen pixels each, "
+                        "at window pixel %.6g,%.6g)\n",
                         options_.screenshot->string().c_str(), current->spp,
                         static_cast<unsigned long long>(current->generation), (x0 - rect.x) / scale,
-                        (y0 - rect.y) / scale, scale);
+                        (y0 - rect.y) / scale, scale, x0, y0);
         }
         if (options_.stats_json) {
             write_file_atomic(*options_.stats_json, stats_json(stats_figures(ctx)));

@@ -5,6 +5,8 @@
 
 #include <imgui_internal.h>  // TempInputIsActive: a drag field in its typed-text mode
 
+#include "viewer/scene_edit.h"
+
 namespace kr::viewer {
 
 namespace {
@@ -63,6 +65,25 @@ bool field_int(PanelContext& ctx, const char* label, int& v, int lo, int hi) {
     }
     v = int((*held)[0]);
     return true;
+}
+
+bool colour_picker(const char* label, Color& c) {
+    float rgb[3] = {float(c.x), float(c.y), float(c.z)};
+    const std::string id = std::string("##pick ") + label;
+    if (!ImGui::ColorEdit3(id.c_str(), rgb, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float)) return false;
+    c = Color(rgb[0], rgb[1], rgb[2]);
+    return true;
+}
+
+bool power_fields(PanelContext& ctx, Color& power, float speed) {
+    bool changed = field(ctx, "power", &power.x, 3, speed, 0.0, kHuge);
+    // power = colour x strength: the colour's largest component is 1.
+    ColourStrength cs = split_power(power);
+    bool split = colour_picker("light colour", cs.colour);
+    ImGui::SameLine();
+    split |= field(ctx, "strength", &cs.strength, 1, speed, 0.0, kHuge);
+    if (split) power = join_power(cs);
+    return changed || split;
 }
 
 }  // namespace kr::viewer

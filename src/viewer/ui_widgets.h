@@ -22,6 +22,12 @@ bool field(PanelContext& ctx, const char* label, double* v, int count, float spe
 // A typed integer in [lo, hi].
 bool field_int(PanelContext& ctx, const char* label, int& v, int lo, int hi);
 
+// A colour swatch on the line before, opening ImGui's picker (ColorEdit3, values in [0, 1]).
+bool colour_picker(const char* label, Color& c);
+// A light's power as the file has it ("power"), and the same split as a colour (a picker,
+// its largest component 1) times a "strength" (split_power): editing either sets the power.
+bool power_fields(PanelContext& ctx, Color& power, float speed = 0.1f);
+
 template <typename Enum, size_t N>
 bool combo(const char* label, Enum& value, const EnumNames<Enum, N>& names) {
     bool changed = false;

@@ -40,6 +40,9 @@ Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run)
   --aperture A          make the camera a thin lens of aperture radius A
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
   --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
+  --select X,Y          a click at image pixel (X, Y): selects the sphere there
+  --move-selection DX,DY  then drag the selection by (DX, DY) image pixels in the view plane
+  --region X0,Y0 X1,Y1  refine only the image pixels [X0, X1) x [Y0, Y1) (the B key's box)
   --frames N            accumulate N full-resolution passes (at most the target spp)
   --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
   --save-scene OUT.json then save the edited scene
@@ -78,6 +81,13 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--aperture") o.aperture = parse_number(arg, value(), 0, 1e9);
         else if (arg == "--orbit") o.orbit = parse_pair(arg, value());
         else if (arg == "--click-focus") o.click_focus = parse_pair(arg, value());
+        else if (arg == "--select") o.select = parse_pair(arg, value());
+        else if (arg == "--move-selection") o.move_selection = parse_pair(arg, value());
+        else if (arg == "--region") {
+            const auto a = parse_pair(arg, value());  // "X0,Y0" then "X1,Y1": two pairs
+            const auto b = parse_pair(arg, value());
+            o.region = std::array<int, 4>{int(a.first), int(a.second), int(b.first), int(b.second)};
+        }
         else if (arg == "--frames") o.frames = int(parse_integer(arg, value(), 1, kMaxSamples));
         else if (arg == "--screenshot") o.screenshot = value();
         else if (arg == "--save-scene") o.save_scene = value();

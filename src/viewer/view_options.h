@@ -2,6 +2,7 @@
 // the flags shared with render (render/options.h) and the viewer's own.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -20,6 +21,9 @@ struct ViewOptions {
     int frames = 0;  // full-resolution passes to accumulate before the screenshot
     std::optional<std::pair<double, double>> orbit;        // a left drag of (dx, dy) pixels
     std::optional<std::pair<double, double>> click_focus;  // Ctrl+click at image pixel (x, y)
+    std::optional<std::pair<double, double>> select;        // a click at image pixel (x, y): selects
+    std::optional<std::pair<double, double>> move_selection;  // then a drag of it by (dx, dy) image pixels
+    std::optional<std::array<int, 4>> region;               // the render region x0,y0,x1,y1 (image pixels)
     std::optional<double> aperture;                        // thin lens with this radius
     std::optional<std::filesystem::path> screenshot;       // image region, read back from GL
     std::optional<std::filesystem::path> save_scene;       // edited scene as JSON
