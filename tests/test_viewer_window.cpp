@@ -535,6 +535,19 @@ TEST_F(ViewerWindow, BookmarkStoredRecalledAndSaved) {
     EXPECT_EQ(active.target, saved.cameras[size_t(mark)].target);
 }
 
+// Ctrl+S released Ctrl first: the chord saves, and its S, still held alone, is no camera
+// key (it used to dolly the camera once, leaving the saved scene edited).
+TEST_F(ViewerWindow, ChordKeyHeldAfterCtrlIsReleasedDoesNotMoveTheCamera) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path copy = dir / "scene3.json";
+    fs::copy_file(kr::test::brief_scene_file(3), copy);
+    auto r = drive(dir, "chord_release_ctrl_first", 3, copy);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["generation_after"], r["generation_edited"]);
+    EXPECT_EQ(r["dirty_after"], "0");
+    EXPECT_EQ(kr::load_scene_file(copy).scene.renderer.samples, 4);  // the saved target
+}
+
 // Missing item 2, the render region with real input: B, then a left drag over the image sets
 // the region to the image pixels under the drag (not an orbit: no edit), Shift+B clears it.
 TEST_F(ViewerWindow, RegionDrawnWithBAndADragClearedWithShiftB) {

@@ -250,6 +250,23 @@ bookmarks)
     xdotool key ctrl+s
     wait_for 'dirty=0' || exit 1
     ;;
+chord_release_ctrl_first)
+    # Ctrl+S let go Ctrl first, S a moment later (as users often do, and as xdotool's
+    # "key ctrl+s" may reach a busy window): it saves, and the S alone never dollies.
+    xdotool key bracketright  # an edit to save (the target), which keeps the image
+    wait_for 'dirty=1' || exit 1
+    echo "generation_edited=$(field generation)"
+    xdotool keydown ctrl keydown s
+    wait_for 'dirty=0' || exit 1
+    xdotool keyup ctrl
+    # Frames with S alone held: each pointer move is a frame the status line shows.
+    xdotool mousemove --window "$wid" 260 330
+    wait_for 'pointer=260,330' || exit 1
+    xdotool mousemove --window "$wid" 250 330
+    wait_for 'pointer=250,330' || exit 1
+    xdotool keyup s
+    echo "dirty_after=$(field dirty)"
+    ;;
 region)
     # B, then a left drag from image pixel (100, 120) to (300, 260): the render region; a
     # drag then orbits again; Shift+B clears the region.

@@ -18,6 +18,14 @@ void InputState::note_key(int key, int action, int mods) {
         key_presses.push_back(key);
         key_mods.push_back(mods);
     }
+    const bool chord = mods & (GLFW_MOD_CONTROL | GLFW_MOD_ALT | GLFW_MOD_SUPER);
+    if (action == GLFW_PRESS && chord && !held_in_chord(key) && chord_keys.size() < 64) chord_keys.push_back(key);
+    // A release (or a plain press, where a release went to another window) ends the chord.
+    if (action == GLFW_RELEASE || (action == GLFW_PRESS && !chord)) chord_keys.erase(std::remove(chord_keys.begin(), chord_keys.end(), key), chord_keys.end());
+}
+
+bool InputState::held_in_chord(int key) const {
+    return std::find(chord_keys.begin(), chord_keys.end(), key) != chord_keys.end();
 }
 
 bool InputState::pressed_with_ctrl(int key) const {
@@ -336,12 +344,14 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         return;
     }
     // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
+    // A chord's key stays no camera key until it is released (Ctrl let go before the S).
+    auto held = [&](int key) { return int(ImGui::IsKeyDown(key) && !in.held_in_chord(key)); };
     KeyMotion keys;
-    keys.orbit_x = int(ImGui::IsKeyDown(GLFW_KEY_RIGHT)) - int(ImGui::IsKeyDown(GLFW_KEY_LEFT));
-    keys.orbit_y = int(ImGui::IsKeyDown(GLFW_KEY_DOWN)) - int(ImGui::IsKeyDown(GLFW_KEY_UP));
-    keys.pan_x = int(ImGui::IsKeyDown(GLFW_KEY_A)) - int(ImGui::IsKeyDown(GLFW_KEY_D));
-    keys.pan_y = int(ImGui::IsKeyDown(GLFW_KEY_E)) - int(ImGui::IsKeyDown(GLFW_KEY_Q));
-    keys.dolly = int(ImGui::IsKeyDown(GLFW_KEY_S)) - int(ImGui::IsKeyDown(GLFW_KEY_W));
+    keys.orbit_x = held(GLFW_KEY_RIGHT) - held(GLFW_KEY_LEFT);
+    keys.orbit_y = held(GLFW_KEY_DOWN) - held(GLFW_KEY_UP);
+    keys.pan_x = held(GLFW_KEY_A) - held(GLFW_KEY_D);
+    keys.pan_y = held(GLFW_KEY_E) - held(GLFW_KEY_Q);
+    keys.dolly = held(GLFW_KEY_S) - held(GLFW_KEY_W);
     if (keys.any()) {
         // The time since the previous frame with keys held; a first frame moves one 60 Hz step.
         const double dt = in.motion_keys_held ? std::clamp(std::chrono::duration<double>(now - in.last_motion).count(), 0.0, 0.1) : 1.0 / 60;

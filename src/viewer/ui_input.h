@@ -27,10 +27,16 @@ struct InputState {
     // (a short tap on a busy machine) never shows in ImGui::IsKeyPressed.
     std::vector<int> key_presses;
     std::vector<int> key_mods;  // each press's modifiers (GLFW_MOD_*), as the event had them
+    // Keys pressed with Ctrl, Alt or Super and not yet released: a chord's key (the S of
+    // Ctrl+S, the D of Ctrl+D) is no camera key even when the modifier goes up first.
+    std::vector<int> chord_keys;
+
 
     void note_key(int key, int action, int mods = 0);
     // `key` was pressed since the last frame with Ctrl held (by its event, not the frame's state).
     bool pressed_with_ctrl(int key) const;
+    // `key` went down as part of a chord and is still held.
+    bool held_in_chord(int key) const;
     // The buttons held on the image for --status-file: 1 left, 2 right, 4 middle, 8 the divider.
     int pressed_bits() const;
     // A held button or camera key: the window redraws at its frame rate.
