@@ -379,3 +379,103 @@ TEST(StatsJson, NameThatIsNotUtf8IsEscaped) {
     const auto j = nlohmann::json::parse(text);
     EXPECT_EQ(j["reference"], "b\\xFF\\xFE.ppm");
 }
+
+// Missing item 4: the feature views. One name table names every view for --view, the combo,
+// the label and the status file; the three new ones are in it, in the order V cycles them.
+TEST(FeatureViews, NameTableRoundTripsAndTheFlagReadsIt) {
+    ASSERT_EQ(view_mode_names.names.size(), 9u);
+    for (size_t i = 0; i < view_mode_names.names.size(); ++i) {
+        const std::string name(view_mode_names.names[i]);
+        EXPECT_EQ(view_mode_names.parse(name), ViewMode(i)) << name;
+        EXPECT_EQ(view_mode_names.name(ViewMode(i)), name);
+        const char* argv[] = {"keithray", "view", "s.json", "--view", name.c_str()};
+        EXPECT_EQ(parse_view_options(5, const_cast<char**>(argv)).compare.mode, ViewMode(i)) << name;
+    }
+    EXPECT_EQ(view_mode_names.name(ViewMode::albedo), "albedo");
+    EXPECT_EQ(view_mode_names.name(ViewMode::normal), "normal");
+    EXPECT_EQ(view_mode_names.name(ViewMode::depth), "depth");
+    EXPECT_TRUE(is_feature_view(ViewMode::albedo) && is_feature_view(ViewMode::normal) && is_feature_view(ViewMode::depth));
+    EXPECT_FALSE(is_feature_view(ViewMode::render) || is_feature_view(ViewMode::samples));
+}
+
+// Each layer value maps to the pixel the view shows: albedo clamped, normal * 0.5 + 0.5, depth
+// a grey ramp from the nearest hit (white) to the farthest (kDepthFarGrey), misses black.
+TEST(FeatureViews, KnownBuffersMapToTheExpectedPixels) {
+    FeatureBuffers f;
+    f.width = 3;
+    f.height = 1;
+    f.albedo = {0.5f, 1.5f, -0.2f, 0, 0, 0, 0.2f, 0.4f, 1.0f};
+    f.normal = {0, 1, -1, 0, 0, 0, 0.6f, -0.6f, 0};
+    const Rgb8Image a = albedo_picture(f), n = normal_picture(f);
+    EXPECT_EQ(a.bytes, (std::vector<uint8_t>{128, 255, 0, 0, 0, 0, 51, 102, 255}));
+    EXPECT_EQ(n.bytes, (std::vector<uint8_t>{128, 255, 0, 128, 128, 128, 204, 51, 128}));
+
+    // Means over 4 samples: all hits at 2, at 10 and at 6; one miss (kMissDepth) among hits at
+    // 3; no samples.
+    const std::vector<double> mean = {2, 10, 6, (1e6 + 3 * 3) / 4.0, 0};
+    const std::vector<uint32_t> samples = {4, 4, 4, 4, 0};
+    const std::vector<float> d = hit_depths(mean, samples);
+    ASSERT_EQ(d.size(), 5u);
+    EXPECT_EQ(d[0], 2);
+    EXPECT_EQ(d[2], 6);
+    EXPECT_TRUE(std::isinf(d[3]));
+    EXPECT_TRUE(std::isinf(d[4]));
+    const auto range = depth_range(d);
+    ASSERT_TRUE(range);
+    EXPECT_EQ(range->near, 2);
+    EXPECT_EQ(range->far, 10);
+    const Rgb8Image g = depth_picture(d, 5, 1, *range);
+    const uint8_t mid = quantize_unit(1 - (1 - kDepthFarGrey) * 0.5);  // 6 is halfway: 143
+    EXPECT_EQ(mid, 143);
+    EXPECT_EQ(g.bytes, (std::vector<uint8_t>{255, 255, 255, 32, 32, 32, mid, mid, mid, 0, 0, 0, 0, 0, 0}));
+    EXPECT_FALSE(depth_range({INFINITY, INFINITY}));
+}
+
+// A frame's picture at the image's size: a preview's in blocks, as the display shows it; a
+// frame without the layer says so, and the inspector reads the layer at the pixel.
+TEST(FeatureViews, PreviewPictureInBlocksAndTheInspectorReadsTheLayer) {
+    Snapshot frame;
+    frame.scale = 2;
+    frame.radiance = Image(2, 2);
+    auto f = std::make_shared<FeatureBuffers>();
+    f->width = f->height = 2;
+    f->albedo = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};  // black, red, green, blue
+    f->normal = {0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1};
+    frame.features = f;
+    frame.hit_depth = {1, 2, 3, INFINITY};
+
+    // The image is 3x3: its last column and row are the preview's second.
+    const FeaturePicture a = feature_picture(frame, ViewMode::albedo, 3, 3);
+    ASSERT_EQ(a.picture.width, 3);
+    ASSERT_EQ(a.picture.height, 3);
+    auto at = [](const Rgb8Image& p, int x, int y) {
+        const size_t i = 3 * (size_t(y) * size_t(p.width) + size_t(x));
+        return std::array<int, 3>{p.bytes[i], p.bytes[i + 1], p.bytes[i + 2]};
+    };
+    EXPECT_EQ(at(a.picture, 0, 0), (std::array<int, 3>{0, 0, 0}));
+    EXPECT_EQ(at(a.picture, 1, 1), (std::array<int, 3>{0, 0, 0}));
+    EXPECT_EQ(at(a.picture, 2, 0), (std::array<int, 3>{255, 0, 0}));
+    EXPECT_EQ(at(a.picture, 0, 2), (std::array<int, 3>{0, 255, 0}));
+    EXPECT_EQ(at(a.picture, 2, 2), (std::array<int, 3>{0, 0, 255}));
+    const FeaturePicture d = feature_picture(frame, ViewMode::depth, 3, 3);
+    ASSERT_TRUE(d.range);
+    EXPECT_EQ(d.range->near, 1);
+    EXPECT_EQ(d.range->far, 3);
+    EXPECT_EQ(at(d.picture, 2, 0), (std::array<int, 3>{143, 143, 143}));
+    EXPECT_EQ(at(d.picture, 2, 2), (std::array<int, 3>{0, 0, 0}));  // no hit
+
+    EXPECT_EQ(feature_readout(frame, ViewMode::albedo, 2, 0), "albedo 1.000 0.000 0.000");
+    EXPECT_EQ(feature_readout(frame, ViewMode::normal, 0, 0), "normal +0.000 +0.000 -1.000");
+    EXPECT_EQ(feature_readout(frame, ViewMode::depth, 0, 2), "depth 3");
+    EXPECT_EQ(feature_readout(frame, ViewMode::depth, 2, 2), "depth: no hit");
+    EXPECT_EQ(feature_readout(frame, ViewMode::noise, 0, 0), "");
+
+    // Without the layers: no picture, and why.
+    frame.features.reset();
+    frame.hit_depth.clear();
+    const FeaturePicture none = feature_picture(frame, ViewMode::normal, 3, 3);
+    EXPECT_TRUE(none.picture.bytes.empty());
+    EXPECT_EQ(none.missing, "no normal in this frame");
+    EXPECT_EQ(feature_picture(frame, ViewMode::depth, 3, 3).missing, "no depth in this frame");
+    EXPECT_EQ(feature_readout(frame, ViewMode::albedo, 0, 0), "albedo: not available");
+}

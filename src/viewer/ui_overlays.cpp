@@ -26,7 +26,7 @@ constexpr const char* kHelpRows[][2] = {
     {"0 / 1", "fit the image to the window / show it 1:1"},
     {"hover / Shift+click", "read a pixel in the status bar / lock the probe on it"},
     {"I", "the pixel's numbers also in a box at the pointer"},
-    {"V", "next view: render, reference, split, error, noise, samples"},
+    {"V", "next view: render, reference, split, error, noise, samples, albedo, normal, depth"},
     {"K", "keep the image as a snapshot (image B)"},
     {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
     {"G", "fly mode on / off (speed: Camera panel)"},
