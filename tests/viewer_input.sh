@@ -278,7 +278,7 @@ feature_views)
         xdotool key v
         wait_for "view=$v " || exit 1
         case $v in albedo | normal | depth) ;; *) continue ;; esac
-        wait_for "feature=$v[_:]" || exit 1
+        wait_for "feature=${v}_[-+0-9]" || exit 1
         echo "feature_$v=$(field feature)"
         # A one-pixel move and back: the frames after the one that read the layer are drawn.
         xdotool mousemove --window "$wid" 251 330
