@@ -479,3 +479,32 @@ TEST(FeatureViews, PreviewPictureInBlocksAndTheInspectorReadsTheLayer) {
     EXPECT_EQ(feature_picture(frame, ViewMode::depth, 3, 3).missing, "no depth in this frame");
     EXPECT_EQ(feature_readout(frame, ViewMode::albedo, 0, 0), "albedo: not available");
 }
+
+// Leftover of issue 34: from a fit by any factor, + steps to the smallest zoom level above
+// the fit (not to a fixed 2x), and - from there fits again; from a level, + and - step one
+// level each way.
+TEST(ImageView, PlusFromAnyFitStepsToTheNextLevelAboveIt) {
+    struct Case {
+        double area_width;  // a square image of 512 in a 560-high area: the fit is area_width / 512
+        double next;
+    };
+    for (const Case c : {Case{307.2, 0.75}, Case{384, 1}, Case{512, 2}, Case{558, 2}, Case{560, 2}}) {
+        ImageView view;
+        const PixelRect area{0, 0, c.area_width, 560};
+        const double fit = view.scale(area, 512, 512);
+        view.zoom_steps(area, 512, 512, 1, c.area_width / 2, 280);
+        EXPECT_EQ(view.scale(area, 512, 512), c.next) << "fit " << fit;
+        view.zoom_steps(area, 512, 512, -1, c.area_width / 2, 280);
+        EXPECT_TRUE(view.fitted()) << "fit " << fit;
+    }
+    // Wider fits: 2.5 -> 3, 3.4 -> 4, 5 -> 6.
+    for (const auto& [fit, next] : {std::pair{2.5, 3.0}, std::pair{3.4, 4.0}, std::pair{5.0, 6.0}}) {
+        ImageView view;
+        const PixelRect area{0, 0, 200 * fit, 200 * fit};
+        view.zoom_steps(area, 200, 200, 1, 100 * fit, 100 * fit);
+        EXPECT_EQ(view.scale(area, 200, 200), next) << "fit " << fit;
+        view.zoom_steps(area, 200, 200, 1, 100 * fit, 100 * fit);
+        view.zoom_steps(area, 200, 200, -1, 100 * fit, 100 * fit);
+        EXPECT_EQ(view.scale(area, 200, 200), next) << "fit " << fit;
+    }
+}
