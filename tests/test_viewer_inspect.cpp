@@ -22,6 +22,7 @@
 #include "viewer/image_view.h"
 #include "viewer/inspect.h"
 #include "viewer/save_dialog.h"
+#include "viewer/status.h"
 #include "viewer/view_options.h"
 
 namespace fs = std::filesystem;
@@ -507,4 +508,41 @@ TEST(ImageView, PlusFromAnyFitStepsToTheNextLevelAboveIt) {
         view.zoom_steps(area, 200, 200, -1, 100 * fit, 100 * fit);
         EXPECT_EQ(view.scale(area, 200, 200), next) << "fit " << fit;
     }
+}
+
+// Leftover of issue 34: with a render region the status bar adds the region's own figures,
+// the mean samples of its pixels and RenderState::relative_error over them only.
+TEST(RegionStatus, TheRegionsOwnSamplesAndNoise) {
+    const Rendered r = render_frame(3, 64, 12);  // adaptive: the pixels hold different counts
+    const auto whole = region_status(r.frame, {0, 0, 64, 64});
+    ASSERT_TRUE(whole);
+    EXPECT_NEAR(whole->noise, r.state.relative_error(), 1e-6 * r.state.relative_error());
+    double all = 0;
+    for (const uint32_t c : r.state.sample_count()) all += c;
+    EXPECT_DOUBLE_EQ(whole->samples_per_pixel, all / (64 * 64));
+
+    const PixelBox box{10, 20, 30, 50};
+    double samples = 0, error_sq = 0, signal_sq = 0;
+    for (int y = box.y0; y < box.y1; ++y)
+        for (int x = box.x0; x < box.x1; ++x) {
+            const size_t i = size_t(y) * 64 + size_t(x);
+            samples += r.state.sample_count()[i];
+            error_sq += std::pow(r.state.pixel_standard_error(i), 2);
+            signal_sq += std::pow(luminance(r.state.radiance().pixels[i]), 2);
+        }
+    const auto part = region_status(r.frame, box);
+    ASSERT_TRUE(part);
+    EXPECT_DOUBLE_EQ(part->samples_per_pixel, samples / (20 * 30));
+    EXPECT_NEAR(part->noise, std::sqrt(error_sq / signal_sq), 1e-6 * part->noise);
+    EXPECT_GT(std::abs(part->noise - whole->noise), 1e-3 * whole->noise);  // not the whole image's figure
+
+    // Clipped to the image; none outside it or for a preview; unknown below 2 samples.
+    EXPECT_DOUBLE_EQ(region_status(r.frame, {-5, -5, 64, 64})->noise, whole->noise);
+    EXPECT_FALSE(region_status(r.frame, {70, 0, 80, 10}));
+    Snapshot preview = r.frame;
+    preview.scale = 2;
+    EXPECT_FALSE(region_status(preview, box));
+    Snapshot fresh = r.frame;
+    fresh.standard_error[size_t(25) * 64 + 15] = INFINITY;
+    EXPECT_EQ(region_status(fresh, box)->noise, -1);
 }
