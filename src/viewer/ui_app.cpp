@@ -343,6 +343,9 @@ bool ViewerApp::draw_frame() {
         const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
         if (options_.zoom > 0) tool.view.set_zoom(ctx_.view_area(), w, h, options_.zoom, w / 2.0, h / 2.0);
     }
+    // The pictures of the frame just fetched, before the panels show their colour bars; again
+    // below (a no-op unless the panels or the keys changed the view).
+    update_pictures(ctx_, *display_);
     draw_panels();
     draw_status_bar(ctx_);
     draw_help(ui_);
