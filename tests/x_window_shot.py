@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Writes what the X server shows of a window as a binary PPM, for tests/viewer_input.sh:
    x_window_shot.py WINDOW_ID OUT.ppm
-The window's pixels as a user sees them (XGetImage through libX11, no other package). It
+The window's pixels as a user sees them (XGetImage through libX11, no other package), the
+part of it on the screen. It
 grabs until two grabs in a row are equal, so a frame being swapped in is not caught half
 drawn; it fails after 50 grabs that keep changing."""
 import ctypes
@@ -36,7 +37,16 @@ def grab(x11, display, window):
     attributes = XWindowAttributes()
     if not x11.XGetWindowAttributes(display, window, ctypes.byref(attributes)):
         sys.exit("x_window_shot: no window %d" % window)
-    w, h = attributes.width, attributes.height
+    # Only the part on the screen can be read: clip to it.
+    root = x11.XDefaultRootWindow(display)
+    screen = XWindowAttributes()
+    x11.XGetWindowAttributes(display, root, ctypes.byref(screen))
+    rx, ry, child = ctypes.c_int(), ctypes.c_int(), ctypes.c_ulong()
+    x11.XTranslateCoordinates(display, window, root, 0, 0, ctypes.byref(rx), ctypes.byref(ry), ctypes.byref(child))
+    w = min(attributes.width, screen.width - rx.value)
+    h = min(attributes.height, screen.height - ry.value)
+    if rx.value < 0 or ry.value < 0 or w <= 0 or h <= 0:
+        sys.exit("x_window_shot: the window's corner is off the screen")
     all_planes = ctypes.c_ulong(-1).value
     image = x11.XGetImage(display, window, 0, 0, w, h, all_planes, 2)  # ZPixmap
     if not image:
@@ -65,6 +75,11 @@ def main():
     x11.XOpenDisplay.restype = ctypes.c_void_p
     x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
     x11.XGetWindowAttributes.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.POINTER(XWindowAttributes)]
+    x11.XDefaultRootWindow.restype = ctypes.c_ulong
+    x11.XDefaultRootWindow.argtypes = [ctypes.c_void_p]
+    x11.XTranslateCoordinates.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_ulong, ctypes.c_int, ctypes.c_int,
+                                          ctypes.POINTER(ctypes.c_int), ctypes.POINTER(ctypes.c_int),
+                                          ctypes.POINTER(ctypes.c_ulong)]
     x11.XGetImage.restype = ctypes.POINTER(XImage)
     x11.XGetImage.argtypes = [ctypes.c_void_p, ctypes.c_ulong, ctypes.c_int, ctypes.c_int, ctypes.c_uint,
                               ctypes.c_uint, ctypes.c_ulong, ctypes.c_int]
