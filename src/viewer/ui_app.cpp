@@ -235,7 +235,6 @@ void ViewerApp::update_title() {
         glfwSetWindowTitle(window_, title.c_str());
         title_ = std::move(title);
     }
-    if (options_.status_file) write_status_file(status);
 }
 
 void ViewerApp::write_status_file(const RunStatus& status) {
@@ -364,6 +363,10 @@ bool ViewerApp::draw_frame() {
     const PixelRect rect = ctx_.image_rect();
     if (ui_.shown) draw_image(ctx_, *display_, rect, fb_w, fb_h);
     if (model_.has_scene()) draw_inspector(ctx_, rect);
+    // After the inspector: the status line is the frame drawn, its pointer's readout included
+    // (written before it, the readout of a frame that came while idle would stay a frame old).
+    if (options_.status_file)
+        write_status_file(run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene()));
     // Scripted runs read the image region back here: what the shader drew, before
     // the panels are drawn over anything.
     const auto read = [this](const PixelRect& r) { return read_image_region(r); };
