@@ -3,7 +3,8 @@
 # viewer's idle CPU once the render is done and once paused (% of one core over 10 s with no
 # input), and the latency from an orbit edit to the first frame of the new image on screen
 # (median and 90th percentile over 30 edits). Runs a real window under Xvfb. Then the
-# per-frame cost of the inspect and compare tools (bench/compare_tools.cpp).
+# per-frame cost of the inspect and compare tools (bench/compare_tools.cpp) and of the
+# feature views (bench/feature_views.cpp).
 # Usage: scripts/bench_viewer.sh [build/keithray]   (docs/viewer.md records its figures)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -19,3 +20,6 @@ done
 echo "== inspect and compare, per full-resolution frame"
 cmake --build "$(dirname "$exe")" --target keithray_bench_compare >/dev/null
 "$(dirname "$exe")/keithray_bench_compare"
+echo "== feature views (albedo, normal, depth)"
+cmake --build "$(dirname "$exe")" --target keithray_bench_features >/dev/null
+"$(dirname "$exe")/keithray_bench_features" res/scenes/assignment_03.json

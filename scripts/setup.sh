@@ -16,6 +16,8 @@ packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           # the viewer (keithray view) and its offscreen display (render --gl), and
           # the X server its window tests run under, with xdotool for real input events
           libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev xvfb xdotool xauth
+          # python3 reads a window back from the X server for the window tests (tests/x_window_shot.py)
+          python3
           # the sanitizer and fuzzing builds (scripts/check_sanitizers.sh): clang, its
           # sanitizer and libFuzzer runtimes, its OpenMP runtime (whose archer tool makes
           # OpenMP visible to ThreadSanitizer) and llvm-symbolizer for the reports' stacks

@@ -22,6 +22,7 @@
 #include "viewer/image_view.h"
 #include "viewer/inspect.h"
 #include "viewer/save_dialog.h"
+#include "viewer/status.h"
 #include "viewer/view_options.h"
 
 namespace fs = std::filesystem;
@@ -378,4 +379,170 @@ TEST(StatsJson, NameThatIsNotUtf8IsEscaped) {
     ASSERT_NO_THROW(text = stats_json(s));
     const auto j = nlohmann::json::parse(text);
     EXPECT_EQ(j["reference"], "b\\xFF\\xFE.ppm");
+}
+
+// Missing item 4: the feature views. One name table names every view for --view, the combo,
+// the label and the status file; the three new ones are in it, in the order V cycles them.
+TEST(FeatureViews, NameTableRoundTripsAndTheFlagReadsIt) {
+    ASSERT_EQ(view_mode_names.names.size(), 9u);
+    for (size_t i = 0; i < view_mode_names.names.size(); ++i) {
+        const std::string name(view_mode_names.names[i]);
+        EXPECT_EQ(view_mode_names.parse(name), ViewMode(i)) << name;
+        EXPECT_EQ(view_mode_names.name(ViewMode(i)), name);
+        const char* argv[] = {"keithray", "view", "s.json", "--view", name.c_str()};
+        EXPECT_EQ(parse_view_options(5, const_cast<char**>(argv)).compare.mode, ViewMode(i)) << name;
+    }
+    EXPECT_EQ(view_mode_names.name(ViewMode::albedo), "albedo");
+    EXPECT_EQ(view_mode_names.name(ViewMode::normal), "normal");
+    EXPECT_EQ(view_mode_names.name(ViewMode::depth), "depth");
+    EXPECT_TRUE(is_feature_view(ViewMode::albedo) && is_feature_view(ViewMode::normal) && is_feature_view(ViewMode::depth));
+    EXPECT_FALSE(is_feature_view(ViewMode::render) || is_feature_view(ViewMode::samples));
+}
+
+// Each layer value maps to the pixel the view shows: albedo clamped, normal * 0.5 + 0.5, depth
+// a grey ramp from the nearest hit (white) to the farthest (kDepthFarGrey), misses black.
+TEST(FeatureViews, KnownBuffersMapToTheExpectedPixels) {
+    FeatureBuffers f;
+    f.width = 3;
+    f.height = 1;
+    f.albedo = {0.5f, 1.5f, -0.2f, 0, 0, 0, 0.2f, 0.4f, 1.0f};
+    f.normal = {0, 1, -1, 0, 0, 0, 0.6f, -0.6f, 0};
+    const Rgb8Image a = albedo_picture(f), n = normal_picture(f);
+    EXPECT_EQ(a.bytes, (std::vector<uint8_t>{128, 255, 0, 0, 0, 0, 51, 102, 255}));
+    EXPECT_EQ(n.bytes, (std::vector<uint8_t>{128, 255, 0, 128, 128, 128, 204, 51, 128}));
+
+    // Means over 4 samples: all hits at 2, at 10 and at 6; one miss (kMissDepth) among hits at
+    // 3; no samples.
+    const std::vector<double> mean = {2, 10, 6, (1e6 + 3 * 3) / 4.0, 0};
+    const std::vector<uint32_t> samples = {4, 4, 4, 4, 0};
+    const std::vector<float> d = hit_depths(mean, samples);
+    ASSERT_EQ(d.size(), 5u);
+    EXPECT_EQ(d[0], 2);
+    EXPECT_EQ(d[2], 6);
+    EXPECT_TRUE(std::isinf(d[3]));
+    EXPECT_TRUE(std::isinf(d[4]));
+    const auto range = depth_range(d);
+    ASSERT_TRUE(range);
+    EXPECT_EQ(range->near, 2);
+    EXPECT_EQ(range->far, 10);
+    const Rgb8Image g = depth_picture(d, 5, 1, *range);
+    const uint8_t mid = quantize_unit(1 - (1 - kDepthFarGrey) * 0.5);  // 6 is halfway: 143
+    EXPECT_EQ(mid, 143);
+    EXPECT_EQ(g.bytes, (std::vector<uint8_t>{255, 255, 255, 32, 32, 32, mid, mid, mid, 0, 0, 0, 0, 0, 0}));
+    EXPECT_FALSE(depth_range({INFINITY, INFINITY}));
+}
+
+// A frame's picture at the image's size: a preview's in blocks, as the display shows it; a
+// frame without the layer says so, and the inspector reads the layer at the pixel.
+TEST(FeatureViews, PreviewPictureInBlocksAndTheInspectorReadsTheLayer) {
+    Snapshot frame;
+    frame.scale = 2;
+    frame.radiance = Image(2, 2);
+    auto f = std::make_shared<FeatureBuffers>();
+    f->width = f->height = 2;
+    f->albedo = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};  // black, red, green, blue
+    f->normal = {0, 0, -1, 0, 0, -1, 0, 0, -1, 0, 0, -1};
+    frame.features = f;
+    frame.hit_depth = {1, 2, 3, INFINITY};
+
+    // The image is 3x3: its last column and row are the preview's second.
+    const FeaturePicture a = feature_picture(frame, ViewMode::albedo, 3, 3);
+    ASSERT_EQ(a.picture.width, 3);
+    ASSERT_EQ(a.picture.height, 3);
+    auto at = [](const Rgb8Image& p, int x, int y) {
+        const size_t i = 3 * (size_t(y) * size_t(p.width) + size_t(x));
+        return std::array<int, 3>{p.bytes[i], p.bytes[i + 1], p.bytes[i + 2]};
+    };
+    EXPECT_EQ(at(a.picture, 0, 0), (std::array<int, 3>{0, 0, 0}));
+    EXPECT_EQ(at(a.picture, 1, 1), (std::array<int, 3>{0, 0, 0}));
+    EXPECT_EQ(at(a.picture, 2, 0), (std::array<int, 3>{255, 0, 0}));
+    EXPECT_EQ(at(a.picture, 0, 2), (std::array<int, 3>{0, 255, 0}));
+    EXPECT_EQ(at(a.picture, 2, 2), (std::array<int, 3>{0, 0, 255}));
+    const FeaturePicture d = feature_picture(frame, ViewMode::depth, 3, 3);
+    ASSERT_TRUE(d.range);
+    EXPECT_EQ(d.range->near, 1);
+    EXPECT_EQ(d.range->far, 3);
+    EXPECT_EQ(at(d.picture, 2, 0), (std::array<int, 3>{143, 143, 143}));
+    EXPECT_EQ(at(d.picture, 2, 2), (std::array<int, 3>{0, 0, 0}));  // no hit
+
+    EXPECT_EQ(feature_readout(frame, ViewMode::albedo, 2, 0), "albedo 1.000 0.000 0.000");
+    EXPECT_EQ(feature_readout(frame, ViewMode::normal, 0, 0), "normal +0.000 +0.000 -1.000");
+    EXPECT_EQ(feature_readout(frame, ViewMode::depth, 0, 2), "depth 3");
+    EXPECT_EQ(feature_readout(frame, ViewMode::depth, 2, 2), "depth: no hit");
+    EXPECT_EQ(feature_readout(frame, ViewMode::noise, 0, 0), "");
+
+    // Without the layers: no picture, and why.
+    frame.features.reset();
+    frame.hit_depth.clear();
+    const FeaturePicture none = feature_picture(frame, ViewMode::normal, 3, 3);
+    EXPECT_TRUE(none.picture.bytes.empty());
+    EXPECT_EQ(none.missing, "no normal in this frame");
+    EXPECT_EQ(feature_picture(frame, ViewMode::depth, 3, 3).missing, "no depth in this frame");
+    EXPECT_EQ(feature_readout(frame, ViewMode::albedo, 0, 0), "albedo: not available");
+}
+
+// Leftover of issue 34: from a fit by any factor, + steps to the smallest zoom level above
+// the fit (not to a fixed 2x), and - from there fits again; from a level, + and - step one
+// level each way.
+TEST(ImageView, PlusFromAnyFitStepsToTheNextLevelAboveIt) {
+    struct Case {
+        double area_width;  // a square image of 512 in a 560-high area: the fit is area_width / 512
+        double next;
+    };
+    for (const Case c : {Case{307.2, 0.75}, Case{384, 1}, Case{512, 2}, Case{558, 2}, Case{560, 2}}) {
+        ImageView view;
+        const PixelRect area{0, 0, c.area_width, 560};
+        const double fit = view.scale(area, 512, 512);
+        view.zoom_steps(area, 512, 512, 1, c.area_width / 2, 280);
+        EXPECT_EQ(view.scale(area, 512, 512), c.next) << "fit " << fit;
+        view.zoom_steps(area, 512, 512, -1, c.area_width / 2, 280);
+        EXPECT_TRUE(view.fitted()) << "fit " << fit;
+    }
+    // Wider fits: 2.5 -> 3, 3.4 -> 4, 5 -> 6.
+    for (const auto& [fit, next] : {std::pair{2.5, 3.0}, std::pair{3.4, 4.0}, std::pair{5.0, 6.0}}) {
+        ImageView view;
+        const PixelRect area{0, 0, 200 * fit, 200 * fit};
+        view.zoom_steps(area, 200, 200, 1, 100 * fit, 100 * fit);
+        EXPECT_EQ(view.scale(area, 200, 200), next) << "fit " << fit;
+        view.zoom_steps(area, 200, 200, 1, 100 * fit, 100 * fit);
+        view.zoom_steps(area, 200, 200, -1, 100 * fit, 100 * fit);
+        EXPECT_EQ(view.scale(area, 200, 200), next) << "fit " << fit;
+    }
+}
+
+// Leftover of issue 34: with a render region the status bar adds the region's own figures,
+// the mean samples of its pixels and RenderState::relative_error over them only.
+TEST(RegionStatus, TheRegionsOwnSamplesAndNoise) {
+    const Rendered r = render_frame(3, 64, 12);  // adaptive: the pixels hold different counts
+    const auto whole = region_status(r.frame, {0, 0, 64, 64});
+    ASSERT_TRUE(whole);
+    EXPECT_NEAR(whole->noise, r.state.relative_error(), 1e-6 * r.state.relative_error());
+    double all = 0;
+    for (const uint32_t c : r.state.sample_count()) all += c;
+    EXPECT_DOUBLE_EQ(whole->samples_per_pixel, all / (64 * 64));
+
+    const PixelBox box{10, 20, 30, 50};
+    double samples = 0, error_sq = 0, signal_sq = 0;
+    for (int y = box.y0; y < box.y1; ++y)
+        for (int x = box.x0; x < box.x1; ++x) {
+            const size_t i = size_t(y) * 64 + size_t(x);
+            samples += r.state.sample_count()[i];
+            error_sq += std::pow(r.state.pixel_standard_error(i), 2);
+            signal_sq += std::pow(luminance(r.state.radiance().pixels[i]), 2);
+        }
+    const auto part = region_status(r.frame, box);
+    ASSERT_TRUE(part);
+    EXPECT_DOUBLE_EQ(part->samples_per_pixel, samples / (20 * 30));
+    EXPECT_NEAR(part->noise, std::sqrt(error_sq / signal_sq), 1e-6 * part->noise);
+    EXPECT_GT(std::abs(part->noise - whole->noise), 1e-3 * whole->noise);  // not the whole image's figure
+
+    // Clipped to the image; none outside it or for a preview; unknown below 2 samples.
+    EXPECT_DOUBLE_EQ(region_status(r.frame, {-5, -5, 64, 64})->noise, whole->noise);
+    EXPECT_FALSE(region_status(r.frame, {70, 0, 80, 10}));
+    Snapshot preview = r.frame;
+    preview.scale = 2;
+    EXPECT_FALSE(region_status(preview, box));
+    Snapshot fresh = r.frame;
+    fresh.standard_error[size_t(25) * 64 + 15] = INFINITY;
+    EXPECT_EQ(region_status(fresh, box)->noise, -1);
 }

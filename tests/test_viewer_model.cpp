@@ -5,17 +5,21 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <thread>
 
 #include "render/camera.h"
+#include "render/outputs.h"
 #include "scene/load.h"
 #include "test_util.h"
 #include "viewer/edit.h"
 #include "viewer/files.h"
+#include "viewer/inspect.h"
 #include "viewer/model.h"
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
@@ -270,6 +274,57 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
     // It stops at the target: no newer frame comes.
     const auto more = worker.wait_newer(f->serial, std::chrono::milliseconds(300));
     EXPECT_EQ(more->serial, f->serial);
+}
+
+// Missing item 4: the feature views' layers. None by default (the default render makes
+// none); asked for once the render is finished, the newest frame comes again with them (the
+// denoiser's feature buffers, the same as render/outputs.h feature_buffers), and every frame
+// after, previews included (at their resolution), has them, with or without the denoiser.
+TEST(RenderThread, FeatureLayersOnlyWhenAskedAlsoForAFinishedRender) {
+    const auto scene = small_scene(8, 40, 30);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 2;
+    std::vector<float> albedo, normal;
+    feature_buffers(*scene, settings, 40, 30, albedo, normal);
+    for (const bool denoise : {true, false}) {
+        RenderWorker worker;
+        worker.set_denoise(denoise);
+        worker.submit({1, scene, settings, StopRule{settings.target_spp}});
+        std::shared_ptr<const Snapshot> f;
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+        while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline) {
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+            if (f) EXPECT_FALSE(f->features || !f->hit_depth.empty());
+        }
+        ASSERT_TRUE(f && f->finished);
+        worker.set_features(true);
+        const auto again = worker.wait_newer(f->serial, std::chrono::seconds(120));
+        ASSERT_GT(again->serial, f->serial);
+        ASSERT_TRUE(again->features);
+        EXPECT_EQ(again->spp, f->spp);
+        EXPECT_EQ(again->radiance.pixels, f->radiance.pixels);
+        EXPECT_EQ(again->features->width, 40);
+        EXPECT_EQ(again->features->albedo, albedo);
+        EXPECT_EQ(again->features->normal, normal);
+        EXPECT_EQ(again->hit_depth, hit_depths(f->depth, f->sample_count));
+        EXPECT_TRUE(std::any_of(again->hit_depth.begin(), again->hit_depth.end(), [](float d) { return std::isfinite(d); }));
+
+        // A new edit with the views on: every frame carries its own resolution's layers.
+        worker.submit({2, scene, settings, StopRule{settings.target_spp}});
+        f.reset();
+        while (!(f && f->generation == 2 && f->finished) && std::chrono::steady_clock::now() < deadline) {
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+            if (!f || f->generation != 2) continue;
+            ASSERT_TRUE(f->features) << f->scale;
+            EXPECT_EQ(f->features->width, f->radiance.width);
+            EXPECT_EQ(f->features->height, f->radiance.height);
+            EXPECT_EQ(f->hit_depth.size(), f->radiance.pixels.size());
+            std::vector<float> a, n;
+            feature_buffers(*scene, settings, f->radiance.width, f->radiance.height, a, n);
+            EXPECT_EQ(f->features->albedo, a) << f->scale;
+        }
+        ASSERT_TRUE(f && f->finished);
+    }
 }
 
 // Missing item 2: a render region. Only its pixels refine; their samples and values are the

@@ -224,6 +224,53 @@ TEST_F(ViewerWindow, SamplesViewShowsUniformAllocationAsOneColour) {
     EXPECT_EQ(wrong, 0);
 }
 
+// Missing item 4: the feature views show what `render --denoise on -o X.exr` writes in its
+// albedo, normal and depth layers (the denoiser's feature buffers; the mean depth and the
+// samples), mapped by the pictures of viewer/inspect.h: the window's pixels are those bytes,
+// shown as they are, so they must be equal (no tolerance).
+struct ExpectedViews {
+    kr::Rgb8Image albedo, normal, depth;
+    kr::HdrImage exr;
+};
+ExpectedViews expected_views(const fs::path& exr_file) {
+    ExpectedViews e;
+    e.exr = kr::read_hdr(exr_file);
+    kr::viewer::FeatureBuffers f;
+    f.width = e.exr.width;
+    f.height = e.exr.height;
+    f.albedo = e.exr.albedo;
+    f.normal = e.exr.normal;
+    e.albedo = kr::viewer::albedo_picture(f);
+    e.normal = kr::viewer::normal_picture(f);
+    const std::vector<float> hit =
+        kr::viewer::hit_depths(std::vector<double>(e.exr.depth.begin(), e.exr.depth.end()), e.exr.samples);
+    const auto range = kr::viewer::depth_range(hit);
+    EXPECT_TRUE(range);
+    if (range) e.depth = kr::viewer::depth_picture(hit, f.width, f.height, *range);
+    return e;
+}
+
+TEST_F(ViewerWindow, FeatureViewsShowTheLayersRenderWritesInItsExr) {
+    const ViewRun r = keithray("render '" + scene(3) + "' --spp 2 --denoise on -q -o '" + (dir / "r.exr").string() + "'", false);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const ExpectedViews e = expected_views(dir / "r.exr");
+    for (const std::string view : {"albedo", "normal", "depth"}) {
+        const fs::path shot = dir / (view + ".ppm");
+        const ViewRun v = keithray("view '" + scene(3) + "' --spp 2 --frames 2 --view " + view + " --screenshot '" +
+                                       shot.string() + "' --timeout 300",
+                                   true);
+        ASSERT_EQ(v.status, 0) << v.out << v.err;
+        const kr::Rgb8Image s = kr::read_ppm(shot);
+        const kr::Rgb8Image& want = view == "albedo" ? e.albedo : view == "normal" ? e.normal : e.depth;
+        ASSERT_EQ(s.width, want.width) << view;
+        ASSERT_EQ(s.height, want.height) << view;
+        EXPECT_EQ(max_channel_difference(s, want), 0) << view;
+    }
+    // The three pictures differ from each other and from the render.
+    EXPECT_GT(max_channel_difference(e.albedo, e.normal), 100);
+    EXPECT_GT(max_channel_difference(e.albedo, e.depth), 100);
+}
+
 TEST_F(ViewerWindow, LivePsnrEqualsThePsnrCommand) {
     const fs::path stats = dir / "stats.json", headless = dir / "headless.ppm";
     const ViewRun v = view_and_render(5, 4, "--probe 200,300 --stats-json '" + stats.string() + "'");
@@ -546,6 +593,48 @@ TEST_F(ViewerWindow, ChordKeyHeldAfterCtrlIsReleasedDoesNotMoveTheCamera) {
     EXPECT_EQ(r["generation_after"], r["generation_edited"]);
     EXPECT_EQ(r["dirty_after"], "0");
     EXPECT_EQ(kr::load_scene_file(copy).scene.renderer.samples, 4);  // the saved target
+}
+
+// Missing item 4 with real input: V six times from the render reaches the albedo view, then
+// normal and depth. What X shows of the window (tests/x_window_shot.py) is, over the image,
+// the picture of render's EXR layers of the same scene and spp, exactly, except under the
+// view's label (the image's top 28 rows); the status bar reads the layer of the pixel under
+// the pointer.
+TEST_F(ViewerWindow, VReachesTheFeatureViewsAndTheWindowShowsTheLayers) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    if (std::system("command -v python3 >/dev/null 2>&1") != 0) GTEST_SKIP() << "python3 takes the X screenshot";
+    auto r = drive(dir, "feature_views", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["generation_after"], r["generation_before"]);  // a view is no edit
+    const ViewRun render = keithray("render '" + scene(3) + "' --spp 2 --denoise on -q -o '" + (dir / "r.exr").string() + "'", false);
+    ASSERT_EQ(render.status, 0) << render.err;
+    const ExpectedViews e = expected_views(dir / "r.exr");
+    for (const std::string view : {"albedo", "normal", "depth"}) {
+        double left = 0, top = 0, scale = 0;
+        ASSERT_EQ(std::sscanf(r["image_" + view].c_str(), "%lf,%lf,fit%lf", &left, &top, &scale), 3) << r["image_" + view];
+        ASSERT_EQ(scale, 1) << "the 512x512 image fits the window at 1:1";
+        const kr::Rgb8Image w = kr::read_ppm(dir / ("window_" + view + ".ppm"));
+        const kr::Rgb8Image& want = view == "albedo" ? e.albedo : view == "normal" ? e.normal : e.depth;
+        ASSERT_GE(w.width, int(left) + want.width);
+        ASSERT_GE(w.height, int(top) + want.height);
+        int wrong = 0;
+        for (int y = 28; y < want.height; ++y)
+            for (int x = 0; x < want.width; ++x)
+                for (int k = 0; k < 3; ++k)
+                    wrong += w.bytes[3 * ((size_t(top) + size_t(y)) * size_t(w.width) + size_t(left) + size_t(x)) + size_t(k)] !=
+                             want.bytes[3 * (size_t(y) * size_t(want.width) + size_t(x)) + size_t(k)];
+        EXPECT_EQ(wrong, 0) << view;
+        // The pointer's pixel, (250, 330) in the window, as the status bar reads it.
+        const size_t px = size_t(250 - int(left)), py = size_t(330 - int(top));
+        const size_t i = py * size_t(want.width) + px;
+        char text[96];
+        if (view == "albedo")
+            std::snprintf(text, sizeof text, "albedo_%.3f_%.3f_%.3f", e.exr.albedo[3 * i], e.exr.albedo[3 * i + 1], e.exr.albedo[3 * i + 2]);
+        else if (view == "normal")
+            std::snprintf(text, sizeof text, "normal_%+.3f_%+.3f_%+.3f", e.exr.normal[3 * i], e.exr.normal[3 * i + 1], e.exr.normal[3 * i + 2]);
+        else std::snprintf(text, sizeof text, "depth_%.4g", double(e.exr.depth[i]));
+        EXPECT_EQ(r["feature_" + view], text);
+    }
 }
 
 // Missing item 2, the render region with real input: B, then a left drag over the image sets

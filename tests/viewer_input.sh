@@ -288,6 +288,26 @@ region)
     wait_for 'region=none' || exit 1
     echo "region_cleared=$(field region)"
     ;;
+feature_views)
+    # V from the render to the albedo view (six presses), then normal and depth: once the
+    # pointer's pixel reads the view's layer, the window's pixels as X shows them.
+    for v in reference split error noise samples albedo normal depth; do
+        xdotool key v
+        wait_for "view=$v " || exit 1
+        case $v in albedo | normal | depth) ;; *) continue ;; esac
+        wait_for "feature=${v}_[-+0-9]" || exit 1
+        echo "feature_$v=$(field feature)"
+        # A one-pixel move and back: the frames after the one that read the layer are drawn.
+        xdotool mousemove --window "$wid" 251 330
+        wait_for 'pointer=251,330' || exit 1
+        xdotool mousemove --window "$wid" 250 330
+        wait_for 'pointer=250,330' || exit 1
+        python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/window_$v.ppm" || { echo "error=no window shot"; exit 1; }
+        echo "image_$v=$(field image)"
+    done
+    xdotool key v
+    wait_for 'view=render ' || exit 1
+    ;;
 esc)
     xdotool key Escape
     ;;

@@ -35,6 +35,13 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
     return out;
 }
 
+void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, int width, int height,
+                     std::vector<float>& albedo, std::vector<float>& normal) {
+    const SurfaceLayers features = averaged_surface_layers(scene, sampling, width, height, kFeatureSamples);
+    albedo = floats(features.albedo);
+    normal = floats(features.normal);
+}
+
 unsigned develop_reads(const DevelopOptions& options) {
     return options.denoise != Denoise::off ? unsigned(kLayerDepth | kLayerVariance) : 0u;
 }
@@ -45,12 +52,8 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
     const int width = estimates.radiance.width, height = estimates.radiance.height;
     out.radiance = options.blur > 0 ? box_blur(estimates.radiance, options.blur) : std::move(estimates.radiance);
     if (options.denoise != Denoise::off) {
-        if (estimates.albedo.empty() || estimates.normal.empty()) {
-            const SurfaceLayers features =
-                averaged_surface_layers(scene, options.sampling, width, height, kFeatureSamples);
-            estimates.albedo = floats(features.albedo);
-            estimates.normal = floats(features.normal);
-        }
+        if (estimates.albedo.empty() || estimates.normal.empty())
+            feature_buffers(scene, options.sampling, width, height, estimates.albedo, estimates.normal);
         DenoiseInput input;
         input.radiance = &out.radiance;
         input.variance = estimates.variance;

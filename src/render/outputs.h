@@ -50,6 +50,11 @@ struct DevelopOptions {
 };
 // The feature buffers' camera samples per pixel (render/aov.h averaged_surface_layers).
 inline constexpr int kFeatureSamples = 8;
+// The denoiser's feature buffers of a width x height render with `sampling`'s camera
+// samples: albedo and normal, 3 floats per pixel, as develop makes them (the viewer's
+// albedo and normal views show them).
+void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, int width, int height,
+                     std::vector<float>& albedo, std::vector<float>& normal);
 // The layers develop reads for `options` besides those of its output.
 unsigned develop_reads(const DevelopOptions& options);
 

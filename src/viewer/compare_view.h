@@ -15,9 +15,15 @@
 namespace kr::viewer {
 
 // What the image area shows: the render (A), image B, A left of a divider and B right of
-// it, the error of A against B, or the render's noise: per-pixel standard error, samples.
-enum class ViewMode { render, reference, split, error, noise, samples };
-inline constexpr EnumNames<ViewMode, 6> view_mode_names{{"render", "reference", "split", "error", "noise", "samples"}};
+// it, the error of A against B, the render's noise: per-pixel standard error, samples; or
+// the first-surface feature layers (viewer/inspect.h): albedo, normal, depth.
+enum class ViewMode { render, reference, split, error, noise, samples, albedo, normal, depth };
+inline constexpr EnumNames<ViewMode, 9> view_mode_names{
+    {"render", "reference", "split", "error", "noise", "samples", "albedo", "normal", "depth"}};
+// The views of the feature layers, which the render thread makes only while one is shown.
+inline bool is_feature_view(ViewMode mode) {
+    return mode == ViewMode::albedo || mode == ViewMode::normal || mode == ViewMode::depth;
+}
 
 // Per pixel, over the channels of the 8-bit values in [0, 1]: RMS of a - b, or of
 // (a - b) / (b + 0.01) (relative; the 0.01 keeps black pixels from dominating).

@@ -1,14 +1,17 @@
 // What the window shows about single pixels and where the samples went, GL-free: the pixel
-// inspector's readout, and the noise and sample-count maps of the noise view.
+// inspector's readout, the noise and sample-count maps of the noise views, and the pictures
+// of the feature views (albedo, normal, depth).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
 #include "render/progressive.h"
+#include "viewer/compare_view.h"
 #include "viewer/edit.h"
 #include "viewer/render_worker.h"
 
@@ -39,6 +42,40 @@ std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int heig
 // `scale`. Empty for a preview frame.
 Rgb8Image standard_error_map(const Snapshot& frame, double scale);
 Rgb8Image sample_count_map(const Snapshot& frame, double scale);
+
+// The feature views (albedo, normal, depth). Per pixel of mean depths over `samples`
+// samples each: the mean where every sample hit, infinite where one missed (a miss counts
+// as kMissDepth in the mean, so a mean of at least kMissDepth / (2 n) has one, for hits
+// nearer than that) or the pixel has none.
+std::vector<float> hit_depths(const std::vector<double>& mean_depth, const std::vector<uint32_t>& samples);
+// The nearest and farthest finite hit distance (none when no pixel hit).
+struct DepthRange {
+    float near = 0, far = 0;
+};
+std::optional<DepthRange> depth_range(const std::vector<float>& hit_depth);
+// Grey from white at range.near to kDepthFarGrey at range.far; black where nothing was hit.
+inline constexpr double kDepthFarGrey = 0.125;  // 32 of 255, apart from the misses' black
+Rgb8Image depth_picture(const std::vector<float>& hit_depth, int width, int height, const DepthRange& range);
+// The albedo clamped to [0, 1], and the normal n as n * 0.5 + 0.5 (a miss's zero normal is
+// mid-grey), 8-bit as the display shows them.
+Rgb8Image albedo_picture(const FeatureBuffers& features);
+Rgb8Image normal_picture(const FeatureBuffers& features);
+// A picture of a 1/scale preview as the display shows the preview: scale x scale blocks,
+// cut to width x height.
+Rgb8Image upscale_blocks(const Rgb8Image& picture, int scale, int width, int height);
+
+// What a feature view shows of `frame`: the picture at the image's size (a preview's in
+// blocks), the depth's range, or why there is none (`missing`).
+struct FeaturePicture {
+    Rgb8Image picture;
+    std::optional<DepthRange> range;
+    std::string missing;
+};
+FeaturePicture feature_picture(const Snapshot& frame, ViewMode mode, int width, int height);
+// The pixel inspector's words for the feature view `mode` at image pixel (x, y) of `frame`
+// (full-resolution coordinates): "albedo R G B", "normal X Y Z", "depth D" or "depth: no
+// hit"; "MODE: not available" without the layer; empty for another view or outside.
+std::string feature_readout(const Snapshot& frame, ViewMode mode, int x, int y);
 
 // A scale for a false-colour map: the q-quantile of the finite values (0 when none), so one
 // firefly does not make the rest of the map dark.

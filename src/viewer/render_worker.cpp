@@ -102,6 +102,14 @@ void RenderWorker::set_region(std::optional<PixelBox> region) {
     changed_.notify_all();
 }
 
+void RenderWorker::set_features(bool on) {
+    {
+        std::lock_guard lock(mutex_);
+        features_.store(on);
+    }
+    changed_.notify_all();
+}
+
 void RenderWorker::set_stop_rule(const StopRule& rule) {
     {
         std::lock_guard lock(mutex_);
@@ -177,7 +185,20 @@ void RenderWorker::run() {
     double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
     std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
+    std::shared_ptr<const FeatureBuffers> features;  // the same for the feature views, made once
     DenoiseWorkspace denoise_planes;    // kept between frames
+    // The feature views' buffers of `job` at full resolution: the denoiser's when it made them.
+    auto full_features = [&] {
+        if (!features) {
+            auto f = std::make_shared<FeatureBuffers>();
+            f->width = job.scene->renderer.width;
+            f->height = job.scene->renderer.height;
+            if (!albedo.empty() && !normal.empty()) f->albedo = albedo, f->normal = normal;
+            else feature_buffers(*job.scene, job.settings, f->width, f->height, f->albedo, f->normal);
+            features = std::move(f);
+        }
+        return features;
+    };
 
     for (;;) {
         StopRule rule;
@@ -186,10 +207,20 @@ void RenderWorker::run() {
             if (!driver || next_preview < previews.size()) return std::nullopt;
             return driver->stop_reason(rule_);
         };
+        // A feature view asked for while no pass is coming: the newest full frame again, with
+        // the feature layers (under the lock).
+        auto features_due = [&] {
+            return features_.load() && driver && latest_ && latest_->generation == job.generation &&
+                   latest_->scale == 1 && latest_->error.empty() && !latest_->features;
+        };
+        std::shared_ptr<const Snapshot> republish;
         {
             std::unique_lock lock(mutex_);
-            changed_.wait(lock, [&] { return quit_ || pending_ || (driver && !paused_ && !stop_reason()); });
+            changed_.wait(lock, [&] {
+                return quit_ || pending_ || (driver && !paused_ && !stop_reason()) || features_due();
+            });
             if (quit_) return;
+            if (!pending_ && !(driver && !paused_ && !stop_reason())) republish = latest_;
             if (pending_) {
                 job = std::move(*pending_);
                 pending_.reset();
@@ -214,6 +245,7 @@ void RenderWorker::run() {
                 }
                 albedo.clear();
                 normal.clear();
+                features.reset();
                 driver.emplace(*job.scene, job.settings, state, rule_, &region);
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
@@ -225,6 +257,19 @@ void RenderWorker::run() {
         }
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
+        if (republish) {
+            try {
+                auto frame = std::make_shared<Snapshot>(*republish);
+                frame->features = full_features();
+                frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
+                publish(std::move(frame));
+            } catch (const std::bad_alloc&) {
+                driver.reset();
+                publish_error(job.generation, "not enough memory for the feature layers of a " + std::to_string(w) +
+                                                  "x" + std::to_string(h) + " image");
+            }
+            continue;
+        }
         const auto start = Clock::now();
         auto frame = std::make_shared<Snapshot>();
         // An allocation that fails here (a preview, a pass's buffers, the frame's copies) is
@@ -238,9 +283,18 @@ void RenderWorker::run() {
             ++next_preview;
             frame->scale = scale;
             frame->radiance = preview.radiance();
-            if (denoise_.load()) {
-                std::vector<float> preview_albedo, preview_normal;
+            std::vector<float> preview_albedo, preview_normal;
+            if (denoise_.load())
                 frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal, denoise_planes);
+            if (features_.load()) {
+                auto f = std::make_shared<FeatureBuffers>();
+                f->width = preview.width;
+                f->height = preview.height;
+                if (preview_albedo.empty() || preview_normal.empty())
+                    feature_buffers(*job.scene, job.settings, f->width, f->height, f->albedo, f->normal);
+                else f->albedo = std::move(preview_albedo), f->normal = std::move(preview_normal);
+                frame->features = std::move(f);
+                frame->hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
             }
         } else {
             // A pass stopped early is always an edit's: the next turn starts the new job.
@@ -250,7 +304,10 @@ void RenderWorker::run() {
             // Only full passes: tiny previews are dominated by per-pass overheads.
             seconds_per_pixel = dt / (double(w) * h);
             frame->radiance = state.radiance();
-            if (denoise_.load()) frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
+            if (denoise_.load()) {
+                if ((albedo.empty() || normal.empty()) && features) albedo = features->albedo, normal = features->normal;
+                frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
+            }
         }
         frame->generation = job.generation;
         frame->spp = state.passes;
@@ -259,7 +316,13 @@ void RenderWorker::run() {
         frame->rays = state.rays;
         frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
         frame->nonfinite_samples = state.nonfinite_samples;
-        if (frame->scale == 1) record_pixel_statistics(state, *frame);
+        if (frame->scale == 1) {
+            record_pixel_statistics(state, *frame);
+            if (features_.load()) {
+                frame->features = full_features();
+                frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
+            }
+        }
         } catch (const std::bad_alloc&) {
             driver.reset();
             publish_error(job.generation, "not enough memory for rendering a " + std::to_string(w) + "x" +

@@ -51,6 +51,14 @@ private:
     bool applied_ = false;
 };
 
+// The first-surface albedo and normal of a frame's pixels (3 floats per pixel each): the
+// denoiser's feature buffers (render/outputs.h feature_buffers), which the albedo and normal
+// views show. One per edit at full resolution, shared by its frames.
+struct FeatureBuffers {
+    int width = 0, height = 0;
+    std::vector<float> albedo, normal;
+};
+
 // One published snapshot of the estimate.
 struct Snapshot {
     uint64_t generation = 0;
@@ -72,6 +80,11 @@ struct Snapshot {
     // depth and, 3 per pixel, the variance of the mean radiance.
     std::vector<double> depth;
     std::vector<float> variance;
+    // While a feature view is on (RenderWorker::set_features), previews included, at the
+    // frame's resolution: the albedo and normal, and per pixel the mean primary hit distance
+    // where every sample hit (infinite where one missed; viewer/inspect.h hit_depths).
+    std::shared_ptr<const FeatureBuffers> features;
+    std::vector<float> hit_depth;
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished
@@ -112,6 +125,9 @@ public:
     void set_region(std::optional<PixelBox> region);
     // Whether frames carry the denoised radiance (Snapshot::denoised), from the next frame on.
     void set_denoise(bool on) { denoise_.store(on); }
+    // Whether frames carry the feature layers (Snapshot::features, hit_depth): from the next
+    // frame on, and a finished or paused render's newest frame is published again with them.
+    void set_features(bool on);
 
     // The newest frame (null before the first).
     std::shared_ptr<const Snapshot> latest() const;
@@ -135,6 +151,7 @@ private:
     uint64_t serial_ = 0;
     std::atomic<bool> stop_{false};
     std::atomic<bool> denoise_{true};
+    std::atomic<bool> features_{false};
     std::thread thread_;  // last: starts after every member above exists
 };
 

@@ -40,6 +40,32 @@ RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool
     return st;
 }
 
+std::optional<RegionStatus> region_status(const Snapshot& frame, const PixelBox& box) {
+    const int w = frame.radiance.width, h = frame.radiance.height;
+    const size_t n = size_t(w) * size_t(h);
+    if (frame.scale != 1 || frame.sample_count.size() != n || frame.standard_error.size() != n) return std::nullopt;
+    const int x0 = std::max(0, box.x0), y0 = std::max(0, box.y0), x1 = std::min(w, box.x1), y1 = std::min(h, box.y1);
+    if (x0 >= x1 || y0 >= y1) return std::nullopt;
+    // The sums of RenderState::relative_error over the box: squared standard errors over
+    // squared mean luminances.
+    double samples = 0, error_sq = 0, signal_sq = 0;
+    bool unknown = false;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            samples += frame.sample_count[i];
+            const double se = frame.standard_error[i];
+            if (!std::isfinite(se)) unknown = true;
+            error_sq += se * se;
+            const double mean = luminance(frame.radiance.pixels[i]);
+            signal_sq += mean * mean;
+        }
+    RegionStatus r;
+    r.samples_per_pixel = samples / (double(x1 - x0) * double(y1 - y0));
+    if (!unknown) r.noise = signal_sq > 0 ? std::sqrt(error_sq / signal_sq) : (error_sq > 0 ? -1 : 0);
+    return r;
+}
+
 std::string format_noise(double noise) {
     char buf[32];
     const double percent = 100 * noise;

@@ -34,6 +34,17 @@ struct RunStatus {
 // `has_error`: a load or edit failure is being shown (the last good image stays).
 RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error);
 
+// While a render region is set, the spp, the stop rules and the noise estimate count the
+// whole image; the status bar adds the region's own figures from a full-resolution frame:
+// the mean samples per pixel of the box's pixels and their estimated relative error (as
+// RenderState::relative_error, over those pixels only; -1 while one has under 2 samples).
+// None for a preview or a box with no pixel in the image.
+struct RegionStatus {
+    double samples_per_pixel = 0;
+    double noise = -1;
+};
+std::optional<RegionStatus> region_status(const Snapshot& frame, const PixelBox& box);
+
 // The noise estimate in the status bar, at most 9 characters: "5.61%", "0.0123%", "< 0.001%".
 std::string format_noise(double noise);
 

@@ -133,6 +133,9 @@ void ViewerApp::sync_worker() {
     Submitted& sub = submitted_;
     if (s.paused != sub.paused) worker_->set_paused(sub.paused = s.paused);
     if ((s.denoise != DenoiseView::off) != sub.denoise) worker_->set_denoise(sub.denoise = s.denoise != DenoiseView::off);
+    // The feature layers only while a view shows them: the default render path makes none.
+    if (const bool f = is_feature_view(ui_.compare.comparison.settings.mode); f != sub.features)
+        worker_->set_features(sub.features = f);
     const StopRule rule = s.stop_rule();
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
@@ -232,7 +235,6 @@ void ViewerApp::update_title() {
         glfwSetWindowTitle(window_, title.c_str());
         title_ = std::move(title);
     }
-    if (options_.status_file) write_status_file(status);
 }
 
 void ViewerApp::write_status_file(const RunStatus& status) {
@@ -257,17 +259,22 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // region: the render region's image pixels x0,y0,x1,y1 ("none": the whole image).
     char region[64] = "none";
     if (ui_.region) std::snprintf(region, sizeof region, "%d,%d,%d,%d", ui_.region->x0, ui_.region->y0, ui_.region->x1, ui_.region->y1);
-    char line[704];
+    // feature: the feature view's readout of the pixel under the pointer, spaces as '_' ("none").
+    std::string feature = tool.hover_feature.empty() ? "none" : tool.hover_feature.substr(0, 80);
+    std::replace(feature.begin(), feature.end(), ' ', '_');
+    char line[800];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s\n",
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
+                  "feature=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
-                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region);
+                  inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
+                  feature.c_str());
     if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
@@ -335,6 +342,9 @@ bool ViewerApp::draw_frame() {
         const int w = model_.scene().renderer.width, h = model_.scene().renderer.height;
         if (options_.zoom > 0) tool.view.set_zoom(ctx_.view_area(), w, h, options_.zoom, w / 2.0, h / 2.0);
     }
+    // The pictures of the frame just fetched, before the panels show their colour bars; again
+    // below (a no-op unless the panels or the keys changed the view).
+    update_pictures(ctx_, *display_);
     draw_panels();
     draw_status_bar(ctx_);
     draw_help(ui_);
@@ -353,6 +363,10 @@ bool ViewerApp::draw_frame() {
     const PixelRect rect = ctx_.image_rect();
     if (ui_.shown) draw_image(ctx_, *display_, rect, fb_w, fb_h);
     if (model_.has_scene()) draw_inspector(ctx_, rect);
+    // After the inspector: the status line is the frame drawn, its pointer's readout included
+    // (written before it, the readout of a frame that came while idle would stay a frame old).
+    if (options_.status_file)
+        write_status_file(run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene()));
     // Scripted runs read the image region back here: what the shader drew, before
     // the panels are drawn over anything.
     const auto read = [this](const PixelRect& r) { return read_image_region(r); };

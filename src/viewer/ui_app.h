@@ -68,6 +68,7 @@ private:
         StopRule stop;
         std::optional<PixelBox> region;
         bool denoise = true;
+        bool features = false;
     } submitted_;
     DenoiseView shown_view_ = DenoiseView::on;  // the view of the frame in the texture
 

@@ -109,6 +109,8 @@ void update_pictures(PanelContext& ctx, Display& display) {
     // The picture draw_bytes shows for the mode.
     tool.picture_current = false;
     tool.picture_scale = 0;
+    tool.picture_range.reset();
+    tool.picture_missing.clear();
     Rgb8Image picture;
     switch (cs.mode) {
         case ViewMode::render: break;
@@ -130,6 +132,15 @@ void update_pictures(PanelContext& ctx, Display& display) {
                 tool.picture_scale = *std::max_element(shown->sample_count.begin(), shown->sample_count.end());
             picture = sample_count_map(*shown, tool.picture_scale);
             break;
+        case ViewMode::albedo:
+        case ViewMode::normal:
+        case ViewMode::depth: {
+            FeaturePicture f = feature_picture(*shown, cs.mode, model.scene().renderer.width, model.scene().renderer.height);
+            picture = std::move(f.picture);
+            tool.picture_range = f.range;
+            tool.picture_missing = std::move(f.missing);
+            break;
+        }
     }
     const int w = model.scene().renderer.width, h = model.scene().renderer.height;
     if (picture.width == w && picture.height == h) {
@@ -213,7 +224,18 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
         std::string label = std::string(view_mode_names.name(mode));
         if (mode == ViewMode::split) label = "split: render | " + (b ? b->name : std::string("no image B"));
         else if ((mode == ViewMode::reference || mode == ViewMode::error) && b) label += ": " + b->name;
-        if (!tool.picture_current) label += " (not available: showing the render)";
+        if (mode == ViewMode::depth && tool.picture_current) {
+            char range[96] = ": no hit";
+            if (tool.picture_range)
+                std::snprintf(range, sizeof range, ": %.4g (white) to %.4g (grey), black: no hit",
+                              double(tool.picture_range->near), double(tool.picture_range->far));
+            label += range;
+        }
+        if (is_feature_view(mode) && tool.picture_current && ctx.ui.shown && ctx.ui.shown->scale > 1)
+            label += " (preview 1/" + std::to_string(ctx.ui.shown->scale) + ")";
+        if (!tool.picture_current)
+            label += " (not available" + (tool.picture_missing.empty() ? "" : ": " + tool.picture_missing) +
+                     ": showing the render)";
         const PixelRect view = ctx.view_area();
         const ImVec2 at(float(std::max(rect.x, view.x) + 6) * to_points, float(std::max(rect.y, view.y) + 6) * to_points);
         const ImVec2 size = ImGui::CalcTextSize(label.c_str());
@@ -227,6 +249,7 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
                       mx < std::min(rect.x + rect.width, area.x + area.width) &&
                       my < std::min(rect.y + rect.height, area.y + area.height);
     tool.hover_text.clear();
+    tool.hover_feature.clear();
     if (!over || io.WantCaptureMouse || io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || !ctx.ui.shown) return;
     const auto p = probe(ctx, int(std::floor((mx - rect.x) / scale)), int(std::floor((my - rect.y) / scale)));
     if (!p) return;
@@ -236,12 +259,15 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
                                 p->mean.x, p->mean.y, p->mean.z, p->displayed[0], p->displayed[1], p->displayed[2]);
     if (n > 0 && size_t(n) < sizeof line && !p->preview && std::isfinite(p->standard_error))
         std::snprintf(line + n, sizeof line - size_t(n), "   %u samples, std. error %.3g", p->samples, p->standard_error);
-    tool.hover_text = line;
+    // The feature view's layer at the pixel.
+    const std::string& feature = tool.hover_feature = feature_readout(*ctx.ui.shown, mode, p->x, p->y);
+    tool.hover_text = feature.empty() ? std::string(line) : std::string(line) + "   " + feature;
     if (!tool.probe_box) return;
     ImGui::BeginTooltip();
     ImGui::Text("pixel %d, %d", p->x, p->y);
     ImGui::Text("radiance %.4g %.4g %.4g", p->mean.x, p->mean.y, p->mean.z);
     ImGui::Text("shown    %d %d %d", p->displayed[0], p->displayed[1], p->displayed[2]);
+    if (!feature.empty()) ImGui::TextUnformatted(feature.c_str());
     if (p->preview) ImGui::TextDisabled("preview: no statistics yet");
     else if (std::isfinite(p->standard_error))
         ImGui::Text("%u samples, std. error %.3g", p->samples, p->standard_error);

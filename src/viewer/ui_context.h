@@ -81,10 +81,13 @@ struct CompareTool {
     std::string figures_note;               // why there are no figures
     bool picture_current = false;  // the texture's bytes are the current view's, for the shown frame
     double picture_scale = 0;      // the false-colour map's top value
+    std::optional<DepthRange> picture_range;  // the depth view's nearest and farthest hit
+    std::string picture_missing;   // a feature view's picture: why there is none
     std::string picture_key;       // what the picture was made from (cleared: make it again)
     double linear_scale = 0;       // tonemap_scale of the shown frame (the inspector)
     std::optional<std::pair<int, int>> locked_probe;
     std::string hover_text;   // the inspector's numbers for the pixel under the pointer (status bar)
+    std::string hover_feature;  // ... of which the feature view's layer ("albedo 0.8 0.5 0.5"; empty in other views)
     bool probe_box = false;   // ... also in a box at the pointer (I)
     bool open_panel = false;  // the command line asked for a view or a probe: the panel opens once
 };

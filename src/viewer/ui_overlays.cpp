@@ -26,7 +26,7 @@ constexpr const char* kHelpRows[][2] = {
     {"0 / 1", "fit the image to the window / show it 1:1"},
     {"hover / Shift+click", "read a pixel in the status bar / lock the probe on it"},
     {"I", "the pixel's numbers also in a box at the pointer"},
-    {"V", "next view: render, reference, split, error, noise, samples"},
+    {"V", "next view: render, reference, split, error, noise, samples, albedo, normal, depth"},
     {"K", "keep the image as a snapshot (image B)"},
     {"Ctrl+click, or F then click", "focus the lens on the clicked surface"},
     {"G", "fly mode on / off (speed: Camera panel)"},
@@ -96,13 +96,29 @@ void draw_status_bar(PanelContext& ctx) {
     ImGui::SameLine(560);
     ImGui::Text("%.2f Mrays/s", st.mrays_per_second);
     ImGui::SameLine(680);
-    // A fixed width, so the figure after it never runs into it.
-    if (st.noise >= 0) ImGui::Text("noise %s", format_noise(st.noise).c_str());
-    else ImGui::TextDisabled("noise: needs 2 spp");
+    // A fixed width, so the figure after it never runs into it. With a render region, the
+    // region's own samples and noise instead (the whole image's in the tooltip): the spp and
+    // the stop rules count the whole image.
+    const std::optional<RegionStatus> region =
+        ctx.ui.region && current ? region_status(*current, *ctx.ui.region) : std::nullopt;
+    const std::string noise = st.noise >= 0 ? "noise " + format_noise(st.noise) : "noise: needs 2 spp";
+    if (region) {
+        const std::string region_noise = region->noise >= 0 ? format_noise(region->noise) : "needs 2 spp";
+        ImGui::TextColored(ImVec4(0, 0.86f, 1, 1), "region %.4g spp, noise %s", region->samples_per_pixel,
+                           region_noise.c_str());
+        if (ImGui::IsItemHovered())
+            ImGui::SetTooltip("the render region's pixels: mean samples, estimated relative error\n"
+                              "the whole image (the spp and the stop rules count it): %s", noise.c_str());
+    } else if (st.noise >= 0) {
+        ImGui::TextUnformatted(noise.c_str());
+    } else {
+        ImGui::TextDisabled("%s", noise.c_str());
+    }
     const std::optional<CompareFigures>& figures = ctx.ui.compare.figures;
     if (figures && current) {
         // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
-        ImGui::SameLine(800);
+        if (region) ImGui::SameLine(0, 24);
+        else ImGui::SameLine(800);
         ImGui::Text("vs B %.2f dB", figures->psnr);
     }
     // Line 2: one message, the most important first; full text on hover.

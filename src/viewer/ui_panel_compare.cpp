@@ -1,6 +1,7 @@
 // The Inspect and compare panel: zoom, the view (render, image B, split, error, noise,
-// samples), image B (the reference or a kept snapshot) with PSNR and RMSE, the locked probe.
+// samples, albedo, normal, depth), image B (the reference or a kept snapshot) with PSNR and RMSE, the locked probe.
 #include <algorithm>
+#include <array>
 #include <cstdio>
 
 #include <imgui.h>
@@ -14,21 +15,22 @@ namespace kr::viewer {
 
 namespace {
 
-// A horizontal viridis bar from 0 to `scale` with its end labels.
-void colour_bar(double scale, const char* unit) {
+// A horizontal bar of colour(t), t from 0 to 1, labelled `low` and `high` at its ends.
+template <class Colour>
+void colour_bar(double low, double high, const char* unit, Colour colour) {
     ImDrawList* draw = ImGui::GetWindowDrawList();
     const ImVec2 at = ImGui::GetCursorScreenPos();
     const float width = std::max(60.0f, ImGui::GetContentRegionAvail().x), height = 12;
     constexpr int kSteps = 64;
     for (int i = 0; i < kSteps; ++i) {
-        const auto c = viridis((i + 0.5) / kSteps);
+        const std::array<uint8_t, 3> c = colour((i + 0.5) / kSteps);
         draw->AddRectFilled(ImVec2(at.x + width * i / kSteps, at.y), ImVec2(at.x + width * (i + 1) / kSteps, at.y + height),
                             IM_COL32(c[0], c[1], c[2], 255));
     }
     ImGui::Dummy(ImVec2(width, height));
-    ImGui::Text("0");
+    ImGui::Text("%.4g%s", low, unit);
     char label[48];
-    std::snprintf(label, sizeof label, "%.3g%s", scale, unit);
+    std::snprintf(label, sizeof label, "%.4g%s", high, unit);
     ImGui::SameLine(std::max(0.0f, width - ImGui::CalcTextSize(label).x));
     ImGui::TextUnformatted(label);
 }
@@ -107,7 +109,16 @@ void panel_compare(PanelContext& ctx) {
             cs.error_scale = std::max(0.0f, top);
     }
     if ((cs.mode == ViewMode::error || cs.mode == ViewMode::noise || cs.mode == ViewMode::samples) && tool.picture_current)
-        colour_bar(tool.picture_scale, cs.mode == ViewMode::samples ? " spp" : "");
+        colour_bar(0, tool.picture_scale, cs.mode == ViewMode::samples ? " spp" : "", [](double t) { return viridis(t); });
+    else if (cs.mode == ViewMode::depth && tool.picture_current && tool.picture_range)
+        colour_bar(tool.picture_range->near, tool.picture_range->far, "", [](double t) {
+            const uint8_t g = quantize_unit(1.0 - (1.0 - kDepthFarGrey) * t);  // depth_picture's ramp
+            return std::array<uint8_t, 3>{g, g, g};
+        });
+    else if (cs.mode == ViewMode::depth && tool.picture_current)
+        ImGui::TextDisabled("no pixel hit a surface");
+    else if (is_feature_view(cs.mode) && !tool.picture_current)
+        ImGui::TextDisabled("%s", tool.picture_missing.empty() ? "waiting for the render thread" : tool.picture_missing.c_str());
     else if (cs.mode != ViewMode::render && !tool.picture_current)
         ImGui::TextDisabled(cs.mode == ViewMode::noise || cs.mode == ViewMode::samples
                                 ? "shown after the preview"

@@ -30,7 +30,8 @@ Options (as for render; they stay in force when another scene is opened):
 constexpr const char* kViewOnlyOptions = R"(  --unlimited           keep refining past the target spp
   --reference FILE      image B for the compare views and PSNR/RMSE (PPM, PNG, EXR, PFM);
                         default: the brief's reference render for the brief's scenes
-  --view MODE           render, reference, split, error, noise or samples (default render)
+  --view MODE           render, reference, split, error, noise, samples, albedo, normal
+                        or depth (default render)
   --split F             the split view's divider at fraction F of the image width (0.5)
   --error METRIC        the error view's per-pixel error: absolute or relative
   --zoom Z              show the image at Z screen pixels per pixel (up to 16) about its centre
