@@ -47,6 +47,7 @@ RenderState render(const Prepared& p, int spp, uint64_t seed) {
     RenderSettings s = p.settings;
     s.seed = seed;
     RenderState state(p.scene.renderer.width, p.scene.renderer.height);
+    state.track_halves();  // as render --denoise does
     StopRule rule;
     rule.max_passes = spp;
     render_until(p.rs, s, state, rule);
@@ -123,7 +124,7 @@ int cost(int rounds, const std::string& scene_file) {
 }
 
 int error(int size, int reference_spp, const std::vector<int>& spps, const std::vector<std::string>& scenes) {
-    std::printf("scene | spp | relMSE raw | relMSE denoised | PSNR raw | PSNR denoised\n");
+    std::printf("scene | spp | relMSE raw | relMSE a-trous | relMSE final | PSNR raw | PSNR a-trous | PSNR final\n");
     for (const std::string& file : scenes) {
         const Prepared p = prepare(file, size, size, true);
         const Image reference = render(p, reference_spp, 99).radiance();
@@ -133,10 +134,16 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
             options.denoise = Denoise::on;
             options.sampling = p.settings;
             options.sampling.seed = 1;
-            const Developed d = develop(p.rs, render_estimates(state, kAllLayers), options, kLayerRadiance);
-            std::printf("%s | %d | %.5f | %.5f | %.2f | %.2f\n", file.substr(file.find_last_of('/') + 1).c_str(), spp,
-                        rel_mse(d.raw, reference), rel_mse(d.radiance, reference), psnr_srgb(d.raw, reference),
-                        psnr_srgb(d.radiance, reference));
+            const RenderEstimates estimates = render_estimates(state, kAllLayers);
+            options.interactive = true;
+            const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
+            options.interactive = false;
+            const Developed final = develop(p.rs, estimates, options, kLayerRadiance);
+            std::printf("%s | %d | %.5f | %.5f | %.5f | %.2f | %.2f | %.2f\n",
+                        file.substr(file.find_last_of('/') + 1).c_str(), spp, rel_mse(final.raw, reference),
+                        rel_mse(fast.radiance, reference), rel_mse(final.radiance, reference),
+                        psnr_srgb(final.raw, reference), psnr_srgb(fast.radiance, reference),
+                        psnr_srgb(final.radiance, reference));
             std::fflush(stdout);
         }
     }

@@ -325,6 +325,14 @@ private:
         if (cluster_.any_flags(!shortfall.empty())) return false;
         stage_ = "the render state of a " + image_;
         state_.reset(width, height);
+        // The final denoiser's two halves of the samples; under MPI they are not gathered, and
+        // it filters without them (docs/denoising.md).
+        if (denoise() != Denoise::off) {
+            if (!cluster_.distributed()) state_.track_halves();
+            else if (leader_)
+                std::fprintf(stderr, "note: %s: under MPI --denoise filters without the two halves of the samples "
+                                     "(docs/denoising.md)\n", file_.c_str());
+        }
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }

@@ -150,6 +150,7 @@ Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vec
     DevelopOptions options;
     options.workspace = &workspace;
     options.denoise = Denoise::on;
+    options.interactive = true;  // the live display: the a-trous filter (Save: the final one)
     options.sampling = job.settings;
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
     estimates.albedo = std::move(albedo);
@@ -206,6 +207,7 @@ void RenderWorker::run() {
                 }
                 try {
                     state.reset(w, h);
+                    state.track_halves();  // for Save's final denoiser
                 } catch (const std::bad_alloc&) {
                     driver.reset();
                     lock.unlock();

@@ -72,6 +72,7 @@ struct Snapshot {
     // depth and, 3 per pixel, the variance of the mean radiance.
     std::vector<double> depth;
     std::vector<float> variance;
+    RenderState::Halves halves;  // the two halves of the samples (the final denoiser's guides)
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished
