@@ -178,7 +178,7 @@ void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float si
 // The last step of both filters: the filtered demodulated radiance (p.c) times the albedo,
 // then faded towards the raw radiance as its relative standard error drops (the
 // 3x3-prefiltered raw variance against the filtered luminance), so a converged pixel keeps
-// its raw value.
+// its raw value. A pixel whose p.c is NaN keeps its raw value exactly.
 void remodulate_and_fade(const DenoiseInput& input, float fade_error, Planes& p, Image& out) {
     std::vector<float>& raw_var = p.var_blur;
     blur3(p.w, p.h, p.raw_var, raw_var);
@@ -188,6 +188,10 @@ void remodulate_and_fade(const DenoiseInput& input, float fade_error, Planes& p,
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < count; ++li) {
         const size_t i = size_t(li);
+        if (std::isnan(p.c[0][i])) {
+            out.pixels[i] = raw.pixels[i];
+            continue;
+        }
         const Color filtered{double(p.c[0][i] * p.demod[0][i]), double(p.c[1][i] * p.demod[1][i]),
                              double(p.c[2][i] * p.demod[2][i])};
         const double l = std::max(luminance(filtered), 0.0);
@@ -326,6 +330,48 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
             blur3(p.w, p.h, p.v[g][k], p.var_blur);
             std::swap(p.v[g][k], p.var_blur);
         }
+    p.clamped.assign(n, 0);
+    if (!halves) return;
+    // Fireflies: a rare bright sample lands in one half only, so each half's value is clamped
+    // to the range of the other half's 3x3 neighbourhood (a highlight is in both halves and
+    // stays). Biased, as the a-trous filter's luminance stop is, for far less error.
+    for (int k = 0; k < 3; ++k) {
+        std::vector<float>& clamped = p.var_blur;
+        for (int g = 0; g < 2; ++g) {
+            const std::vector<float>&mine = p.u[g][k], &other = p.u[1 - g][k];
+            clamped.resize(n);
+#pragma omp parallel for schedule(static)
+            for (int y = 0; y < p.h; ++y)
+                for (int x = 0; x < p.w; ++x) {
+                    float lo = INFINITY, hi = -INFINITY;
+                    for (int yy = std::max(0, y - 1); yy <= std::min(p.h - 1, y + 1); ++yy)
+                        for (int xx = std::max(0, x - 1); xx <= std::min(p.w - 1, x + 1); ++xx) {
+                            const float o = other[size_t(yy) * size_t(p.w) + size_t(xx)];
+                            lo = std::min(lo, o);
+                            hi = std::max(hi, o);
+                        }
+                    const size_t i = size_t(y) * size_t(p.w) + size_t(x);
+                    clamped[i] = std::clamp(mine[i], lo, hi);
+                }
+            // Both halves are clamped against the other's unclamped values.
+            std::swap(p.acc[g][k], clamped);
+        }
+        for (int g = 0; g < 2; ++g) std::swap(p.u[g][k], p.acc[g][k]);
+    }
+    // The raw candidate of a pixel whose halves were clamped is their clamped mean.
+    p.clamped.assign(n, 0);
+    const long count2 = long(n);
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < count2; ++li) {
+        const size_t i = size_t(li);
+        bool changed = false;
+        for (int g = 0; g < 2; ++g)
+            for (int k = 0; k < 3; ++k) changed |= p.u[g][k][i] != p.acc[g][k][i];
+        if (!changed) continue;
+        p.clamped[i] = 1;
+        const double n0 = in.half_count[0][i], n1 = in.half_count[1][i], t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
+        for (int k = 0; k < 3; ++k) p.c[k][i] = float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i]));
+    }
 }
 
 // One guide's patch distance terms along a row, for the pixels [x0, x1) of the row at `at`
@@ -475,7 +521,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     // Stein's unbiased risk estimate per half, which a filter linear in the half it filters
     // allows (the weights come from the other half): |F - u|^2 - v + 2 (dF/du) v per channel,
     // dF/du the centre's share of the weights, 1 over their sum.
-    const float strengths[2] = {params.k, params.k_strong};
+    const float strengths[2] = {params.k, params.k_weak};
     for (int c = 0; c < 2; ++c) {
         nlm_filter(params, strengths[c], p);
         for (auto& plane : p.cand[c]) plane.resize(n);
@@ -500,12 +546,33 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
         box_mean(w, h, params.select_radius, p.cand[c][3], p.hbox[0], p.hbox[1]);
         std::swap(p.cand[c][3], p.hbox[1]);
     }
-    // Per pixel the candidate of the smaller smoothed risk.
+    // The raw mean is the third candidate, its risk the halves' variances: where no filter
+    // is estimated to do better (a converged or noiseless region) the pixel stays raw.
+    std::vector<float>& raw_risk = p.cand[2][3];
+    raw_risk.resize(n);
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < long(n); ++li) {
+        float risk = 0;
+        for (int g = 0; g < 2; ++g)
+            for (int k = 0; k < 3; ++k) {
+                const float v = p.v[g][k][size_t(li)];
+                risk += std::isfinite(v) ? v : 0.f;
+            }
+        raw_risk[size_t(li)] = risk;
+    }
+    box_mean(w, h, params.select_radius, raw_risk, p.hbox[0], p.hbox[1]);
+    std::swap(raw_risk, p.hbox[1]);
+    // Per pixel the candidate of the smallest smoothed risk (the raw one: its clamped mean, or
+    // where nothing was clamped NaN, which remodulate_and_fade reads as the raw radiance, bit
+    // for bit).
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < long(n); ++li) {
         const size_t i = size_t(li);
         const int c = p.cand[1][3][i] < p.cand[0][3][i] ? 1 : 0;
-        for (int k = 0; k < 3; ++k) p.c[k][i] = p.cand[c][k][i];
+        if (p.cand[c][3][i] < raw_risk[i])
+            for (int k = 0; k < 3; ++k) p.c[k][i] = p.cand[c][k][i];
+        else if (!p.clamped[i])
+            p.c[0][i] = NAN;
     }
     remodulate_and_fade(input, params.fade_error, p, out);
     return out;

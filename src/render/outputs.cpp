@@ -66,8 +66,11 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
                 input.half[h] = &estimates.halves.mean[h];
                 input.half_count[h] = estimates.halves.count[h];
             }
+        // A Whitted render's only noise is the pixel's anti-aliasing: the final filter would
+        // only soften its edges (docs/denoising.md), so it keeps the raw image.
         Image denoised = options.interactive ? denoise_atrous(input, {}, options.workspace)
-                                             : denoise_nlmeans(input, {}, options.workspace);
+                         : options.sampling.integrator == Integrator::wrt ? out.radiance
+                                                                          : denoise_nlmeans(input, {}, options.workspace);
         out.raw = std::exchange(out.radiance, std::move(denoised));
         // An output with first-surface layers keeps the feature buffers the denoiser read.
         if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);
