@@ -275,6 +275,25 @@ TEST(Denoise, FinalFilterNoiseOnAConstantDropsByTheWindowsCount) {
     }
 }
 
+// A firefly (one huge sample) lands in one half only and is clamped away; a highlight is in
+// both halves and is kept.
+TEST(Denoise, FinalFilterRemovesAFireflyAndKeepsAHighlight) {
+    Synthetic s(64, 48);
+    for (int y = 0; y < s.h; ++y)
+        for (int x = 0; x < s.w; ++x) s.set(x, y, (x >= 40 && x < 42 && y >= 20 && y < 22) ? 5.0 : 0.5, 0.5, {0, 0, -1}, 10);
+    s.add_noise_halves(0.05);
+    const size_t fly = s.at(20, 20);
+    s.half[0].pixels[fly] = Color(100.0);
+    s.noisy.pixels[fly] = (s.half[0].pixels[fly] + s.half[1].pixels[fly]) * 0.5;
+    for (int k = 0; k < 3; ++k) s.variance[3 * fly + size_t(k)] = 50.f * 50.f / 8;  // as its samples would say
+    const Image out = s.denoise_final();
+    for (int y = 18; y <= 22; ++y)
+        for (int x = 18; x <= 22; ++x) EXPECT_NEAR(out.at(x, y).y, 0.5, 0.1) << x << "," << y;
+    for (int y = 20; y < 22; ++y)
+        for (int x = 40; x < 42; ++x) EXPECT_NEAR(out.at(x, y).y, 5.0, 0.25) << x << "," << y;
+    EXPECT_NEAR(out.at(43, 20).y, 0.5, 0.1);  // and it did not spread
+}
+
 TEST(Denoise, FinalFilterLeavesAConvergedImageAsItIs) {
     Synthetic s(48, 48);
     for (int y = 0; y < s.h; ++y)
