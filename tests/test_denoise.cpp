@@ -95,19 +95,42 @@ double column_mean(const Image& img, int x, int margin) {
     return s / (img.height - 2 * margin);
 }
 
+// Both filters, with and without their fade: noiseless halves of a constant (with a variance
+// given) come back as the constant.
 TEST(Denoise, ConstantStaysConstant) {
     Synthetic s(64, 48);
     for (int y = 0; y < s.h; ++y)
         for (int x = 0; x < s.w; ++x) s.set(x, y, 0.37, 0.5, {0, 0, -1}, 7);
+    s.add_noise_halves(0.1);  // the variance of the mean: 0.01
+    for (int h = 0; h < 2; ++h) s.half[h] = s.truth;
     s.noisy = s.truth;
-    for (float& v : s.variance) v = 0.01f;
-    AtrousParams no_fade;
-    no_fade.fade_error = 0;
-    for (const AtrousParams& params : {AtrousParams{}, no_fade}) {
-        const Image out = s.denoise(params);
+    auto expect_constant = [](const Image& out) {
         for (const Color& c : out.pixels)
             for (int k = 0; k < 3; ++k) ASSERT_NEAR(c[k], 0.37, 1e-5);
-    }
+    };
+    AtrousParams no_fade;
+    no_fade.fade_error = 0;
+    for (const AtrousParams& params : {AtrousParams{}, no_fade}) expect_constant(s.denoise(params));
+    NlmParams final_no_fade;
+    final_no_fade.fade_error = 0;
+    for (const NlmParams& params : {NlmParams{}, final_no_fade}) expect_constant(s.denoise_final(params));
+}
+
+// A filtered noisy constant of 1 (i.i.d. noise of `sigma`): its mean stays 1 beyond `margin`
+// pixels from the border, and its variance there over sigma^2 is returned.
+double noise_factor(const Image& out, int margin, double sigma) {
+    double sum = 0, sq = 0;
+    int n = 0;
+    for (int y = margin; y < out.height - margin; ++y)
+        for (int x = margin; x < out.width - margin; ++x) {
+            const double v = out.at(x, y).y;
+            sum += v;
+            sq += v * v;
+            ++n;
+        }
+    const double mean = sum / n;
+    EXPECT_NEAR(mean, 1.0, 0.005);
+    return (sq / n - mean * mean) / (sigma * sigma);
 }
 
 // With every edge stop at one (flat features, no luminance stop, no fade) the filter is the
@@ -140,19 +163,7 @@ TEST(Denoise, NoiseOnAConstantDropsByTheCascadesFactor) {
     for (const bool with_luminance_stop : {false, true}) {
         AtrousParams params = linear;
         if (with_luminance_stop) params.sigma_luminance = AtrousParams{}.sigma_luminance;
-        const Image out = s.denoise(params);
-        double sum = 0, sq = 0;
-        int n = 0;
-        for (int y = margin; y < s.h - margin; ++y)
-            for (int x = margin; x < s.w - margin; ++x) {
-                const double v = out.at(x, y).y;
-                sum += v;
-                sq += v * v;
-                ++n;
-            }
-        const double mean = sum / n, var = sq / n - mean * mean;
-        EXPECT_NEAR(mean, 1.0, 0.005);
-        const double factor = var / (0.1 * 0.1);
+        const double factor = noise_factor(s.denoise(params), margin, 0.1);
         if (!with_luminance_stop) {
             // One realisation of correlated output: about 10 % spread.
             EXPECT_GT(factor, 0.7 * expected_factor) << expected_factor;
@@ -217,23 +228,6 @@ TEST(Denoise, DepthEdgeIsKept) {
             0.2, 0.8, 0.03, final);
 }
 
-TEST(Denoise, FinalFilterKeepsAConstant) {
-    // Noiseless halves of a constant (with a variance given): every weighted mean is it.
-    Synthetic s(48, 40);
-    for (int y = 0; y < s.h; ++y)
-        for (int x = 0; x < s.w; ++x) s.set(x, y, 0.37, 0.5, {0, 0, -1}, 7);
-    s.add_noise_halves(0.1);
-    for (int h = 0; h < 2; ++h) s.half[h] = s.truth;
-    s.noisy = s.truth;
-    NlmParams no_fade;
-    no_fade.fade_error = 0;
-    for (const NlmParams& params : {NlmParams{}, no_fade}) {
-        const Image out = s.denoise_final(params);
-        for (const Color& c : out.pixels)
-            for (int k = 0; k < 3; ++k) ASSERT_NEAR(c[k], 0.37, 1e-5);
-    }
-}
-
 // With every weight at one (distances scaled away, flat features, no fade) the final filter
 // is the mean over its (2 radius + 1)^2 window: i.i.d. noise's variance drops by that count.
 TEST(Denoise, FinalFilterNoiseOnAConstantDropsByTheWindowsCount) {
@@ -251,19 +245,7 @@ TEST(Denoise, FinalFilterNoiseOnAConstantDropsByTheWindowsCount) {
             params.k = NlmParams{}.k;
             params.k_weak = NlmParams{}.k_weak;
         }
-        const Image out = s.denoise_final(params);
-        const int margin = flat.radius;
-        double sum = 0, sq = 0;
-        int n = 0;
-        for (int y = margin; y < s.h - margin; ++y)
-            for (int x = margin; x < s.w - margin; ++x) {
-                const double v = out.at(x, y).y;
-                sum += v;
-                sq += v * v;
-                ++n;
-            }
-        const double mean = sum / n, factor = (sq / n - mean * mean) / (0.1 * 0.1);
-        EXPECT_NEAR(mean, 1.0, 0.005);
+        const double factor = noise_factor(s.denoise_final(params), flat.radius, 0.1);
         if (!default_weights) {
             // About 180^2 / 289 independent windows: a spread of about 5 %.
             EXPECT_GT(factor, 0.8 / window);
@@ -294,23 +276,16 @@ TEST(Denoise, FinalFilterRemovesAFireflyAndKeepsAHighlight) {
     EXPECT_NEAR(out.at(43, 20).y, 0.5, 0.1);  // and it did not spread
 }
 
-TEST(Denoise, FinalFilterLeavesAConvergedImageAsItIs) {
+TEST(Denoise, ConvergedImageIsLeftAsItIs) {
+    // A relative standard error far below the fade's: each filter's output is its input.
     Synthetic s(48, 48);
     for (int y = 0; y < s.h; ++y)
         for (int x = 0; x < s.w; ++x) s.set(x, y, 0.1 + 0.8 * ((x / 3 + y / 5) % 2), 0.5, {0, 0, -1}, 10);
     s.add_noise_halves(1e-5);
-    const Image out = s.denoise_final();
-    for (size_t i = 0; i < out.pixels.size(); ++i) ASSERT_NEAR(out.pixels[i].y, s.noisy.pixels[i].y, 2e-5);
-}
-
-TEST(Denoise, ConvergedImageIsLeftAsItIs) {
-    // A relative standard error far below the fade's: the output is the input.
-    Synthetic s(48, 48);
-    for (int y = 0; y < s.h; ++y)
-        for (int x = 0; x < s.w; ++x) s.set(x, y, 0.1 + 0.8 * ((x / 3 + y / 5) % 2), 0.5, {0, 0, -1}, 10);
-    s.add_noise(1e-5);
-    const Image out = s.denoise();
-    for (size_t i = 0; i < out.pixels.size(); ++i) ASSERT_NEAR(out.pixels[i].y, s.noisy.pixels[i].y, 2e-5);
+    for (const bool final : {false, true}) {
+        const Image out = final ? s.denoise_final() : s.denoise();
+        for (size_t i = 0; i < out.pixels.size(); ++i) ASSERT_NEAR(out.pixels[i].y, s.noisy.pixels[i].y, 2e-5) << final;
+    }
 }
 
 TEST(Denoise, FeatureBuffersAverageTheCameraSamples) {

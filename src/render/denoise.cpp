@@ -144,6 +144,13 @@ void prepare(const DenoiseInput& in, Planes& p) {
         }
 }
 
+// Both filters' start: the caller's workspace (or `local`), prepared for `input`.
+Planes& prepared_planes(const DenoiseInput& input, DenoiseWorkspace* workspace, DenoiseWorkspace& local) {
+    Planes& p = workspace ? *workspace : local;
+    prepare(input, p);
+    return p;
+}
+
 // One tap of an a-trous pass along a row: pixels [x0, x1) of the row at p, their taps at
 // p + off. Compiled for AVX2 too where GCC can dispatch on the CPU (twice the lanes).
 struct TapRow {
@@ -208,8 +215,7 @@ void remodulate_and_fade(const DenoiseInput& input, float fade_error, Planes& p,
 
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, DenoiseWorkspace* workspace) {
     DenoiseWorkspace local;
-    Planes& p = workspace ? *workspace : local;
-    prepare(input, p);
+    Planes& p = prepared_planes(input, workspace, local);
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
     Image out(w, h);
@@ -509,13 +515,12 @@ void box_mean(int w, int h, int r, const std::vector<float>& in, std::vector<flo
 
 Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, DenoiseWorkspace* workspace) {
     DenoiseWorkspace local;
-    Planes& p = workspace ? *workspace : local;
-    prepare(input, p);
-    const int w = p.w, h = p.h;
-    const size_t n = size_t(w) * size_t(h);
-    Image out(w, h);
-    if (n == 0) return out;
+    Planes& p = prepared_planes(input, workspace, local);
+    Image out(p.w, p.h);
+    if (out.pixels.empty()) return out;
     prepare_halves(input, p);
+    const int w = p.w, h = p.h;
+    const size_t n = out.pixels.size();
     const bool halves = input.half_count[0].size() == n && input.half_count[1].size() == n;
     // Each candidate's image (the halves averaged by their counts) and its estimated error:
     // Stein's unbiased risk estimate per half, which a filter linear in the half it filters
