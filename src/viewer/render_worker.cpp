@@ -142,8 +142,8 @@ void RenderWorker::publish_error(uint64_t generation, std::string error) {
 
 namespace {
 
-// The denoised radiance of `state`, developed as `render --denoise` and Save develop it
-// (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
+// The denoised radiance of `state` for the display, developed by render/outputs.h with the
+// interactive filter (Save and `render --denoise` develop with the final one). `albedo` and `normal` keep the feature buffers of a full-resolution
 // state between passes (empty: made here).
 Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
                         std::vector<float>& normal, DenoiseWorkspace& workspace) {
