@@ -300,6 +300,18 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, Deno
 
 namespace {
 
+// Whether neighbouring pixels i and j see the same surface: normals within about 25 degrees,
+// albedos within 0.1, depths within twice the local gradient (a pixel is its own).
+bool same_surface(const Planes& p, size_t i, size_t j) {
+    float fd = 0, da = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float d = p.demod[k][i] - p.demod[k][j];
+        da += d * d;
+    }
+    for (const auto& f : p.f) fd += f[i] * f[j];
+    return i == j || (fd > 0.9f && da < 0.01f && std::fabs(p.z[i] - p.z[j]) <= 2 * (p.zgrad[i] + 1e-3f * p.z[i]));
+}
+
 // The guides of the final filter: per half g, the demodulated radiance u[g] and the variance
 // of its mean v[g] (3x3-prefiltered). A pixel without two non-empty halves takes the mean for
 // both, with the mean's variance.
@@ -339,8 +351,9 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
     p.clamped.assign(n, 0);
     if (!halves) return;
     // Fireflies: a rare bright sample lands in one half only, so each half's value is clamped
-    // to the range of the other half's 3x3 neighbourhood (a highlight is in both halves and
-    // stays). Biased, as the a-trous filter's luminance stop is, for far less error.
+    // to the range of the other half's 3x3 neighbourhood on the same surface (a highlight is
+    // in both halves and stays; a pixel across an edge would widen the range on one side).
+    // Biased, as the a-trous filter's luminance stop is, for far less error.
     for (int k = 0; k < 3; ++k) {
         std::vector<float>& clamped = p.var_blur;
         for (int g = 0; g < 2; ++g) {
@@ -349,15 +362,23 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
 #pragma omp parallel for schedule(static)
             for (int y = 0; y < p.h; ++y)
                 for (int x = 0; x < p.w; ++x) {
-                    float lo = INFINITY, hi = -INFINITY;
+                    // The range over the same surface's pixels, and over all nine.
+                    float lo = INFINITY, hi = -INFINITY, all_lo = INFINITY, all_hi = -INFINITY;
+                    int count = 0;
+                    const size_t i = size_t(y) * size_t(p.w) + size_t(x);
                     for (int yy = std::max(0, y - 1); yy <= std::min(p.h - 1, y + 1); ++yy)
                         for (int xx = std::max(0, x - 1); xx <= std::min(p.w - 1, x + 1); ++xx) {
-                            const float o = other[size_t(yy) * size_t(p.w) + size_t(xx)];
+                            const size_t j = size_t(yy) * size_t(p.w) + size_t(xx);
+                            const float o = other[j];
+                            all_lo = std::min(all_lo, o);
+                            all_hi = std::max(all_hi, o);
+                            if (!same_surface(p, i, j)) continue;
+                            ++count;
                             lo = std::min(lo, o);
                             hi = std::max(hi, o);
                         }
-                    const size_t i = size_t(y) * size_t(p.w) + size_t(x);
-                    clamped[i] = std::clamp(mine[i], lo, hi);
+                    // Fewer than 4 values on the surface say too little of the range: all nine.
+                    clamped[i] = count >= 4 ? std::clamp(mine[i], lo, hi) : std::clamp(mine[i], all_lo, all_hi);
                 }
             // Both halves are clamped against the other's unclamped values.
             std::swap(p.acc[g][k], clamped);

@@ -70,8 +70,8 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {},
 
 // The final filter's parameters (docs/denoising.md says how they were chosen).
 struct NlmParams {
-    int radius = 8;             // search window: (2 radius + 1)^2 pixels
-    int patch = 2;              // patch: (2 patch + 1)^2 pixels
+    int radius = 5;             // search window: (2 radius + 1)^2 pixels
+    int patch = 1;              // patch: (2 patch + 1)^2 pixels
     float k = 0.45f;            // patch distance scale, in standard deviations of the difference
     float k_weak = 0.25f;       // the second candidate's (per pixel the one of least estimated error)
     int select_radius = 3;      // the estimated errors are averaged over (2 r + 1)^2 pixels
