@@ -1,12 +1,14 @@
 // docs/denoising.md's figures: the denoiser's error against a converged reference, raw and
 // denoised, at several sample counts, and its cost.
 //   keithray_bench_denoise cost [ROUNDS]
-//       the a-trous filter alone on scene 3's 4 spp estimates at 512x512 and 1920x1080
-//       (medians of ROUNDS runs; OMP_NUM_THREADS sets the threads)
+//       each filter alone on scene 3's 4 spp estimates at 512x512 and 1920x1080 (medians of
+//       ROUNDS runs of the a-trous filter, of at most 3 of the final one; OMP_NUM_THREADS sets
+//       the threads)
 //   keithray_bench_denoise error SIZE REFERENCE_SPP SPP,SPP,... SCENE.json...
 //       each scene at SIZE x SIZE: a reference at REFERENCE_SPP (seed 99, exact light
-//       sampling), then renders at each SPP (seed 1) raw and denoised: relMSE (luminance,
-//       over ref^2 + 0.01) and PSNR of the sRGB-tone-mapped 8-bit images against the reference's
+//       sampling), then renders at each SPP (seed 1) raw and denoised by each filter (the
+//       interactive a-trous and the final one): relMSE (luminance, over ref^2 + 0.01) and PSNR
+//       of the sRGB-tone-mapped 8-bit images against the reference's
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -47,6 +49,7 @@ RenderState render(const Prepared& p, int spp, uint64_t seed) {
     RenderSettings s = p.settings;
     s.seed = seed;
     RenderState state(p.scene.renderer.width, p.scene.renderer.height);
+    state.track_halves();  // as render --denoise does
     StopRule rule;
     rule.max_passes = spp;
     render_until(p.rs, s, state, rule);
@@ -80,6 +83,7 @@ double median(std::vector<double> v) {
 }
 
 int cost(int rounds, const std::string& scene_file) {
+    const int final_rounds = std::min(rounds, 3);
     for (const auto [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
         const Prepared p = prepare(scene_file, w, h, false);
         const RenderState state = render(p, 4, 1);
@@ -97,7 +101,11 @@ int cost(int rounds, const std::string& scene_file) {
         in.albedo = albedo;
         in.normal = normal;
         in.depth = est.depth;
-        std::vector<double> ms, cpu_ms, feature_ms;
+        for (int h = 0; h < 2; ++h) {
+            in.half[h] = &est.halves.mean[h];
+            in.half_count[h] = est.halves.count[h];
+        }
+        std::vector<double> ms, cpu_ms, feature_ms, final_ms, final_cpu_ms;
         DenoiseWorkspace workspace;  // as the viewer keeps it
         for (int r = 0; r < rounds; ++r) {
             const double c0 = cpu_seconds();
@@ -107,6 +115,14 @@ int cost(int rounds, const std::string& scene_file) {
             cpu_ms.push_back(1e3 * (cpu_seconds() - c0));
             ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
             if (out.pixels.empty()) return 1;
+            if (r < final_rounds) {
+                const double f0 = cpu_seconds();
+                const auto s0 = std::chrono::steady_clock::now();
+                const Image final = denoise_nlmeans(in, {}, &workspace);
+                final_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count());
+                final_cpu_ms.push_back(1e3 * (cpu_seconds() - f0));
+                if (final.pixels.empty()) return 1;
+            }
             if (r < 3) {
                 t0 = std::chrono::steady_clock::now();
                 (void)averaged_surface_layers(p.rs, p.settings, w, h, kFeatureSamples);
@@ -115,15 +131,16 @@ int cost(int rounds, const std::string& scene_file) {
             }
         }
         std::printf("%dx%d: a-trous filter %.1f ms wall (median of %d; min %.1f), %.1f ms CPU (all threads; min %.1f); "
-                    "feature buffers at %d samples %.1f ms wall\n",
+                    "feature buffers at %d samples %.1f ms wall; final filter %.0f ms wall (median of %d), %.0f ms CPU\n",
                     w, h, median(ms), rounds, *std::min_element(ms.begin(), ms.end()), median(cpu_ms),
-                    *std::min_element(cpu_ms.begin(), cpu_ms.end()), kFeatureSamples, median(feature_ms));
+                    *std::min_element(cpu_ms.begin(), cpu_ms.end()), kFeatureSamples, median(feature_ms),
+                    median(final_ms), final_rounds, median(final_cpu_ms));
     }
     return 0;
 }
 
 int error(int size, int reference_spp, const std::vector<int>& spps, const std::vector<std::string>& scenes) {
-    std::printf("scene | spp | relMSE raw | relMSE denoised | PSNR raw | PSNR denoised\n");
+    std::printf("scene | spp | relMSE raw | relMSE a-trous | relMSE final | PSNR raw | PSNR a-trous | PSNR final\n");
     for (const std::string& file : scenes) {
         const Prepared p = prepare(file, size, size, true);
         const Image reference = render(p, reference_spp, 99).radiance();
@@ -133,10 +150,16 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
             options.denoise = Denoise::on;
             options.sampling = p.settings;
             options.sampling.seed = 1;
-            const Developed d = develop(p.rs, render_estimates(state, kAllLayers), options, kLayerRadiance);
-            std::printf("%s | %d | %.5f | %.5f | %.2f | %.2f\n", file.substr(file.find_last_of('/') + 1).c_str(), spp,
-                        rel_mse(d.raw, reference), rel_mse(d.radiance, reference), psnr_srgb(d.raw, reference),
-                        psnr_srgb(d.radiance, reference));
+            const RenderEstimates estimates = render_estimates(state, kAllLayers);
+            options.interactive = true;
+            const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
+            options.interactive = false;
+            const Developed final = develop(p.rs, estimates, options, kLayerRadiance);
+            std::printf("%s | %d | %.5f | %.5f | %.5f | %.2f | %.2f | %.2f\n",
+                        file.substr(file.find_last_of('/') + 1).c_str(), spp, rel_mse(final.raw, reference),
+                        rel_mse(fast.radiance, reference), rel_mse(final.radiance, reference),
+                        psnr_srgb(final.raw, reference), psnr_srgb(fast.radiance, reference),
+                        psnr_srgb(final.radiance, reference));
             std::fflush(stdout);
         }
     }

@@ -159,6 +159,7 @@ TEST_F(SaveDialog, ImageFilesAreTheRenderOutputsOfTheSameState) {
     ViewerModel m;
     m.set_scene(scene);
     RenderState state(24, 16);
+    state.track_halves();  // as the render thread and render --denoise do: the final filter's
     StopRule rule;
     rule.max_passes = 2;
     render_until(*m.prepared(), m.settings().render, state, rule);
@@ -167,7 +168,7 @@ TEST_F(SaveDialog, ImageFilesAreTheRenderOutputsOfTheSameState) {
     frame.radiance = state.radiance();
     record_pixel_statistics(state, frame);
 
-    // Raw and denoised (the display's denoiser, which Save develops with, as render --denoise).
+    // Raw and denoised (Save develops with the final filter over the halves, as render --denoise).
     for (const DenoiseView view : {DenoiseView::off, DenoiseView::on})
     for (const char* ext : {".ppm", ".png", ".exr", ".pfm"}) {
         m.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.denoise = view; });

@@ -375,6 +375,14 @@ private:
         auto last_checkpoint = std::chrono::steady_clock::now();
         double last_draw = -1;
         StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
+        // The final denoiser's two halves of the samples, from here on (a checkpoint does not
+        // hold them); under MPI they are not gathered, and it filters without them.
+        if (denoise() != Denoise::off) {
+            if (!cluster_.distributed()) state_.track_halves();
+            else if (leader_)
+                std::fprintf(stderr, "note: %s: under MPI --denoise filters without the two halves of the samples "
+                                     "(docs/denoising.md)\n", file_.c_str());
+        }
         hooks_ = cluster_.deal_rows(open_ended_);
         stage_ = "rendering a " + image_;
         StopReason reason = render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {

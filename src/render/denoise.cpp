@@ -144,6 +144,13 @@ void prepare(const DenoiseInput& in, Planes& p) {
         }
 }
 
+// Both filters' start: the caller's workspace (or `local`), prepared for `input`.
+Planes& prepared_planes(const DenoiseInput& input, DenoiseWorkspace* workspace, DenoiseWorkspace& local) {
+    Planes& p = workspace ? *workspace : local;
+    prepare(input, p);
+    return p;
+}
+
 // One tap of an a-trous pass along a row: pixels [x0, x1) of the row at p, their taps at
 // p + off. Compiled for AVX2 too where GCC can dispatch on the CPU (twice the lanes).
 struct TapRow {
@@ -175,12 +182,40 @@ void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float si
     }
 }
 
+// The last step of both filters: the filtered demodulated radiance (p.c) times the albedo,
+// then faded towards the raw radiance as its relative standard error drops (the
+// 3x3-prefiltered raw variance against the filtered luminance), so a converged pixel keeps
+// its raw value. A pixel whose p.c is NaN keeps its raw value exactly.
+void remodulate_and_fade(const DenoiseInput& input, float fade_error, Planes& p, Image& out) {
+    std::vector<float>& raw_var = p.var_blur;
+    blur3(p.w, p.h, p.raw_var, raw_var);
+    const float t2 = fade_error * fade_error;
+    const Image& raw = *input.radiance;
+    const long count = long(raw.pixels.size());
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < count; ++li) {
+        const size_t i = size_t(li);
+        if (std::isnan(p.c[0][i])) {
+            out.pixels[i] = raw.pixels[i];
+            continue;
+        }
+        const Color filtered{double(p.c[0][i] * p.demod[0][i]), double(p.c[1][i] * p.demod[1][i]),
+                             double(p.c[2][i] * p.demod[2][i])};
+        const double l = std::max(luminance(filtered), 0.0);
+        double blend = 1;
+        if (t2 > 0) {
+            const double r2 = l > 0 ? raw_var[i] / (l * l) : (raw_var[i] > 0 ? INFINITY : 0.0);
+            blend = std::isfinite(r2) ? r2 / (r2 + t2) : 1.0;
+        }
+        out.pixels[i] = raw.pixels[i] + blend * (filtered - raw.pixels[i]);
+    }
+}
+
 }  // namespace
 
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, DenoiseWorkspace* workspace) {
     DenoiseWorkspace local;
-    Planes& p = workspace ? *workspace : local;
-    prepare(input, p);
+    Planes& p = prepared_planes(input, workspace, local);
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
     Image out(w, h);
@@ -259,26 +294,313 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, Deno
             }
         }
     }
-    // Remodulate, then fade towards the raw radiance as its relative standard error drops
-    // (the 3x3-prefiltered raw variance against the filtered luminance).
-    std::vector<float>& raw_var = p.var_blur;
-    blur3(w, h, p.raw_var, raw_var);
-    const float t2 = params.fade_error * params.fade_error;
-    const Image& raw = *input.radiance;
+    remodulate_and_fade(input, params.fade_error, p, out);
+    return out;
+}
+
+namespace {
+
+// Whether neighbouring pixels i and j see the same surface: normals within about 25 degrees,
+// albedos within 0.1, depths within twice the local gradient (a pixel is its own).
+bool same_surface(const Planes& p, size_t i, size_t j) {
+    float fd = 0, da = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float d = p.demod[k][i] - p.demod[k][j];
+        da += d * d;
+    }
+    for (const auto& f : p.f) fd += f[i] * f[j];
+    return i == j || (fd > 0.9f && da < 0.01f && std::fabs(p.z[i] - p.z[j]) <= 2 * (p.zgrad[i] + 1e-3f * p.z[i]));
+}
+
+// The guides of the final filter: per half g, the demodulated radiance u[g] and the variance
+// of its mean v[g] (3x3-prefiltered). A pixel without two non-empty halves takes the mean for
+// both, with the mean's variance.
+void prepare_halves(const DenoiseInput& in, Planes& p) {
+    const size_t n = size_t(p.w) * size_t(p.h);
+    for (int g = 0; g < 2; ++g)
+        for (int k = 0; k < 3; ++k) {
+            p.u[g][k].resize(n);
+            p.v[g][k].resize(n);
+        }
+    const bool halves = in.half[0] && in.half[1] && in.half[0]->pixels.size() == n && in.half[1]->pixels.size() == n &&
+                        in.half_count[0].size() == n && in.half_count[1].size() == n;
     const long count = long(n);
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < count; ++li) {
         const size_t i = size_t(li);
-        const Color filtered{double(p.c[0][i] * p.demod[0][i]), double(p.c[1][i] * p.demod[1][i]),
-                             double(p.c[2][i] * p.demod[2][i])};
-        const double l = std::max(luminance(filtered), 0.0);
-        double blend = 1;
-        if (t2 > 0) {
-            const double r2 = l > 0 ? raw_var[i] / (l * l) : (raw_var[i] > 0 ? INFINITY : 0.0);
-            blend = std::isfinite(r2) ? r2 / (r2 + t2) : 1.0;
+        const uint32_t n0 = halves ? in.half_count[0][i] : 0, n1 = halves ? in.half_count[1][i] : 0;
+        const bool split = n0 > 0 && n1 > 0;
+        for (int g = 0; g < 2; ++g) {
+            // A half's mean has the variance of the pixel's mean times all samples over its own.
+            const double share = split ? double(n0 + n1) / double(g == 0 ? n0 : n1) : 1.0;
+            for (int k = 0; k < 3; ++k) {
+                const float d = p.demod[k][i];
+                const double r = split ? in.half[g]->pixels[i][k] : in.radiance->pixels[i][k];
+                const float v = float(in.variance[3 * i + size_t(k)] * share) / (d * d);
+                p.u[g][k][i] = float(r) / d;
+                p.v[g][k][i] = std::isfinite(v) ? v : INFINITY;
+            }
         }
-        out.pixels[i] = raw.pixels[i] + blend * (filtered - raw.pixels[i]);
     }
+    for (int g = 0; g < 2; ++g)
+        for (int k = 0; k < 3; ++k) {
+            fill_unknown_variance(p.w, p.h, p.u[g][k], p.v[g][k]);
+            blur3(p.w, p.h, p.v[g][k], p.var_blur);
+            std::swap(p.v[g][k], p.var_blur);
+        }
+    p.clamped.assign(n, 0);
+    if (!halves) return;
+    // Fireflies: a rare bright sample lands in one half only, so each half's value is clamped
+    // to the range of the other half's 3x3 neighbourhood on the same surface (a highlight is
+    // in both halves and stays; a pixel across an edge would widen the range on one side).
+    // Biased, as the a-trous filter's luminance stop is, for far less error.
+    for (int k = 0; k < 3; ++k) {
+        std::vector<float>& clamped = p.var_blur;
+        for (int g = 0; g < 2; ++g) {
+            const std::vector<float>&mine = p.u[g][k], &other = p.u[1 - g][k];
+            clamped.resize(n);
+#pragma omp parallel for schedule(static)
+            for (int y = 0; y < p.h; ++y)
+                for (int x = 0; x < p.w; ++x) {
+                    // The range over the same surface's pixels, and over all nine.
+                    float lo = INFINITY, hi = -INFINITY, all_lo = INFINITY, all_hi = -INFINITY;
+                    int count = 0;
+                    const size_t i = size_t(y) * size_t(p.w) + size_t(x);
+                    for (int yy = std::max(0, y - 1); yy <= std::min(p.h - 1, y + 1); ++yy)
+                        for (int xx = std::max(0, x - 1); xx <= std::min(p.w - 1, x + 1); ++xx) {
+                            const size_t j = size_t(yy) * size_t(p.w) + size_t(xx);
+                            const float o = other[j];
+                            all_lo = std::min(all_lo, o);
+                            all_hi = std::max(all_hi, o);
+                            if (!same_surface(p, i, j)) continue;
+                            ++count;
+                            lo = std::min(lo, o);
+                            hi = std::max(hi, o);
+                        }
+                    // Fewer than 4 values on the surface say too little of the range: all nine.
+                    clamped[i] = count >= 4 ? std::clamp(mine[i], lo, hi) : std::clamp(mine[i], all_lo, all_hi);
+                }
+            // Both halves are clamped against the other's unclamped values.
+            std::swap(p.acc[g][k], clamped);
+        }
+        for (int g = 0; g < 2; ++g) std::swap(p.u[g][k], p.acc[g][k]);
+    }
+    // The raw candidate of a pixel whose halves were clamped is their clamped mean.
+    p.clamped.assign(n, 0);
+    const long count2 = long(n);
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < count2; ++li) {
+        const size_t i = size_t(li);
+        bool changed = false;
+        for (int g = 0; g < 2; ++g)
+            for (int k = 0; k < 3; ++k) changed |= p.u[g][k][i] != p.acc[g][k][i];
+        if (!changed) continue;
+        p.clamped[i] = 1;
+        const double n0 = in.half_count[0][i], n1 = in.half_count[1][i], t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
+        for (int k = 0; k < 3; ++k) p.c[k][i] = float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i]));
+    }
+}
+
+// One guide's patch distance terms along a row, for the pixels [x0, x1) of the row at `at`
+// against those at `at + off` (Rousselle et al. 2012): per channel the squared difference
+// less its expected noise, over eps + k^2 times the variance of the difference, averaged.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void patch_terms(const float* const u[3], const float* const v[3], size_t at, ptrdiff_t off, int x0, int x1, float k2,
+                 float* out) {
+    for (int x = x0; x < x1; ++x) out[x] = 0;
+    for (int c = 0; c < 3; ++c) {
+        const float *up = u[c] + at, *uq = u[c] + at + off, *vp = v[c] + at, *vq = v[c] + at + off;
+#pragma omp simd
+        for (int x = x0; x < x1; ++x) {
+            const float d = up[x] - uq[x];
+            const float noise = vp[x] + std::min(vp[x], vq[x]);
+            out[x] += (d * d - noise) / (1e-10f + k2 * (vp[x] + vq[x]));
+        }
+    }
+}
+
+
+// One non-local means filter of both halves at distance scale k: p.acc[g] gets half g's
+// sums with weights from the other half, and their weights (the centre's is 1).
+void nlm_filter(const NlmParams& params, float k, Planes& p) {
+    const int w = p.w, h = p.h;
+    const size_t n = size_t(w) * size_t(h);
+    for (int g = 0; g < 2; ++g) {
+        p.hbox[g].assign(n, 0.f);
+        for (auto& plane : p.acc[g]) plane.assign(n, 0.f);
+    }
+    const int r = std::max(0, params.radius), f = std::max(0, params.patch);
+    const float k2 = k * k, inv_patch = 1.f / float((2 * f + 1) * (2 * f + 1));
+    const float inv_albedo2 = 1.f / (params.sigma_albedo * params.sigma_albedo);
+#pragma omp parallel
+    {
+        std::vector<float> terms(static_cast<size_t>(w)), wf(static_cast<size_t>(w));
+        for (int oy = -r; oy <= r; ++oy)
+            for (int ox = -r; ox <= r; ++ox) {
+                // The pixels whose offset neighbour q = p + (ox, oy) lies in the image.
+                const int x0 = std::max(0, -ox), x1 = std::min(w, w - ox), y0 = std::max(0, -oy), y1 = std::min(h, h - oy);
+                if (x0 >= x1 || y0 >= y1) continue;
+                const ptrdiff_t off = ptrdiff_t(oy) * w + ox;
+                // 1. Per guide, the distance terms of each pixel, summed over the patch's
+                //    columns (running sums; the row's ends repeat its first and last term).
+#pragma omp for schedule(static)
+                for (int y = y0; y < y1; ++y) {
+                    const size_t row = size_t(y) * size_t(w);
+                    for (int g = 0; g < 2; ++g) {
+                        const float* const u[3] = {p.u[g][0].data(), p.u[g][1].data(), p.u[g][2].data()};
+                        const float* const v[3] = {p.v[g][0].data(), p.v[g][1].data(), p.v[g][2].data()};
+                        patch_terms(u, v, row, off, x0, x1, k2, terms.data());
+                        float* hb = p.hbox[g].data() + row;
+                        float sum = 0;
+                        for (int dx = -f; dx <= f; ++dx) sum += terms[size_t(std::clamp(x0 + dx, x0, x1 - 1))];
+                        for (int x = x0; x < x1; ++x) {
+                            hb[x] = sum;
+                            sum += terms[size_t(std::min(x + f + 1, x1 - 1))] - terms[size_t(std::max(x - f, x0))];
+                        }
+                    }
+                }
+                // 2. The patch distance (the column sums over the patch's rows, the image's
+                //    ends repeated), its weight times the feature stops, and each half's
+                //    sums with the other half's weights.
+                const float zscale = params.sigma_depth * float(std::max(std::abs(ox), std::abs(oy)));
+#pragma omp for schedule(static)
+                for (int y = y0; y < y1; ++y) {
+                    const size_t row = size_t(y) * size_t(w);
+                    const size_t qrow = size_t(ptrdiff_t(row) + off);
+                    const float *f0 = p.f[0].data() + row, *f1 = p.f[1].data() + row, *f2 = p.f[2].data() + row,
+                                *f3 = p.f[3].data() + row, *q0 = p.f[0].data() + qrow, *q1 = p.f[1].data() + qrow,
+                                *q2 = p.f[2].data() + qrow, *q3 = p.f[3].data() + qrow;
+                    const float *a0 = p.demod[0].data() + row, *a1 = p.demod[1].data() + row,
+                                *a2 = p.demod[2].data() + row, *b0 = p.demod[0].data() + qrow,
+                                *b1 = p.demod[1].data() + qrow, *b2 = p.demod[2].data() + qrow;
+                    const float *z = p.z.data() + row, *qz = p.z.data() + qrow, *zg = p.zgrad.data() + row;
+#pragma omp simd
+                    for (int x = x0; x < x1; ++x) {
+                        const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
+                        const float da0 = a0[x] - b0[x], da1 = a1[x] - b1[x], da2 = a2[x] - b2[x];
+                        wf[size_t(x)] = params.sigma_normal * std::max(0.f, 1.f - fd) +
+                                        (da0 * da0 + da1 * da1 + da2 * da2) * inv_albedo2 +
+                                        std::fabs(z[x] - qz[x]) / (zscale * zg[x] + 1e-3f * z[x] + 1e-9f);
+                    }
+                    for (int g = 0; g < 2; ++g) {
+                        const float* rows[16];
+                        const int taps = std::min(2 * f + 1, 16);
+                        for (int t = 0; t < taps; ++t)
+                            rows[t] = p.hbox[g].data() + size_t(std::clamp(y + t - f, y0, y1 - 1)) * size_t(w);
+                        // Guide g's weights filter the other half.
+                        const int o = 1 - g;
+                        float *sr = p.acc[o][0].data() + row, *sg = p.acc[o][1].data() + row,
+                              *sb = p.acc[o][2].data() + row, *sw = p.acc[o][3].data() + row;
+                        const float *ur = p.u[o][0].data() + qrow, *ug = p.u[o][1].data() + qrow,
+                                    *ub = p.u[o][2].data() + qrow;
+#pragma omp simd
+                        for (int x = x0; x < x1; ++x) {
+                            float dist = 0;
+                            for (int t = 0; t < taps; ++t) dist += rows[t][x];
+                            const float wt = fast_exp_neg(std::max(0.f, dist * inv_patch) + wf[size_t(x)]);
+                            sw[x] += wt;
+                            sr[x] += wt * ur[x];
+                            sg[x] += wt * ug[x];
+                            sb[x] += wt * ub[x];
+                        }
+                    }
+                }
+            }
+    }
+}
+
+// A plane's mean over the (2 r + 1)^2 box around each pixel (the image's ends repeated).
+void box_mean(int w, int h, int r, const std::vector<float>& in, std::vector<float>& tmp, std::vector<float>& out) {
+    tmp.resize(in.size());
+    out.resize(in.size());
+    const float inv = 1.f / float((2 * r + 1) * (2 * r + 1));
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float s = 0;
+            for (int d = -r; d <= r; ++d) s += in[size_t(y) * size_t(w) + size_t(std::clamp(x + d, 0, w - 1))];
+            tmp[size_t(y) * size_t(w) + size_t(x)] = s;
+        }
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float s = 0;
+            for (int d = -r; d <= r; ++d) s += tmp[size_t(std::clamp(y + d, 0, h - 1)) * size_t(w) + size_t(x)];
+            out[size_t(y) * size_t(w) + size_t(x)] = s * inv;
+        }
+}
+
+}  // namespace
+
+Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, DenoiseWorkspace* workspace) {
+    DenoiseWorkspace local;
+    Planes& p = prepared_planes(input, workspace, local);
+    Image out(p.w, p.h);
+    if (out.pixels.empty()) return out;
+    prepare_halves(input, p);
+    const int w = p.w, h = p.h;
+    const size_t n = out.pixels.size();
+    const bool halves = input.half_count[0].size() == n && input.half_count[1].size() == n;
+    // Each candidate's image (the halves averaged by their counts) and its estimated error:
+    // Stein's unbiased risk estimate per half, which a filter linear in the half it filters
+    // allows (the weights come from the other half): |F - u|^2 - v + 2 (dF/du) v per channel,
+    // dF/du the centre's share of the weights, 1 over their sum.
+    const float strengths[2] = {params.k, params.k_weak};
+    for (int c = 0; c < 2; ++c) {
+        nlm_filter(params, strengths[c], p);
+        for (auto& plane : p.cand[c]) plane.resize(n);
+#pragma omp parallel for schedule(static)
+        for (long li = 0; li < long(n); ++li) {
+            const size_t i = size_t(li);
+            const double n0 = halves ? input.half_count[0][i] : 1, n1 = halves ? input.half_count[1][i] : 1;
+            const double t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
+            float risk = 0;
+            for (int k = 0; k < 3; ++k) {
+                float fh[2];
+                for (int g = 0; g < 2; ++g) {
+                    const float inv = 1 / p.acc[g][3][i];
+                    fh[g] = p.acc[g][k][i] * inv;
+                    const float d = fh[g] - p.u[g][k][i], v = std::isfinite(p.v[g][k][i]) ? p.v[g][k][i] : 0.f;
+                    risk += d * d - v + 2 * inv * v;
+                }
+                p.cand[c][k][i] = float(fh[0] + t * (fh[1] - fh[0]));
+            }
+            p.cand[c][3][i] = risk;
+        }
+        box_mean(w, h, params.select_radius, p.cand[c][3], p.hbox[0], p.hbox[1]);
+        std::swap(p.cand[c][3], p.hbox[1]);
+    }
+    // The raw mean is the third candidate, its risk the halves' variances: where no filter
+    // is estimated to do better (a converged or noiseless region) the pixel stays raw.
+    std::vector<float>& raw_risk = p.cand[2][3];
+    raw_risk.resize(n);
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < long(n); ++li) {
+        float risk = 0;
+        for (int g = 0; g < 2; ++g)
+            for (int k = 0; k < 3; ++k) {
+                const float v = p.v[g][k][size_t(li)];
+                risk += std::isfinite(v) ? v : 0.f;
+            }
+        raw_risk[size_t(li)] = risk;
+    }
+    box_mean(w, h, params.select_radius, raw_risk, p.hbox[0], p.hbox[1]);
+    std::swap(raw_risk, p.hbox[1]);
+    // Per pixel the candidate of the smallest smoothed risk (the raw one: its clamped mean, or
+    // where nothing was clamped NaN, which remodulate_and_fade reads as the raw radiance, bit
+    // for bit).
+#pragma omp parallel for schedule(static)
+    for (long li = 0; li < long(n); ++li) {
+        const size_t i = size_t(li);
+        const int c = p.cand[1][3][i] < p.cand[0][3][i] ? 1 : 0;
+        if (p.cand[c][3][i] < raw_risk[i])
+            for (int k = 0; k < 3; ++k) p.c[k][i] = p.cand[c][k][i];
+        else if (!p.clamped[i])
+            p.c[0][i] = NAN;
+    }
+    remodulate_and_fade(input, params.fade_error, p, out);
     return out;
 }
 

@@ -14,7 +14,8 @@
 
 namespace kr {
 
-// off: the raw estimate; on: the edge-avoiding a-trous filter (denoise_atrous).
+// off: the raw estimate; on: denoised (render and the viewer's Save: the final filter,
+// denoise_nlmeans; the viewer's live display: the interactive one, denoise_atrous).
 enum class Denoise { off, on };
 inline constexpr EnumNames<Denoise, 2> denoise_names{{"off", "on"}};
 
@@ -25,6 +26,11 @@ struct DenoiseInput {
     std::span<const float> albedo;    // 3 per pixel: first-surface albedo, averaged
     std::span<const float> normal;    // 3 per pixel: first-surface normal, averaged (shorter at silhouettes)
     std::span<const double> depth;    // the mean primary hit distance
+    // The final filter's two independent halves of each pixel's samples (RenderState::halves):
+    // their means and counts. Absent (null), or a pixel with an empty half: that pixel's
+    // distances are taken on the mean itself.
+    const Image* half[2] = {nullptr, nullptr};
+    std::span<const uint32_t> half_count[2];
 };
 
 // The interactive filter's parameters (docs/denoising.md says how they were chosen).
@@ -55,10 +61,40 @@ struct DenoiseWorkspace {
     std::vector<float> z, zgrad;     // depth and its local gradient (per pixel step)
     std::vector<float> raw_var;      // variance of the raw radiance's luminance
     std::vector<float> lum, lum_raw, inv_l, inv_z, var_blur;  // per-pass scratch
+    // The final filter's: per half, the demodulated radiance and its variance, the patch
+    // distances of one offset (summed along rows), the filtered sums and weights.
+    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4];
+    std::vector<uint8_t> clamped;  // per pixel: a half was clamped (a firefly)
 };
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
 
+// The final filter's parameters (docs/denoising.md says how they were chosen).
+struct NlmParams {
+    int radius = 5;             // search window: (2 radius + 1)^2 pixels
+    int patch = 1;              // patch: (2 patch + 1)^2 pixels
+    float k = 0.45f;            // patch distance scale, in standard deviations of the difference
+    float k_weak = 0.25f;       // the second candidate's (per pixel the one of least estimated error)
+    int select_radius = 3;      // the estimated errors are averaged over (2 r + 1)^2 pixels
+    float sigma_normal = 128;   // normal stop: exp(-sigma (1 - n.n'))
+    float sigma_albedo = 0.1f;  // albedo stop: exp(-|a - a'|^2 / sigma^2)
+    float sigma_depth = 1;      // depth stop in units of the local depth gradient times the offset
+    float fade_error = 0.01f;   // as AtrousParams::fade_error
+};
+
+// The final-quality filter: joint non-local means (Buades et al. 2005) with the patch
+// distance of Rousselle, Knaus and Zwicker 2012 (squared differences less their expected
+// noise, over the variance of the difference) taken on the albedo-demodulated radiance,
+// times edge stops on normal, albedo and depth. Each half of the samples is filtered with
+// weights from the other half, so each filtered half is linear in its own samples and Stein's
+// unbiased risk estimate gives its error; per pixel, of the two strengths (k, k_weak) and
+// the raw mean, the one of least risk (averaged over a small box) is kept. The halves are
+// averaged, the albedo multiplied back, and the result faded towards the raw radiance as a
+// pixel converges, as denoise_atrous does. Parallel over rows (OpenMP); the result does not
+// depend on the thread count.
+Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, DenoiseWorkspace* workspace = nullptr);
+
 // Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
-inline constexpr uint64_t kDenoiseBytesPerPixel = 40 * sizeof(float) + sizeof(Color);
+// The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
+inline constexpr uint64_t kDenoiseBytesPerPixel = (40 + 34) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
 
 }  // namespace kr

@@ -81,10 +81,11 @@ const std::array kFlags{
                               "exposure in stops, in %r: radiance x 2^EV before the tone map (default: the "
                               "scene's \"display\" block, else 0)"),
     name_flag<denoise_names, &O::denoise>(
-        "--denoise", "%r: the edge-avoiding a-trous filter on the image, guided by albedo, normal and depth "
-                     "(biased: compare --statistical tests raw images; an .exr keeps the raw radiance as raw.R/G/B; "
-                     "docs/denoising.md); given alone (last, or before a flag or a .json): on (default: off for render, on for "
-                     "view's display)",
+        "--denoise", "%r: denoise the image, guided by albedo, normal and depth: render and the viewer's Save run "
+                     "non-local means over the two halves of the samples, the viewer's display the faster a-trous "
+                     "filter (biased: compare --statistical tests raw images; an .exr keeps the raw radiance as "
+                     "raw.R/G/B; docs/denoising.md); given alone (last, or before a flag or a .json): on (default: off "
+                     "for render, on for view's display)",
         "on"),
 };
 

@@ -31,7 +31,10 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
     if (layers & kLayerRadiance) out.radiance = state.radiance();
     if (layers & kLayerDepth) out.depth = state.mean_depth();
     if (layers & kLayerSamples) out.samples = state.sample_count();
-    if (layers & kLayerVariance) out.variance = floats(state.variance_of_mean());
+    if (layers & kLayerVariance) {
+        out.variance = floats(state.variance_of_mean());
+        if (state.tracks_halves()) out.halves = state.halves();
+    }
     return out;
 }
 
@@ -60,7 +63,17 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
         input.albedo = estimates.albedo;
         input.normal = estimates.normal;
         input.depth = estimates.depth;
-        Image denoised = denoise_atrous(input, {}, options.workspace);
+        // The halves are of the unblurred mean: a blurred image is filtered without them.
+        if (options.blur == 0)
+            for (int h = 0; h < 2; ++h) {
+                input.half[h] = &estimates.halves.mean[h];
+                input.half_count[h] = estimates.halves.count[h];
+            }
+        // A Whitted render's only noise is the pixel's anti-aliasing: the final filter would
+        // only soften its edges (docs/denoising.md), so it keeps the raw image.
+        Image denoised = options.interactive ? denoise_atrous(input, {}, options.workspace)
+                         : options.sampling.integrator == Integrator::wrt ? out.radiance
+                                                                          : denoise_nlmeans(input, {}, options.workspace);
         out.raw = std::exchange(out.radiance, std::move(denoised));
         // An output with first-surface layers keeps the feature buffers the denoiser read.
         if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);

@@ -32,8 +32,12 @@ struct RenderEstimates {
     // keeps them (the viewer's render thread makes them once per edit); develop makes them
     // when it denoises and they are empty.
     std::vector<float> albedo, normal;  // 3 per pixel
+    // The two independent halves of each pixel's samples (RenderState::halves), where the state
+    // keeps them: the final denoiser's guides. Empty: none.
+    RenderState::Halves halves;
 };
-// The estimates of `state` for the layers `layers` asks for (RenderLayer bits).
+// The estimates of `state` for the layers `layers` asks for (RenderLayer bits); with the
+// variance, the halves where the state tracks them.
 RenderEstimates render_estimates(const RenderState& state, unsigned layers);
 
 // How a render is developed into its images. A new step (a denoiser reading the albedo and
@@ -41,8 +45,11 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers);
 struct DevelopOptions {
     int blur = 0;  // box blur radius of the radiance (0: none)
     // The denoiser (render/denoise.h), after the blur; it reads the depth and the variance and
-    // the feature buffers.
+    // the feature buffers (and the halves, where the estimates have them).
     Denoise denoise = Denoise::off;
+    // Which filter denoises: the final one (denoise_nlmeans: render, the viewer's Save) or,
+    // where true, the interactive one (denoise_atrous: the viewer's live display).
+    bool interactive = false;
     // The render's settings: the feature buffers' camera samples are drawn as its are.
     RenderSettings sampling;
     // The denoiser's planes, where the caller keeps them between develops (the viewer).

@@ -18,6 +18,7 @@ void record_pixel_statistics(const RenderState& totals, Snapshot& frame) {
     RenderEstimates layers = render_estimates(totals, kLayerDepth | kLayerVariance);
     frame.depth = std::move(layers.depth);
     frame.variance = std::move(layers.variance);
+    frame.halves = std::move(layers.halves);
 }
 
 std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int height, int x, int y,

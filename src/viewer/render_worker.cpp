@@ -150,14 +150,15 @@ void RenderWorker::publish_error(uint64_t generation, std::string error) {
 
 namespace {
 
-// The denoised radiance of `state`, developed as `render --denoise` and Save develop it
-// (render/outputs.h). `albedo` and `normal` keep the feature buffers of a full-resolution
+// The denoised radiance of `state` for the display, developed by render/outputs.h with the
+// interactive filter (Save and `render --denoise` develop with the final one). `albedo` and `normal` keep the feature buffers of a full-resolution
 // state between passes (empty: made here).
 Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
                         std::vector<float>& normal, DenoiseWorkspace& workspace) {
     DevelopOptions options;
     options.workspace = &workspace;
     options.denoise = Denoise::on;
+    options.interactive = true;  // the live display: the a-trous filter (Save: the final one)
     options.sampling = job.settings;
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
     estimates.albedo = std::move(albedo);
@@ -237,6 +238,7 @@ void RenderWorker::run() {
                 }
                 try {
                     state.reset(w, h);
+                    state.track_halves();  // for Save's final denoiser
                 } catch (const std::bad_alloc&) {
                     driver.reset();
                     lock.unlock();

@@ -85,6 +85,7 @@ struct Snapshot {
     // where every sample hit (infinite where one missed; viewer/inspect.h hit_depths).
     std::shared_ptr<const FeatureBuffers> features;
     std::vector<float> hit_depth;
+    RenderState::Halves halves;  // the two halves of the samples (the final denoiser's guides)
     uint64_t nonfinite_samples = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished

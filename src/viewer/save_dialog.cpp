@@ -43,11 +43,11 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
     if (image_save_kind(path) != kind)
         throw std::invalid_argument(quoted_path(path) + ": a " + format_info(image_format(kind)).name +
                                     " image needs a name ending in " + extension(kind));
-    RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance, {}, {}};
+    RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance, {}, {}, shown->halves};
     OutputRequest request;
     request.path = path;
     request.display = model.settings().tone;
-    // The display's denoiser, as `render --denoise` develops it.
+    // Denoised where the display is, with the final filter, as `render --denoise` develops it.
     request.develop.denoise = model.settings().denoise != DenoiseView::off ? Denoise::on : Denoise::off;
     request.develop.sampling = model.settings().render;
     write_files_atomic(output_files(*model.prepared(), std::move(estimates), request));
