@@ -112,9 +112,12 @@ struct RowDeal {
     }
 };
 
-class DealtRows final : public PassHooks {
+// The driver's hooks of one rank: its rows masked in around each pass, the statistics of its
+// rows' neighbours (the 3x3 guard's) received from the ranks that own them when the plan or
+// the noise rule reads them, and the per-row sums combined (RowShare).
+class DealtRows final : public PassHooks, public RowShare {
 public:
-    DealtRows(int rank, int size, bool always_combine) : rank_(rank), size_(size), always_combine_(always_combine) {}
+    DealtRows(int rank, int size) : RowShare(rank, size) {}
 
     void before_pass(RenderState& state) override {
         // render_pass skips pixels whose mask entry is 0: this rank's rows of the noise
@@ -122,7 +125,7 @@ public:
         const size_t w = size_t(state.width), pixels = w * size_t(state.height);
         if (owned_.size() != pixels) {
             owned_.assign(pixels, 0);
-            for (int y = rank_; y < state.height; y += size_) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
+            for (int y : rows_owned(this, state.height)) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
         }
         noise_mask_.swap(state.buffers().active);
         if (noise_mask_.empty()) {
@@ -132,7 +135,8 @@ public:
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < pixels; ++i) state.buffers().active[i] = owned_[i] & noise_mask_[i];
         }
-        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
+        // Planning and the noise rule since the last pass, less their exchanges.
+        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_ - (cost_.combine_seconds - combine_mark_);
         cpu_start_ = cpu_seconds();
     }
 
@@ -142,15 +146,11 @@ public:
         noise_mask_.clear();
         ++passes_;
         pass_end_ = wall_seconds();
-        if (!statistics && !always_combine_) return;
-        const double start = pass_end_;
-        const RowDeal deal{rank_, size_, state.width, state.height};
-        deal.exchange(state.buffers().radiance_sum, true, mine_, gathered_);
-        deal.exchange(state.buffers().luminance_sq_sum, true, mine_, gathered_);
-        deal.exchange(state.buffers().sample_count, true, mine_, gathered_);
-        pass_end_ = wall_seconds();
-        cost_.combine_seconds += pass_end_ - start;
-        ++cost_.exchanges;
+        if (statistics) {
+            receive_guard_rows(state);
+            ++cost_.exchanges;
+        }
+        combine_mark_ = cost_.combine_seconds;
     }
 
     bool any(bool stop) override {
@@ -159,15 +159,94 @@ public:
         return result != 0;
     }
 
-    RankCost cost_;
+    const RowShare* rows() const override { return this; }
+
+    // Every rank's rows of `values` (`fields` doubles a row), gathered and put in row order.
+    void combine(std::vector<double>& values, int fields) const override {
+        const double start = wall_seconds();
+        const int height = int(values.size() / size_t(fields));
+        const RowDeal deal{index(), count(), fields, height};
+        std::vector<double> mine;
+        for (int y : rows_owned(this, height))
+            mine.insert(mine.end(), values.begin() + ptrdiff_t(y) * fields, values.begin() + ptrdiff_t(y + 1) * fields);
+        const std::vector<int> counts = deal.counts(), offsets = deal.offsets(counts);
+        std::vector<double> all(values.size());
+        MPI_Allgatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                       MPI_DOUBLE, MPI_COMM_WORLD);
+        // Row y is rank (y mod N)'s row y div N.
+        for (int y = 0; y < height; ++y)
+            std::copy_n(all.begin() + offsets[size_t(y % count())] + ptrdiff_t(y / count()) * fields, fields,
+                        values.begin() + ptrdiff_t(y) * fields);
+        cost_.received_bytes += double((values.size() - mine.size()) * sizeof(double));
+        cost_.combine_seconds += wall_seconds() - start;
+    }
+
+    mutable RankCost cost_;
 
 private:
-    int rank_, size_;
-    bool always_combine_;
+    // The rows the 3x3 guard reads besides this rank's own: rows y - 1 and y + 1 of each own
+    // row y, which ranks r - 1 and r + 1 (mod N) own. Each rank sends its rows' three sums to
+    // both and receives theirs (from the one other rank when N = 2).
+    void receive_guard_rows(RenderState& state) {
+        if (count() == 1) return;
+        const double start = wall_seconds();
+        const int width = state.width, height = state.height;
+        const RowDeal deal{index(), count(), width, height};
+        PixelBuffers& px = state.buffers();
+        const size_t w = size_t(width);
+        const size_t row_bytes = w * (sizeof(Color) + sizeof(double) + sizeof(uint32_t));
+        const std::vector<int> own = rows_owned(this, height);
+        send_.resize(own.size() * row_bytes);
+#pragma omp parallel for schedule(static)
+        for (size_t k = 0; k < own.size(); ++k) {
+            char* at = send_.data() + k * row_bytes;
+            const size_t first = size_t(own[k]) * w;
+            at = std::copy_n(reinterpret_cast<const char*>(&px.radiance_sum[first]), w * sizeof(Color), at);
+            at = std::copy_n(reinterpret_cast<const char*>(&px.luminance_sq_sum[first]), w * sizeof(double), at);
+            std::copy_n(reinterpret_cast<const char*>(&px.sample_count[first]), w * sizeof(uint32_t), at);
+        }
+        MPI_Datatype row;
+        MPI_Type_contiguous(int(row_bytes), MPI_BYTE, &row);
+        MPI_Type_commit(&row);
+        const int before = (index() + count() - 1) % count(), after = (index() + 1) % count();
+        std::vector<int> neighbours = {before};
+        if (after != before) neighbours.push_back(after);
+        received_.resize(neighbours.size());
+        std::vector<MPI_Request> requests;
+        for (size_t n = 0; n < neighbours.size(); ++n) {
+            received_[n].resize(size_t(deal.rows_of(neighbours[n])) * row_bytes);
+            requests.emplace_back();
+            MPI_Irecv(received_[n].data(), deal.rows_of(neighbours[n]), row, neighbours[n], 0, MPI_COMM_WORLD,
+                      &requests.back());
+        }
+        for (int to : neighbours) {
+            requests.emplace_back();
+            MPI_Isend(send_.data(), int(own.size()), row, to, 0, MPI_COMM_WORLD, &requests.back());
+        }
+        MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        MPI_Type_free(&row);
+        for (size_t n = 0; n < neighbours.size(); ++n) {
+            const int rows = deal.rows_of(neighbours[n]);
+#pragma omp parallel for schedule(static)
+            for (int k = 0; k < rows; ++k) {
+                const char* at = received_[n].data() + size_t(k) * row_bytes;
+                const size_t first = size_t(neighbours[n] + k * count()) * w;
+                std::copy_n(at, w * sizeof(Color), reinterpret_cast<char*>(&px.radiance_sum[first]));
+                at += w * sizeof(Color);
+                std::copy_n(at, w * sizeof(double), reinterpret_cast<char*>(&px.luminance_sq_sum[first]));
+                at += w * sizeof(double);
+                std::copy_n(at, w * sizeof(uint32_t), reinterpret_cast<char*>(&px.sample_count[first]));
+            }
+            cost_.received_bytes += double(received_[n].size());
+        }
+        cost_.combine_seconds += wall_seconds() - start;
+    }
+
     std::vector<uint8_t> noise_mask_;
     std::vector<uint8_t> owned_;  // 1 on this rank's rows
-    std::vector<char> mine_, gathered_;  // exchange buffers, kept between passes
-    double cpu_start_ = 0, pass_end_ = 0;
+    std::vector<char> send_;      // the guard rows' buffers, kept between passes
+    std::vector<std::vector<char>> received_;
+    double cpu_start_ = 0, pass_end_ = 0, combine_mark_ = 0;
     int passes_ = 0;
 };
 
@@ -222,14 +301,14 @@ int Cluster::any_flags(int flags) const {
 
 std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
     if (!mpi_) return {cost};
-    constexpr int kFields = 5;
-    const double mine[kFields] = {cost.busy_seconds, cost.combine_seconds, cost.between_seconds,
-                                  double(cost.exchanges), double(cost.rays)};
+    constexpr int kFields = 6;
+    const double mine[kFields] = {cost.busy_seconds,       cost.combine_seconds, cost.between_seconds,
+                                  double(cost.exchanges), double(cost.rays),    cost.received_bytes};
     std::vector<double> all(leader() ? kFields * size_t(size_) : 0);
     MPI_Gather(mine, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     std::vector<RankCost> costs;
     for (size_t r = 0; r < all.size(); r += kFields)
-        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4])});
+        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4]), all[r + 5]});
     return costs;
 }
 
@@ -246,6 +325,9 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     deal.exchange(state.buffers().radiance_sq_sum, false, mine, gathered);
     deal.exchange(state.buffers().sample_count, false, mine, gathered);
     deal.exchange(state.buffers().sample_index, false, mine, gathered);
+    // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
+    if (!state.buffers().active.empty()) deal.exchange(state.buffers().active, false, mine, gathered);
+    if (!state.buffers().sample_credit.empty()) deal.exchange(state.buffers().sample_credit, false, mine, gathered);
     const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
     unsigned long long sum[2] = {0, 0};
     MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
@@ -253,9 +335,9 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     nonfinite = sum[1];
 }
 
-std::unique_ptr<PassHooks> Cluster::deal_rows(bool always_combine) const {
+std::unique_ptr<PassHooks> Cluster::deal_rows() const {
     if (!mpi_) return nullptr;
-    return std::make_unique<DealtRows>(rank_, size_, always_combine);
+    return std::make_unique<DealtRows>(rank_, size_);
 }
 
 RankCost Cluster::cost(const PassHooks& hooks) {

@@ -179,11 +179,13 @@ bool write_checkpoint(const Cluster& cluster, const fs::path& path, const Checkp
 }
 
 // The per-rank line of the summary: busy time (CPU seconds in render_pass), its spread, each
-// rank's Mrays/s, the rows' exchange (the slowest rank's wall time in it, waiting included)
-// and the time between passes (planning, the noise rule: every rank does it for the image).
+// rank's Mrays/s, the exchange between passes (the slowest rank's wall time in it, waiting
+// included, and the most bytes a rank received) and the time between passes less the
+// exchange (planning and the noise rule, each rank on its own rows).
 void print_rank_costs(const std::vector<RankCost>& costs) {
-    double total = 0, slowest = 0, combine = 0, between = 0;
+    double total = 0, slowest = 0, combine = 0, between = 0, received = 0;
     for (const RankCost& c : costs) {
+        received = std::max(received, c.received_bytes);
         total += c.busy_seconds;
         slowest = std::max(slowest, c.busy_seconds);
         combine = std::max(combine, c.combine_seconds);
@@ -199,9 +201,9 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
         speed += buf;
     }
     std::printf("  %zu ranks: busy s%s (slowest %+.1f%% of the mean); Mrays/s per busy s%s; exchange %.3f s "
-                "after %d passes; between passes %.3f s\n",
+                "and %.3f MB received after %d passes; between passes %.3f s\n",
                 costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
-                costs.front().exchanges, between);
+                received * 1e-6, costs.front().exchanges, between);
 }
 
 // One scene's render, in the order its steps run: load, check the outputs, check the memory,
@@ -375,7 +377,11 @@ private:
         auto last_checkpoint = std::chrono::steady_clock::now();
         double last_draw = -1;
         StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
-        hooks_ = cluster_.deal_rows(open_ended_);
+        hooks_ = cluster_.deal_rows();
+        const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
+        // The progress line's estimated error is added up from every rank's rows: every rank
+        // takes part where rank 0 shows it.
+        const bool estimate_error = cluster_.broadcast(show_progress_) && rule_.noise > 0;
         stage_ = "rendering a " + image_;
         StopReason reason = render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
             if (opt_.checkpoint) {
@@ -389,9 +395,9 @@ private:
                 }
                 if (flags & 2) return false;
             }
+            const double noise = estimate_error ? s.relative_error(share) : 0;
             if (show_progress_ && elapsed() - last_draw > 0.1) {
                 // The bar goes towards the rule nearest to ending the render.
-                const double noise = rule_.noise > 0 ? s.relative_error() : 0;
                 const StopProgress progress = stop_progress(rule_, s.passes, elapsed(), noise);
                 char what[96];
                 if (open_ended_) std::snprintf(what, sizeof what, "%d passes", s.passes);

@@ -116,29 +116,50 @@ double RenderState::pixel_standard_error(size_t i) const {
     return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
 }
 
-double RenderState::relative_error() const {
-    // Per-row sums in parallel, added in row order: the same estimate for any thread count.
-    // (The viewer shows it after every pass.)
-    const size_t w = size_t(width);
-    std::vector<double> row_error(size_t(height), 0.0), row_signal(size_t(height), 0.0);
-    std::vector<uint8_t> row_unknown(size_t(height), 0);
-#pragma omp parallel for schedule(static)
+std::vector<int> rows_owned(const RowShare* share, int height) {
+    std::vector<int> rows;
+    for (int y = share ? share->index() : 0; y < height; y += share ? share->count() : 1) rows.push_back(y);
+    return rows;
+}
+
+std::vector<int> rows_guarded(const RowShare* share, int height) {
+    std::vector<int> rows;
     for (int y = 0; y < height; ++y)
-        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+        if (!share || share->owns(y) || (y > 0 && share->owns(y - 1)) || (y + 1 < height && share->owns(y + 1)))
+            rows.push_back(y);
+    return rows;
+}
+
+double RenderState::relative_error(const RowShare* share) const {
+    // Per-row sums in parallel, added in row order: the same estimate for any thread or
+    // process count. (The viewer shows it after every pass.) Per row: the error, the signal,
+    // and whether a pixel's error is unknown.
+    const size_t w = size_t(width);
+    const std::vector<int> own = rows_owned(share, height);
+    std::vector<double> rows(3 * size_t(height), 0.0);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < own.size(); ++k) {
+        const size_t y = size_t(own[k]);
+        double error = 0, signal = 0;
+        for (size_t i = y * w; i < (y + 1) * w; ++i) {
             const double se = pixel_standard_error(i);
             if (!std::isfinite(se)) {
-                row_unknown[size_t(y)] = 1;
+                rows[3 * y + 2] = 1;
                 break;
             }
-            row_error[size_t(y)] += se * se;
+            error += se * se;
             const double mean = luminance(px_.radiance_sum[i]) / px_.sample_count[i];
-            row_signal[size_t(y)] += mean * mean;
+            signal += mean * mean;
         }
+        rows[3 * y] = error;
+        rows[3 * y + 1] = signal;
+    }
+    if (share) share->combine(rows, 3);
     double error_sq = 0, signal_sq = 0;
     for (size_t y = 0; y < size_t(height); ++y) {
-        if (row_unknown[y]) return kInfinity;
-        error_sq += row_error[y];
-        signal_sq += row_signal[y];
+        if (rows[3 * y + 2] != 0) return kInfinity;
+        error_sq += rows[3 * y];
+        signal_sq += rows[3 * y + 1];
     }
     if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
     return std::sqrt(error_sq / signal_sq);

@@ -46,6 +46,32 @@ struct PixelBuffers {
     std::vector<uint32_t> half_count;
 };
 
+// The rows of an image shared between processes (app/cluster.h deals them through the
+// driver's PassHooks). This process owns the rows y with y mod count == index: it samples and
+// plans them, and holds the statistics of their neighbours too (the 3x3 guard reads them).
+// The image-wide sums (of the plan, the noise rule, the estimated error) are taken per row,
+// made known to every process by combine() and added in row order by each: the same plan and
+// verdicts, bit for bit, as one process that owns every row (no RowShare).
+class RowShare {
+public:
+    RowShare(int index, int count) : index_(index), count_(count) {}
+    virtual ~RowShare() = default;
+    int index() const { return index_; }
+    int count() const { return count_; }
+    bool owns(int y) const { return y % count_ == index_; }
+    // `values` holds `fields` numbers per row, rows in order, this process's own rows filled
+    // in: replaces every other row's with the numbers of the process that owns it.
+    virtual void combine(std::vector<double>& values, int fields) const = 0;
+
+private:
+    int index_, count_;
+};
+
+// The rows `share` gives this process, in order (every row without a share), and those its
+// 3x3 guard reads: its own and their neighbours.
+std::vector<int> rows_owned(const RowShare* share, int height);
+std::vector<int> rows_guarded(const RowShare* share, int height);
+
 class RenderState {
 public:
     int width = 0, height = 0;
@@ -84,21 +110,26 @@ public:
     double pixel_standard_error(size_t i) const;
     // Estimated relative RMS error of the whole image: sqrt(sum of per-pixel variances of the
     // mean) / sqrt(sum of squared mean luminances). Infinite before two samples per pixel.
-    double relative_error() const;
+    // With `share`, every process calls it after the same pass and gets the same estimate.
+    double relative_error(const RowShare* share = nullptr) const;
 
     // Adaptive sampling towards an image relative error `target` (as relative_error()): a
     // pixel stays active while the variance of its mean exceeds an equal share of the allowed
     // total, target^2 * sum(mean^2) / pixels, or it has fewer than `min_samples` samples.
-    // When no pixel is active the image meets the target. Returns the active count.
-    size_t update_adaptive(double target, uint32_t min_samples = 16);
+    // When no pixel is active the image meets the target. Returns the active count. With
+    // `share`, the mask is set on this process's rows (from their and their neighbours'
+    // statistics) and the count is the image's.
+    size_t update_adaptive(double target, uint32_t min_samples = 16, const RowShare* share = nullptr);
 
     // Plans the next pass for `settings.allocation` (fills pass_samples). Adaptive: after
     // kAllocationWarmup passes, each active pixel's share of the pass (as many samples as
     // active pixels) is proportional to its estimated standard deviation (3x3 guarded, as
     // update_adaptive) plus a floor, which minimises the summed variance of the pixel means
     // for the budget; fractions carry over between passes. Parallel over rows, with the rows'
-    // sums added in order: the plan does not depend on threads.
-    void plan_pass(const RenderSettings& settings);
+    // sums added in order: the plan does not depend on threads. With `share`, only this
+    // process's rows are planned (their pass_samples and sample_credit), from their and their
+    // neighbours' statistics and the image's sums.
+    void plan_pass(const RenderSettings& settings, const RowShare* share = nullptr);
 
     // Samples every pixel again (no adaptive mask).
     void clear_adaptive() { px_.active.clear(); }
