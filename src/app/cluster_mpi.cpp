@@ -120,21 +120,12 @@ public:
     DealtRows(int rank, int size) : RowShare(rank, size) {}
 
     void before_pass(RenderState& state) override {
-        // render_pass skips pixels whose mask entry is 0: this rank's rows of the noise
-        // rule's mask (all rows' pixels where there is none).
-        const size_t w = size_t(state.width), pixels = w * size_t(state.height);
-        if (owned_.size() != pixels) {
-            owned_.assign(pixels, 0);
-            for (int y : rows_owned(this, state.height)) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
+        // render_pass samples only this rank's rows (of the noise rule's mask, if any).
+        if (owned_rows_.size() != size_t(state.height)) {
+            owned_rows_.assign(size_t(state.height), 0);
+            for (int y : rows_owned(this, state.height)) owned_rows_[size_t(y)] = 1;
         }
-        noise_mask_.swap(state.buffers().active);
-        if (noise_mask_.empty()) {
-            state.buffers().active = owned_;
-        } else {
-            state.buffers().active.resize(pixels);
-#pragma omp parallel for schedule(static)
-            for (size_t i = 0; i < pixels; ++i) state.buffers().active[i] = owned_[i] & noise_mask_[i];
-        }
+        state.buffers().active_rows = owned_rows_;
         // Planning and the noise rule since the last pass, less their exchanges.
         if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_ - (cost_.combine_seconds - combine_mark_);
         cpu_start_ = cpu_seconds();
@@ -142,15 +133,14 @@ public:
 
     void after_pass(RenderState& state, bool statistics) override {
         cost_.busy_seconds += cpu_seconds() - cpu_start_;
-        state.buffers().active.swap(noise_mask_);
-        noise_mask_.clear();
+        state.buffers().active_rows.clear();
         ++passes_;
         pass_end_ = wall_seconds();
+        combine_mark_ = cost_.combine_seconds;
         if (statistics) {
             receive_guard_rows(state);
             ++cost_.exchanges;
         }
-        combine_mark_ = cost_.combine_seconds;
     }
 
     bool any(bool stop) override {
@@ -242,8 +232,7 @@ private:
         cost_.combine_seconds += wall_seconds() - start;
     }
 
-    std::vector<uint8_t> noise_mask_;
-    std::vector<uint8_t> owned_;  // 1 on this rank's rows
+    std::vector<uint8_t> owned_rows_;  // 1 for this rank's rows
     std::vector<char> send_;      // the guard rows' buffers, kept between passes
     std::vector<std::vector<char>> received_;
     double cpu_start_ = 0, pass_end_ = 0, combine_mark_ = 0;

@@ -89,6 +89,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     const PixelSums pixel_sums{px.radiance_sum.data(), px.radiance_compensation.data(), px.depth_sum.data(),
                                px.luminance_sq_sum.data(), px.radiance_sq_sum.data(), px.sample_count.data()};
     const uint8_t* const pixel_active = px.active.empty() ? nullptr : px.active.data();
+    const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
     const uint8_t* const pixel_pass_samples = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
@@ -116,6 +117,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; ++y) {
+            if (rows_active && !rows_active[y]) continue;
             if (stop && stop->load(std::memory_order_relaxed)) {
                 stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
                 continue;

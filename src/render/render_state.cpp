@@ -23,6 +23,7 @@ void RenderState::reset(int w, int h) {
     rays = 0;
     nonfinite_samples = 0;
     px_.active.clear();
+    px_.active_rows.clear();
     px_.pass_samples.clear();
     px_.sample_credit.clear();
     for (auto& scratch : px_.allocation_scratch) scratch.clear();

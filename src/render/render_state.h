@@ -31,6 +31,9 @@ struct PixelBuffers {
     // The noise rule (update_adaptive): render_pass samples only pixels whose entry is 1
     // (empty: all of them).
     std::vector<uint8_t> active;
+    // Per row, whether render_pass samples it at all (empty: every row): a process's share of
+    // the rows, set around each pass by its PassHooks.
+    std::vector<uint8_t> active_rows;
     // Samples per pixel in the next pass, set by plan_pass (empty: one each).
     std::vector<uint8_t> pass_samples;
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
