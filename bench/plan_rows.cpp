@@ -6,14 +6,23 @@
 // pixel, varying variances): the plan's cost does not depend on the scene. The per-row sums'
 // exchange is not timed here (its combine leaves the other rows' sums at zero); the
 // exchanged bytes per pass are printed from their sizes.
-//   keithray_bench_plan_rows [ROUNDS]
+//   keithray_bench_plan_rows plan [ROUNDS]
+// And how evenly rows dealt round-robin share a scene's rendering when ranks get few rows:
+// each row's CPU time over PASSES passes (render_pass on that row alone, one thread), then
+// for N ranks the busiest rank's rows' time against the mean (1 = perfectly even).
+//   keithray_bench_plan_rows balance SCENE.json SIZE PASSES N,N,...
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 #include <vector>
 
-#include "render/render_state.h"
+#include <sstream>
+#include <string>
+
+#include "render/render_pass.h"
+#include "render/render_scene.h"
+#include "scene/load.h"
 
 using namespace kr;
 
@@ -52,10 +61,54 @@ double median(std::vector<double> v) {
     return v[v.size() / 2];
 }
 
+// Each row's rendering CPU seconds, PASSES passes of one sample a pixel (uniform allocation).
+std::vector<double> row_seconds(const std::string& file, int size, int passes) {
+    Scene authored = load_scene_file(file).scene;
+    authored.renderer.width = authored.renderer.height = size;
+    const RenderScene scene = prepare_scene(authored);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.allocation = Allocation::uniform;
+    RenderState state(size, size);
+    std::vector<double> seconds(size_t(size), 0.0);
+    for (int pass = 0; pass < passes; ++pass)
+        for (int y = 0; y < size; ++y) {
+            state.buffers().active_rows.assign(size_t(size), 0);
+            state.buffers().active_rows[size_t(y)] = 1;
+            const double start = cpu_seconds();
+            render_pass(scene, settings, state);
+            seconds[size_t(y)] += cpu_seconds() - start;
+        }
+    return seconds;
+}
+
+int balance(const std::string& file, int size, int passes, const std::string& counts) {
+    const std::vector<double> seconds = row_seconds(file, size, passes);
+    double total = 0;
+    for (double s : seconds) total += s;
+    std::printf("%s at %dx%d, %d passes: %.1f ns a pixel and pass; busiest rank against the mean:\n", file.c_str(),
+                size, size, passes, 1e9 * total / (double(size) * size * passes));
+    std::stringstream list(counts);
+    for (std::string item; std::getline(list, item, ',');) {
+        const int count = std::atoi(item.c_str());
+        if (count < 1) continue;
+        std::vector<double> rank(size_t(count), 0.0);
+        for (int y = 0; y < size; ++y) rank[size_t(y % count)] += seconds[size_t(y)];
+        std::printf("  %d ranks (%.2f rows each): %.3f\n", count, double(size) / count,
+                    *std::max_element(rank.begin(), rank.end()) / (total / count));
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    const int rounds = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
+    const std::string mode = argc > 1 ? argv[1] : "plan";
+    if (mode == "balance" && argc == 6) return balance(argv[2], std::atoi(argv[3]), std::atoi(argv[4]), argv[5]);
+    if (mode != "plan") {
+        std::fprintf(stderr, "usage: keithray_bench_plan_rows plan [ROUNDS] | balance SCENE.json SIZE PASSES N,N,...\n");
+        return 2;
+    }
+    const int rounds = argc > 2 ? std::max(1, std::atoi(argv[2])) : 5;
     RenderSettings settings;
     settings.allocation = Allocation::adaptive;
     std::printf("ranks | size | own rows | plan ms | noise check ms | plan ns per own pixel | guard rows in | row sums in\n");

@@ -6,7 +6,7 @@
 #            here with mpicxx) at 512x512 and 3840x2160, 2 and 4 ranks.
 #   balance: mpirun -np 4 (oversubscribed, 1 thread each) on scenes 3, 6 and 8 at their own
 #            spp; prints keithray's per-rank summary (busy CPU seconds, slowest vs mean).
-#   plan:    adaptive against uniform allocation under mpirun -np 2 and -np 4 (1 thread each),
+#   plan:    adaptive against uniform allocation under mpirun -np 1, 2 and 4 (1 thread each),
 #            scene 6 at 512x512, 64 spp, interleaved, REPEATS rounds: each run's wall seconds,
 #            and per pass after which the statistics were exchanged, what the busiest rank
 #            spent exchanging and planning (keithray's per-rank summary) and the bytes a rank
@@ -75,7 +75,7 @@ plan)
                  else printf "%s - - -\n", t }'
   }
   for ((i = 0; i < repeats; i++)); do
-    for n in 2 4; do
+    for n in 1 2 4; do
       for alloc in adaptive uniform; do
         for e in "${!exes[@]}"; do
           run "${exes[$e]}" $n $alloc "$@" >>"$out/plan-$e-$n-$alloc"
@@ -86,7 +86,7 @@ plan)
   echo "scene 6, 512x512, 64 spp, $repeats rounds interleaved; medians (per exchanged pass: busiest rank)"
   echo "build | np | allocation | wall s | exchange ms | plan + noise ms | MB received"
   for e in "${!exes[@]}"; do
-    for n in 2 4; do
+    for n in 1 2 4; do
       for alloc in adaptive uniform; do
         f="$out/plan-$e-$n-$alloc"
         col() { awk -v c="$1" '{print $c}' "$f" | grep -v '^-$' | median; }

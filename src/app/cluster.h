@@ -23,7 +23,7 @@ namespace kr {
 // Per rank, what a render cost it, for the summary.
 struct RankCost {
     double busy_seconds = 0;     // CPU time spent in render_pass (the rank's share of the work)
-    double combine_seconds = 0;  // wall time in the exchanges (waiting for the others included)
+    double combine_seconds = 0;  // wall time in the exchanges and the --time agreement (waiting included)
     double between_seconds = 0;  // wall time between passes less its exchanges: planning, the noise rule
     int exchanges = 0;           // passes after which the guard rows' statistics were exchanged
     uint64_t rays = 0;

@@ -144,8 +144,10 @@ public:
     }
 
     bool any(bool stop) override {
+        const double start = wall_seconds();  // mostly waiting for the slowest rank's pass
         int flag = stop, result = 0;
         MPI_Allreduce(&flag, &result, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
+        cost_.combine_seconds += wall_seconds() - start;
         return result != 0;
     }
 
