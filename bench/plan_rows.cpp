@@ -8,7 +8,8 @@
 // exchanged bytes per pass are printed from their sizes.
 //   keithray_bench_plan_rows plan [ROUNDS]
 // And how evenly rows dealt round-robin share a scene's rendering when ranks get few rows:
-// each row's CPU time over PASSES passes (render_pass on that row alone, one thread), then
+// each row's CPU time over PASSES passes after an untimed one (render_pass on that row alone,
+// one thread), then
 // for N ranks the busiest rank's rows' time against the mean (1 = perfectly even).
 //   keithray_bench_plan_rows balance SCENE.json SIZE PASSES N,N,...
 #include <algorithm>
@@ -69,6 +70,7 @@ std::vector<double> row_seconds(const std::string& file, int size, int passes) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.allocation = Allocation::uniform;
     RenderState state(size, size);
+    render_pass(scene, settings, state);  // untimed: the buffers' first touch (page faults)
     std::vector<double> seconds(size_t(size), 0.0);
     for (int pass = 0; pass < passes; ++pass)
         for (int y = 0; y < size; ++y) {
