@@ -1,7 +1,8 @@
 // keithray under mpirun (issues 26 and 36; app/cluster.h): the bytes of the render without
 // MPI at 1 to 4 ranks for every integrator, estimator and allocation and the noise rule, also
 // where a rank owns one row or none; the checkpoint of one process at any rank count; each
-// rank receives only its rows' neighbours and the per-row sums between passes; a bad scene
+// rank receives only its rows' neighbours and the per-row sums between passes; a plain run
+// never starts MPI; a bad scene
 // ends every rank with one error line; a rank killed mid-render ends the job non-zero with no
 // image and a checkpoint that resumes to the uninterrupted image. Every run is under
 // `timeout`: a hang fails the test instead of the suite.
@@ -152,6 +153,19 @@ TEST_F(Mpi, RanksReceiveOnlyTheirNeighbourRowsAndRowSums) {
     const double per_pass = megabytes * 1e6 / passes;
     EXPECT_GT(per_pass, 16 * 64 * 36) << r.out;
     EXPECT_LE(per_pass, 2 * 16 * 64 * 36 + 64 * 2 * 8) << r.out;
+}
+
+// Run plainly (no launcher in the environment), keithray never calls MPI_Init: Open MPI's
+// initialisation, even as a singleton, leaves its session folder (ompi.HOST.UID) in TMPDIR.
+TEST_F(Mpi, PlainRunNeverStartsMpi) {
+    scene(6, 16, "scene.json");
+    fs::create_directories(dir / "tmp");
+    const test::CommandResult r =
+        here("env -u OMPI_COMM_WORLD_SIZE -u PMIX_RANK -u PMI_RANK TMPDIR='" + (dir / "tmp").string() + "' " +
+             keithray() + "render -q scene.json --spp 12 --noise 0.05 -o plain.ppm");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("ranks: busy"), std::string::npos) << r.out;
+    for (const auto& entry : fs::directory_iterator(dir / "tmp")) ADD_FAILURE() << "MPI started: " << entry.path();
 }
 
 // A bad scene beside a good one: one error line, a non-zero exit from every rank (no hang),
