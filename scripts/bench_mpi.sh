@@ -12,7 +12,9 @@
 #            spent exchanging and planning (keithray's per-rank summary) and the bytes a rank
 #            received. With BASELINE=path/to/another/keithray, that build's runs are
 #            interleaved with these (its summary names no bytes: 36 B x P x (N-1)/N a pass).
-# Usage: scripts/bench_mpi.sh ratio|balance|exchange|plan [REPEATS] [extra render flags]
+#   memory:  each rank's peak resident memory (/usr/bin/time) in a 4096x4096 render (scene 1,
+#            10 spp: adaptive allocation plans passes 9 and 10) at np 1, 2 and 4.
+# Usage: scripts/bench_mpi.sh ratio|balance|exchange|plan|memory [REPEATS] [extra render flags]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 exe=build/keithray
@@ -95,5 +97,13 @@ plan)
     done
   done
   ;;
-*) echo "usage: $0 ratio|balance|exchange|plan [REPEATS] [render flags]" >&2; exit 2 ;;
+memory)
+  sed 's/"dimensions" : \[512, 512\]/"dimensions" : [4096, 4096]/' res/scenes/assignment_01.json >"$out/big.json"
+  for n in 1 2 4; do
+    echo "np $n (rank order not kept), peak resident kB:"
+    "${mpi[@]}" -np $n /usr/bin/time -f "  %M" "$exe" render "$out/big.json" --spp 10 -q -o "$out/big.ppm" "$@" 2>&1 |
+      grep -E '^  [0-9]+$|ranks: busy'
+  done
+  ;;
+*) echo "usage: $0 ratio|balance|exchange|plan|memory [REPEATS] [render flags]" >&2; exit 2 ;;
 esac

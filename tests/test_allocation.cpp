@@ -291,10 +291,11 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     for (size_t i = 0; i < image.pixels.size(); ++i) EXPECT_EQ(f->radiance.pixels[i].x, image.pixels[i].x) << i;
 }
 
-// Each process plans its own rows (RowShare): with only its rows and their neighbours' (the
-// others poisoned with NaN and wrong counts), and the per-row sums combined, its rows get the
-// estimated error, the noise mask, the active count and the plan of one process, bit for bit;
-// N from 2 to more processes than rows (some own none), odd sizes.
+// Each process plans its own rows (RowShare): holding only its rows and their neighbours'
+// (RenderState::reset's held rows), or every row with the others poisoned with NaN and wrong
+// counts, and with the per-row sums combined, its rows get the estimated error, the noise
+// mask, the active count and the plan of one process, bit for bit; N from 2 to more processes
+// than rows (some own none), odd sizes.
 TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
     const int w = 13, h = 11;
     Scene authored = brief_scene(6, w);
@@ -314,8 +315,10 @@ TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
     ASSERT_FALSE(whole.pass_samples().empty());
     ASSERT_GT(active, 0u);
     ASSERT_LT(active, size_t(w * h));  // the mask leaves some pixels out
+    for (const bool held : {true, false})
     for (int count : {2, 3, 4, 5, 12}) {
         SCOPED_TRACE(count);
+        SCOPED_TRACE(held ? "held rows" : "poisoned rows");
         std::vector<RenderState> states(size_t(count), rendered);
         std::vector<double> errors(static_cast<size_t>(count)), table(3 * static_cast<size_t>(h));
         std::vector<size_t> actives(static_cast<size_t>(count));
@@ -326,12 +329,26 @@ TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
                 const ThreadRows share(r, count, sync, table);
                 RenderState& s = states[size_t(r)];
                 const std::vector<int> guarded = rows_guarded(&share, h);
-                for (int y = 0; y < h; ++y) {
-                    if (std::find(guarded.begin(), guarded.end(), y) != guarded.end()) continue;
-                    for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
-                        s.buffers().radiance_sum[i] = Color(std::nan(""));
-                        s.buffers().luminance_sq_sum[i] = std::nan("");
-                        s.buffers().sample_count[i] = 3;
+                if (held) {  // the held rows' sums, counts and carried fractions
+                    s.reset(w, h, guarded);
+                    s.passes = rendered.passes;
+                    s.buffers().sample_credit.resize(s.sample_count().size());
+                    for (int y : guarded)
+                        for (size_t x = 0; x < size_t(w); ++x) {
+                            const size_t from = size_t(y) * w + x, to = s.row_start(y) + x;
+                            s.buffers().radiance_sum[to] = rendered.radiance_sum()[from];
+                            s.buffers().luminance_sq_sum[to] = rendered.luminance_sq_sum()[from];
+                            s.buffers().sample_count[to] = rendered.sample_count()[from];
+                            s.buffers().sample_credit[to] = rendered.sample_credit()[from];
+                        }
+                } else {
+                    for (int y = 0; y < h; ++y) {
+                        if (std::find(guarded.begin(), guarded.end(), y) != guarded.end()) continue;
+                        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+                            s.buffers().radiance_sum[i] = Color(std::nan(""));
+                            s.buffers().luminance_sq_sum[i] = std::nan("");
+                            s.buffers().sample_count[i] = 3;
+                        }
                     }
                 }
                 errors[size_t(r)] = s.relative_error(&share);
@@ -345,10 +362,11 @@ TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
             EXPECT_EQ(errors[size_t(r)], error);
             EXPECT_EQ(actives[size_t(r)], active);
             for (int y = r; y < h; y += count)
-                for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
-                    EXPECT_EQ(s.active()[i], whole.active()[i]) << i;
-                    EXPECT_EQ(s.pass_samples()[i], whole.pass_samples()[i]) << i;
-                    EXPECT_EQ(s.sample_credit()[i], whole.sample_credit()[i]) << i;
+                for (size_t x = 0; x < size_t(w); ++x) {
+                    const size_t i = s.row_start(y) + x, at = size_t(y) * w + x;
+                    EXPECT_EQ(s.active()[i], whole.active()[at]) << at;
+                    EXPECT_EQ(s.pass_samples()[i], whole.pass_samples()[at]) << at;
+                    EXPECT_EQ(s.sample_credit()[i], whole.sample_credit()[at]) << at;
                 }
         }
     }

@@ -1,6 +1,7 @@
 // keithray under mpirun (issues 26 and 36; app/cluster.h): the bytes of the render without
 // MPI at 1 to 4 ranks for every integrator, estimator and allocation and the noise rule, also
 // where a rank owns one row or none; the checkpoint of one process at any rank count; each
+// rank's memory check of the rows it holds; each
 // rank receives only its rows' neighbours and the per-row sums between passes; a plain run
 // never starts MPI; a bad scene
 // ends every rank with one error line; a rank killed mid-render ends the job non-zero with no
@@ -17,6 +18,8 @@
 #include <string>
 #include <thread>
 
+#include "core/memory.h"
+#include "render/render_state.h"
 #include "scene/save.h"
 #include "test_util.h"
 
@@ -153,6 +156,25 @@ TEST_F(Mpi, RanksReceiveOnlyTheirNeighbourRowsAndRowSums) {
     const double per_pass = megabytes * 1e6 / passes;
     EXPECT_GT(per_pass, 16 * 64 * 36) << r.out;
     EXPECT_LE(per_pass, 2 * 16 * 64 * 36 + 64 * 2 * 8) << r.out;
+}
+
+// Rank 0 holds the whole state (it gathers it and writes the outputs); every other rank only
+// its rows and their neighbours': the memory check of each says so, here refused under a
+// 16 GiB address-space limit for a 32768x32768 image (each rank of 4 holds 3 rows in 4).
+TEST_F(Mpi, EachRankChecksTheMemoryOfTheRowsItHolds) {
+    scene(6, 32768, "huge.json");
+    const test::CommandResult r = here("ulimit -v 16777216; " + mpirun(4) + "render -q huge.json -o huge.ppm");
+    EXPECT_NE(r.status, 0);
+    const std::string rank0 = "needs about " + format_bytes(render_memory_bytes(32768, 32768, false)) + ", above the "
+                              "address-space limit (ulimit -v) (16.0 GiB) on rank 0";
+    EXPECT_NE(r.err.find(rank0), std::string::npos) << r.err;
+    const std::string others = "needs about " + format_bytes(render_state_bytes(32768, 3 * 32768 / 4));
+    for (int rank : {1, 2, 3})
+        EXPECT_NE(r.err.find(others + ", above the address-space limit (ulimit -v) (16.0 GiB) on rank " +
+                             std::to_string(rank)),
+                  std::string::npos)
+            << r.err;
+    EXPECT_FALSE(fs::exists(dir / "huge.ppm"));
 }
 
 // Run plainly (no launcher in the environment), keithray never calls MPI_Init: Open MPI's

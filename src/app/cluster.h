@@ -8,8 +8,8 @@
 // RowShare): after a pass whose next step reads the statistics (adaptive allocation, the
 // noise rule), it receives the three sums of its rows' neighbouring rows (the 3x3 guard's)
 // from the ranks r - 1 and r + 1, and the image-wide sums are gathered as per-row sums that
-// every rank adds in row order. Rank 0 gathers the whole state for the outputs and
-// checkpoints.
+// every rank adds in row order. Rank 0 holds the whole state, gathered for the outputs and
+// checkpoints; every other rank holds only its rows and their neighbours (held_rows).
 #pragma once
 
 #include <memory>
@@ -55,6 +55,13 @@ public:
     int any_flags(int flags) const;
     // At rank 0, every rank's `cost` (rank order); elsewhere empty.
     std::vector<RankCost> gather(const RankCost& cost) const;
+    // The rows this rank's RenderState holds (RenderState::reset): its own and their
+    // neighbours; every row (empty) at rank 0, which gathers the whole state, and alone.
+    std::vector<int> held_rows(int height) const;
+    // After rank 0 decoded a checkpoint into `state` (every row): every other rank's state
+    // (reset to its held_rows) gets its rows of it, with the passes; the rays and dropped
+    // samples stay counted at rank 0.
+    void scatter_state(RenderState& state) const;
     // Makes rank 0's `state` whole (every pixel's sums and counts from the rank that drew
     // them) and returns the job's rays and dropped samples there; the other ranks' states are
     // unchanged.

@@ -74,15 +74,15 @@ struct RowDeal {
         for (size_t r = 1; r < counts.size(); ++r) o[r] = o[r - 1] + counts[r - 1];
         return o;
     }
-    // This rank's rows of `field`, packed in order into `out`.
+    // This rank's rows of `field` (of `state`'s buffers), packed in order into `out`.
     template <class T>
-    void pack(const std::vector<T>& field, std::vector<char>& out) const {
+    void pack(const RenderState& state, const std::vector<T>& field, std::vector<char>& out) const {
         const size_t row = size_t(width) * sizeof(T);
         const int rows = rows_of(rank);
         out.resize(size_t(rows) * row);
 #pragma omp parallel for schedule(static)
         for (int k = 0; k < rows; ++k)
-            std::memcpy(out.data() + size_t(k) * row, field.data() + size_t(rank + k * size) * size_t(width), row);
+            std::memcpy(out.data() + size_t(k) * row, field.data() + state.row_start(rank + k * size), row);
     }
     template <class T>
     void unpack(const std::vector<char>& all, const std::vector<int>& offsets, std::vector<T>& field) const {
@@ -93,28 +93,43 @@ struct RowDeal {
             std::memcpy(field.data() + size_t(y) * size_t(width),
                         all.data() + size_t(offsets[size_t(y % size)]) * sizeof(T) + size_t(y / size) * row, row);
     }
-    // Every rank's rows of `field` in every rank (all) or in rank 0 only. `mine` and
+    // Every rank's rows of `field` in rank 0, whose state holds every row. `mine` and
     // `gathered` are buffers kept between calls: fresh pages cost more than the copy.
     template <class T>
-    void exchange(std::vector<T>& field, bool all, std::vector<char>& mine, std::vector<char>& gathered) const {
-        const Counted<T> as(field.size());
+    void gather(const RenderState& state, std::vector<T>& field, std::vector<char>& mine,
+                std::vector<char>& gathered) const {
+        const Counted<T> as(size_t(width) * size_t(height));  // the same in every rank
         const std::vector<int> counts = this->counts(), offsets = this->offsets(counts);
         const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
-        if (all || rank == 0) gathered.resize(field.size() * sizeof(T));
-        pack(field, mine);
-        if (all)
-            MPI_Allgatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(),
-                           mpi_counts.data(), mpi_offsets.data(), as.type(), MPI_COMM_WORLD);
-        else
-            MPI_Gatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(), mpi_counts.data(),
-                        mpi_offsets.data(), as.type(), 0, MPI_COMM_WORLD);
-        if (all || rank == 0) unpack(gathered, offsets, field);
+        if (rank == 0) gathered.resize(field.size() * sizeof(T));
+        pack(state, field, mine);
+        MPI_Gatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(), mpi_counts.data(),
+                    mpi_offsets.data(), as.type(), 0, MPI_COMM_WORLD);
+        if (rank == 0) unpack(gathered, offsets, field);
+    }
+    // Rank 0's `field` (every row) to every other rank, each receiving the rows its state
+    // holds (rows_guarded), in order: its buffers' layout.
+    template <class T>
+    void scatter(std::vector<T>& field) const {
+        const Counted<T> as(3 * size_t(width) * size_t(height));  // a rank's rows and their neighbours
+        std::vector<int> counts(static_cast<size_t>(size)), offsets(static_cast<size_t>(size), 0);
+        for (int r = 0; r < size; ++r) {
+            counts[size_t(r)] = r == 0 ? 0 : int(rows_guarded(r, size, height).size()) * width;
+            if (r > 0) offsets[size_t(r)] = offsets[size_t(r - 1)] + counts[size_t(r - 1)];
+        }
+        std::vector<T> sent;
+        if (rank == 0) {
+            sent.reserve(size_t(offsets.back()) + size_t(counts.back()));
+            for (int r = 1; r < size; ++r)
+                for (int y : rows_guarded(r, size, height))
+                    sent.insert(sent.end(), field.begin() + ptrdiff_t(y) * width, field.begin() + ptrdiff_t(y + 1) * width);
+        }
+        const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
+        MPI_Scatterv(sent.data(), mpi_counts.data(), mpi_offsets.data(), as.type(), rank == 0 ? MPI_IN_PLACE : field.data(),
+                     as.count(rank == 0 ? 0 : field.size()), as.type(), 0, MPI_COMM_WORLD);
     }
 };
 
-// The driver's hooks of one rank: its rows masked in around each pass, the statistics of its
-// rows' neighbours (the 3x3 guard's) received from the ranks that own them when the plan or
-// the noise rule reads them, and the per-row sums combined (RowShare).
 class DealtRows final : public PassHooks, public RowShare {
 public:
     DealtRows(int rank, int size) : RowShare(rank, size) {}
@@ -186,13 +201,13 @@ private:
         const RowDeal deal{index(), count(), width, height};
         PixelBuffers& px = state.buffers();
         const size_t w = size_t(width);
-        const size_t row_bytes = w * (sizeof(Color) + sizeof(double) + sizeof(uint32_t));
+        const size_t row_bytes = w * kGuardRowBytesPerPixel;
         const std::vector<int> own = rows_owned(this, height);
         send_.resize(own.size() * row_bytes);
 #pragma omp parallel for schedule(static)
         for (size_t k = 0; k < own.size(); ++k) {
             char* at = send_.data() + k * row_bytes;
-            const size_t first = size_t(own[k]) * w;
+            const size_t first = state.row_start(own[k]);
             at = std::copy_n(reinterpret_cast<const char*>(&px.radiance_sum[first]), w * sizeof(Color), at);
             at = std::copy_n(reinterpret_cast<const char*>(&px.luminance_sq_sum[first]), w * sizeof(double), at);
             std::copy_n(reinterpret_cast<const char*>(&px.sample_count[first]), w * sizeof(uint32_t), at);
@@ -221,8 +236,10 @@ private:
             const int rows = deal.rows_of(neighbours[n]);
 #pragma omp parallel for schedule(static)
             for (int k = 0; k < rows; ++k) {
+                const int y = neighbours[n] + k * count();
+                if (!state.holds_row(y)) continue;  // the last row, where the neighbour owns it
                 const char* at = received_[n].data() + size_t(k) * row_bytes;
-                const size_t first = size_t(neighbours[n] + k * count()) * w;
+                const size_t first = state.row_start(y);
                 std::copy_n(at, w * sizeof(Color), reinterpret_cast<char*>(&px.radiance_sum[first]));
                 at += w * sizeof(Color);
                 std::copy_n(at, w * sizeof(double), reinterpret_cast<char*>(&px.luminance_sq_sum[first]));
@@ -309,21 +326,53 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     if (!mpi_) return;
     const RowDeal deal{rank_, size_, state.width, state.height};
     std::vector<char> mine, gathered;
-    deal.exchange(state.buffers().radiance_sum, false, mine, gathered);
-    deal.exchange(state.buffers().radiance_compensation, false, mine, gathered);
-    deal.exchange(state.buffers().depth_sum, false, mine, gathered);
-    deal.exchange(state.buffers().luminance_sq_sum, false, mine, gathered);
-    deal.exchange(state.buffers().radiance_sq_sum, false, mine, gathered);
-    deal.exchange(state.buffers().sample_count, false, mine, gathered);
-    deal.exchange(state.buffers().sample_index, false, mine, gathered);
+    PixelBuffers& px = state.buffers();
+    deal.gather(state, px.radiance_sum, mine, gathered);
+    deal.gather(state, px.radiance_compensation, mine, gathered);
+    deal.gather(state, px.depth_sum, mine, gathered);
+    deal.gather(state, px.luminance_sq_sum, mine, gathered);
+    deal.gather(state, px.radiance_sq_sum, mine, gathered);
+    deal.gather(state, px.sample_count, mine, gathered);
+    deal.gather(state, px.sample_index, mine, gathered);
     // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
-    if (!state.buffers().active.empty()) deal.exchange(state.buffers().active, false, mine, gathered);
-    if (!state.buffers().sample_credit.empty()) deal.exchange(state.buffers().sample_credit, false, mine, gathered);
+    if (!px.active.empty()) deal.gather(state, px.active, mine, gathered);
+    if (!px.sample_credit.empty()) deal.gather(state, px.sample_credit, mine, gathered);
     const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
     unsigned long long sum[2] = {0, 0};
     MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
     rays = sum[0];
     nonfinite = sum[1];
+}
+
+void Cluster::scatter_state(RenderState& state) const {
+    if (!mpi_) return;
+    const RowDeal deal{rank_, size_, state.width, state.height};
+    PixelBuffers& px = state.buffers();
+    // The counters and which optional buffers are in use, then each buffer.
+    long long counters[4] = {state.passes, (long long)state.nonfinite_samples, !px.active.empty(),
+                             !px.sample_credit.empty()};
+    MPI_Bcast(counters, 4, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    if (!leader()) {
+        state.passes = int(counters[0]);
+        state.nonfinite_samples = 0;  // counted once, at rank 0
+        state.rays = 0;
+        if (counters[2]) px.active.resize(px.sample_count.size());
+        if (counters[3]) px.sample_credit.resize(px.sample_count.size());
+    }
+    deal.scatter(px.radiance_sum);
+    deal.scatter(px.radiance_compensation);
+    deal.scatter(px.depth_sum);
+    deal.scatter(px.luminance_sq_sum);
+    deal.scatter(px.radiance_sq_sum);
+    deal.scatter(px.sample_count);
+    deal.scatter(px.sample_index);
+    if (counters[2]) deal.scatter(px.active);
+    if (counters[3]) deal.scatter(px.sample_credit);
+}
+
+std::vector<int> Cluster::held_rows(int height) const {
+    if (!mpi_ || leader()) return {};
+    return rows_guarded(rank_, size_, height);
 }
 
 std::unique_ptr<PassHooks> Cluster::deal_rows() const {

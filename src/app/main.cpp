@@ -319,14 +319,18 @@ private:
     bool check_memory() {
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
-        const std::string shortfall =
-            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off), "the render of a " + image_);
-        if (!shortfall.empty())  // every rank holds the whole state: each checks its own machine
+        // Rank 0 holds the whole state and writes the outputs; another rank holds its rows and
+        // their neighbours only. Each checks its own machine.
+        std::vector<int> held = cluster_.held_rows(height);
+        const uint64_t bytes = held.empty() ? render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off)
+                                            : render_state_bytes(width, held.size());
+        const std::string shortfall = memory_shortfall(bytes, "the render of a " + image_);
+        if (!shortfall.empty())
             std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
                          cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
         if (cluster_.any_flags(!shortfall.empty())) return false;
         stage_ = "the render state of a " + image_;
-        state_.reset(width, height);
+        state_.reset(width, height, std::move(held));
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }
@@ -340,30 +344,22 @@ private:
         key_ = checkpoint_key(loaded_.scene, scene_, settings_, rule_);
     }
 
-    // --resume: every rank decodes rank 0's bytes and so comes to the same verdict; rank 0
-    // says it.
+    // --resume: rank 0 reads and decodes the checkpoint and says its verdict; every other
+    // rank receives its rows of it.
     bool resume() {
         if (opt_.resume) {
             stage_ = "the checkpoint of a " + image_;
-            std::string bytes, error;
+            std::string error;
             if (leader_) try {
-                    bytes = read_checkpoint_file(*opt_.resume, key_);
+                    decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
                 } catch (const std::runtime_error& e) {
                     error = e.what();
                 }
-            if (error.empty()) {
-                cluster_.broadcast(bytes);
-                try {
-                    decode_checkpoint(bytes, *opt_.resume, key_, state_);
-                } catch (const std::runtime_error& e) {
-                    error = e.what();
-                }
-            }
             if (cluster_.broadcast(!error.empty())) {
                 if (leader_) std::fprintf(stderr, "error: --resume %s; nothing rendered\n", error.c_str());
                 return false;
             }
-            if (!leader_) state_.rays = state_.nonfinite_samples = 0;  // counted once, at rank 0
+            cluster_.scatter_state(state_);
         }
         rays_before_ = state_.rays;
         return true;

@@ -19,13 +19,15 @@ void sum_three_along_row(const double* values, double* sums, size_t width) {
         sums[x] = (x > 0 ? values[x - 1] : 0.0) + values[x] + (x + 1 < width ? values[x + 1] : 0.0);
 }
 
-double guarded_3x3(const std::vector<double>& values, const std::vector<double>& row_sums, int width, int height,
-                   int y, size_t x) {
-    const size_t w = size_t(width), i = size_t(y) * w + x;
+// At pixel x of row y, whose row starts at `start` in the buffers (and the rows above and
+// below at their own starts, where they are in the image).
+double guarded_3x3(const RenderState& state, const std::vector<double>& values, const std::vector<double>& row_sums,
+                   int y, size_t start, size_t x) {
+    const size_t i = start + x;
     double sum = row_sums[i], cells = 1.0;
-    if (y > 0) sum += row_sums[i - w], cells += 1.0;
-    if (y + 1 < height) sum += row_sums[i + w], cells += 1.0;
-    cells *= 1.0 + (x > 0) + (x + 1 < w);
+    if (y > 0) sum += row_sums[state.row_start(y - 1) + x], cells += 1.0;
+    if (y + 1 < state.height) sum += row_sums[state.row_start(y + 1) + x], cells += 1.0;
+    cells *= 1.0 + (x > 0) + (x + 1 < size_t(state.width));
     return std::max(values[i], sum / cells);
 }
 
@@ -43,28 +45,30 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples, const R
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
         const int y = guarded[k];
-        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+        const size_t start = row_start(y);
+        for (size_t i = start; i < start + w; ++i) {
             const double mean = px_.sample_count[i] ? luminance(px_.radiance_sum[i]) / px_.sample_count[i] : 0.0;
             row_signal[size_t(y)] += mean * mean;
             const double se = pixel_standard_error(i);
             error_sq[i] = se * se;
         }
-        sum_three_along_row(&error_sq[size_t(y) * w], &row_sums[size_t(y) * w], w);
+        sum_three_along_row(&error_sq[start], &row_sums[start], w);
     }
     if (share) share->combine(row_signal, 1);
     double signal_sq = 0;
     for (double s : row_signal) signal_sq += s;
-    const double allowed = target * target * signal_sq / double(std::max<size_t>(n, 1));
+    const double allowed = target * target * signal_sq / double(std::max<size_t>(size_t(width) * size_t(height), 1));
     px_.active.resize(n);
     std::vector<double> row_count(size_t(height), 0.0);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
+        const size_t start = row_start(y);
         size_t count = 0;
         for (size_t x = 0; x < w; ++x) {
-            const size_t i = size_t(y) * w + x;
+            const size_t i = start + x;
             const bool needs_more =
-                px_.sample_count[i] < min_samples || !(guarded_3x3(error_sq, row_sums, width, height, y, x) <= allowed);
+                px_.sample_count[i] < min_samples || !(guarded_3x3(*this, error_sq, row_sums, y, start, x) <= allowed);
             px_.active[i] = needs_more;
             count += needs_more;
         }
@@ -98,9 +102,9 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     weight.resize(n);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
-        const int y = guarded[k];
-        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) variance[i] = sample_variance(i);
-        sum_three_along_row(&variance[size_t(y) * w], &row_sums[size_t(y) * w], w);
+        const size_t start = row_start(guarded[k]);
+        for (size_t i = start; i < start + w; ++i) variance[i] = sample_variance(i);
+        sum_three_along_row(&variance[start], &row_sums[start], w);
     }
     // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
     // standard deviation; per row, the sum of the weights and the active pixels.
@@ -108,12 +112,13 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
+        const size_t start = row_start(y);
         double row_weight = 0;
         size_t row_active = 0;
         for (size_t x = 0; x < w; ++x) {
-            const size_t i = size_t(y) * w + x;
+            const size_t i = start + x;
             const bool on = px_.active.empty() || px_.active[i];
-            const double guarded_variance = guarded_3x3(variance, row_sums, width, height, y, x);
+            const double guarded_variance = guarded_3x3(*this, variance, row_sums, y, start, x);
             weight[i] = on && std::isfinite(guarded_variance) ? std::sqrt(guarded_variance) : 0.0;
             row_weight += weight[i];
             row_active += on;
@@ -139,8 +144,8 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
-        const int y = own[k];
-        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+        const size_t start = row_start(own[k]);
+        for (size_t i = start; i < start + w; ++i) {
             if (!(px_.active.empty() || px_.active[i])) {
                 px_.pass_samples[i] = 0;
                 continue;

@@ -8,10 +8,16 @@
 
 namespace kr {
 
-void RenderState::reset(int w, int h) {
+void RenderState::reset(int w, int h, std::vector<int> held) {
     width = w;
     height = h;
-    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+    held_ = std::move(held);
+    slot_.clear();
+    if (!held_.empty()) {
+        slot_.assign(size_t(h), -1);
+        for (size_t k = 0; k < held_.size(); ++k) slot_[size_t(held_[k])] = int(k);
+    }
+    const size_t n = static_cast<size_t>(w) * (held_.empty() ? static_cast<size_t>(h) : held_.size());
     px_.radiance_sum.assign(n, Color());
     px_.radiance_compensation.assign(n, Color());
     px_.depth_sum.assign(n, 0.0);
@@ -123,12 +129,16 @@ std::vector<int> rows_owned(const RowShare* share, int height) {
     return rows;
 }
 
-std::vector<int> rows_guarded(const RowShare* share, int height) {
+std::vector<int> rows_guarded(int index, int count, int height) {
     std::vector<int> rows;
+    const auto owns = [&](int y) { return y >= 0 && y < height && y % count == index; };
     for (int y = 0; y < height; ++y)
-        if (!share || share->owns(y) || (y > 0 && share->owns(y - 1)) || (y + 1 < height && share->owns(y + 1)))
-            rows.push_back(y);
+        if (owns(y) || owns(y - 1) || owns(y + 1)) rows.push_back(y);
     return rows;
+}
+
+std::vector<int> rows_guarded(const RowShare* share, int height) {
+    return share ? rows_guarded(share->index(), share->count(), height) : rows_guarded(0, 1, height);
 }
 
 double RenderState::relative_error(const RowShare* share) const {
@@ -140,9 +150,9 @@ double RenderState::relative_error(const RowShare* share) const {
     std::vector<double> rows(3 * size_t(height), 0.0);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
-        const size_t y = size_t(own[k]);
+        const size_t y = size_t(own[k]), start = row_start(own[k]);
         double error = 0, signal = 0;
-        for (size_t i = y * w; i < (y + 1) * w; ++i) {
+        for (size_t i = start; i < start + w; ++i) {
             const double se = pixel_standard_error(i);
             if (!std::isfinite(se)) {
                 rows[3 * y + 2] = 1;

@@ -74,6 +74,8 @@ private:
 // 3x3 guard reads: its own and their neighbours.
 std::vector<int> rows_owned(const RowShare* share, int height);
 std::vector<int> rows_guarded(const RowShare* share, int height);
+// Those of process `index` of `count`.
+std::vector<int> rows_guarded(int index, int count, int height);
 
 class RenderState {
 public:
@@ -99,14 +101,24 @@ public:
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
-    void reset(int w, int h);
+    // A w x h render's state holding the image rows `held` (in order; empty: every row). A
+    // process of a shared render holds its own rows and their neighbours (rows_guarded): its
+    // buffers have those rows only, each pixel's sums at row_start(y) + x.
+    void reset(int w, int h, std::vector<int> held = {});
+    const std::vector<int>& held_rows() const { return held_; }
+    bool holds_row(int y) const { return held_.empty() || slot_[size_t(y)] >= 0; }
+    // Where the buffers hold pixel (0, y) of a held row.
+    size_t row_start(int y) const { return size_t(held_.empty() ? y : slot_[size_t(y)]) * size_t(width); }
+
+    // The images and the halves below read a state that holds every row.
     Image radiance() const;                  // per-pixel mean radiance (compensated sums)
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
     // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
     // over the count (infinite below two samples). What `keithray compare --statistical` tests.
     std::vector<Color> variance_of_mean() const;
 
-    // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
+    // Unbiased variance of one sample's luminance in the buffers' pixel `i` (infinite below
+    // two samples).
     double sample_variance(size_t i) const;
     // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
     // two samples).
@@ -159,6 +171,8 @@ public:
 private:
     void add_sums_to_half(int sign);
     PixelBuffers px_;
+    std::vector<int> held_;  // the rows held (empty: all)
+    std::vector<int> slot_;  // per image row, its place among held_ (-1: not held); empty with held_
 };
 
 // The bytes per pixel a RenderState holds once every buffer is in use: the seven sums and
@@ -175,6 +189,16 @@ inline constexpr uint64_t kRenderStateBytesPerPixel =
 // A denoised render adds its halves (render_state), its feature buffers and the denoiser's
 // working images (render/denoise.h: kDenoiseBytesPerPixel).
 uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised = false);
+// The three sums of a pixel that the 3x3 guard reads (radiance_sum, luminance_sq_sum,
+// sample_count): what a process of a shared render sends its neighbours of its rows.
+inline constexpr uint64_t kGuardRowBytesPerPixel = sizeof(Color) + sizeof(double) + sizeof(uint32_t);
+
+// The memory of a process of a shared render that holds `rows` rows of `width` pixels and
+// writes nothing (RenderState::reset's held rows): their state, and the buffers in which it
+// sends its own rows' guard sums and receives its neighbours'.
+inline uint64_t render_state_bytes(int width, size_t rows) {
+    return uint64_t(width) * uint64_t(rows) * (kRenderStateBytesPerPixel + kGuardRowBytesPerPixel);
+}
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
 inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean
