@@ -6,7 +6,15 @@
 #            here with mpicxx) at 512x512 and 3840x2160, 2 and 4 ranks.
 #   balance: mpirun -np 4 (oversubscribed, 1 thread each) on scenes 3, 6 and 8 at their own
 #            spp; prints keithray's per-rank summary (busy CPU seconds, slowest vs mean).
-# Usage: scripts/bench_mpi.sh ratio|balance|exchange [REPEATS] [extra render flags]
+#   plan:    adaptive against uniform allocation under mpirun -np 1, 2 and 4 (1 thread each),
+#            scene 6 at 512x512, 64 spp, interleaved, REPEATS rounds: each run's wall seconds,
+#            and per pass after which the statistics were exchanged, what the busiest rank
+#            spent exchanging and planning (keithray's per-rank summary) and the bytes a rank
+#            received. With BASELINE=path/to/another/keithray, that build's runs are
+#            interleaved with these (its summary names no bytes: 36 B x P x (N-1)/N a pass).
+#   memory:  each rank's peak resident memory (/usr/bin/time) in a 4096x4096 render (scene 1,
+#            10 spp: adaptive allocation plans passes 9 and 10) at np 1, 2 and 4.
+# Usage: scripts/bench_mpi.sh ratio|balance|exchange|plan|memory [REPEATS] [extra render flags]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 exe=build/keithray
@@ -20,7 +28,7 @@ out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
 seconds() { sed -n 's/.* spp, \([0-9.]*\) s,.*/\1/p' | head -1; }
-median() { sort -g | awk '{v[NR]=$1} END {print (NR % 2) ? v[(NR+1)/2] : (v[NR/2] + v[NR/2+1]) / 2}'; }
+median() { sort -g | awk '{v[NR]=$1} END {print NR == 0 ? "-" : (NR % 2) ? v[(NR+1)/2] : (v[NR/2] + v[NR/2+1]) / 2}'; }
 
 case $what in
 ratio)
@@ -52,5 +60,50 @@ exchange)
     for size in "512 512" "3840 2160"; do "${mpi[@]}" -np $n "$out/exchange" $size; done
   done
   ;;
-*) echo "usage: $0 ratio|balance|exchange [REPEATS] [render flags]" >&2; exit 2 ;;
+plan)
+  exes=("$exe")
+  [ -n "${BASELINE:-}" ] && exes=("$BASELINE" "$exe")
+  # One run: its wall seconds, then per exchanged pass: exchange ms, plan ms, MB received.
+  run() {
+    local binary=$1 np=$2 alloc=$3
+    shift 3
+    "${mpi[@]}" -np "$np" "$binary" render res/scenes/assignment_06.json -q --spp 64 --allocation "$alloc" \
+      -o "$out/p.ppm" "$@" |
+      awk '/ spp, / { for (i = 1; i <= NF; i++) if ($(i + 1) == "s,") t = $i }
+           /ranks: busy/ { for (i = 1; i <= NF; i++) {
+               if ($i == "exchange") x = $(i + 1); if ($i == "MB") mb = $(i - 1)
+               if ($i == "after") n = $(i + 1); if ($i == "between") b = $(i + 2) } }
+           END { if (n > 0) printf "%s %.2f %.2f %s\n", t, 1000 * x / n, 1000 * b / n, mb == "" ? "-" : mb / n
+                 else printf "%s - - -\n", t }'
+  }
+  for ((i = 0; i < repeats; i++)); do
+    for n in 1 2 4; do
+      for alloc in adaptive uniform; do
+        for e in "${!exes[@]}"; do
+          run "${exes[$e]}" $n $alloc "$@" >>"$out/plan-$e-$n-$alloc"
+        done
+      done
+    done
+  done
+  echo "scene 6, 512x512, 64 spp, $repeats rounds interleaved; medians (per exchanged pass: busiest rank)"
+  echo "build | np | allocation | wall s | exchange ms | plan + noise ms | MB received"
+  for e in "${!exes[@]}"; do
+    for n in 1 2 4; do
+      for alloc in adaptive uniform; do
+        f="$out/plan-$e-$n-$alloc"
+        col() { awk -v c="$1" '{print $c}' "$f" | grep -v '^-$' | median; }
+        echo "$([ ${#exes[@]} = 2 ] && [ "$e" = 0 ] && echo baseline || echo this) | $n | $alloc | $(col 1) | $(col 2) | $(col 3) | $(col 4)"
+      done
+    done
+  done
+  ;;
+memory)
+  sed 's/"dimensions" : \[512, 512\]/"dimensions" : [4096, 4096]/' res/scenes/assignment_01.json >"$out/big.json"
+  for n in 1 2 4; do
+    echo "np $n (rank order not kept), peak resident kB:"
+    "${mpi[@]}" -np $n /usr/bin/time -f "  %M" "$exe" render "$out/big.json" --spp 10 -q -o "$out/big.ppm" "$@" 2>&1 |
+      grep -E '^  [0-9]+$|ranks: busy'
+  done
+  ;;
+*) echo "usage: $0 ratio|balance|exchange|plan|memory [REPEATS] [render flags]" >&2; exit 2 ;;
 esac

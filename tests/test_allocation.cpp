@@ -1,13 +1,15 @@
 // Adaptive allocation of a pass's samples (RenderState::plan_pass): the plan itself on
 // hand-made statistics, unbiasedness on an analytic scene, the gain it exists for, and
-// independence from threads.
+// independence from threads and from the rows' share between processes.
 #include <gtest/gtest.h>
 
+#include <barrier>
 #include <chrono>
 #include <cmath>
 #include <memory>
 #include <numeric>
 #include <omp.h>
+#include <thread>
 
 #include "render/progressive.h"
 #include "render/trace.h"
@@ -52,6 +54,26 @@ double mean_squared_error(const Image& a, const Image& b) {
     }
     return sum / double(a.pixels.size());
 }
+
+// The processes of a shared render played by threads, one RenderState each: combine() puts
+// every thread's own rows of the per-row sums in one table, waits for all, and reads it back.
+class ThreadRows final : public RowShare {
+public:
+    ThreadRows(int index, int count, std::barrier<>& sync, std::vector<double>& table)
+        : RowShare(index, count), sync_(sync), table_(table) {}
+    void combine(std::vector<double>& values, int fields) const override {
+        const int height = int(values.size()) / fields;
+        for (int y = index(); y < height; y += count())
+            std::copy_n(values.begin() + y * fields, fields, table_.begin() + y * fields);
+        sync_.arrive_and_wait();
+        std::copy_n(table_.begin(), values.size(), values.begin());
+        sync_.arrive_and_wait();  // every thread has read the table before the next combine
+    }
+
+private:
+    std::barrier<>& sync_;
+    std::vector<double>& table_;
+};
 
 }  // namespace
 
@@ -267,4 +289,85 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     EXPECT_EQ(f->sample_count, one.sample_count());
     const Image image = one.radiance();
     for (size_t i = 0; i < image.pixels.size(); ++i) EXPECT_EQ(f->radiance.pixels[i].x, image.pixels[i].x) << i;
+}
+
+// Each process plans its own rows (RowShare): holding only its rows and their neighbours'
+// (RenderState::reset's held rows), or every row with the others poisoned with NaN and wrong
+// counts, and with the per-row sums combined, its rows get the estimated error, the noise
+// mask, the active count and the plan of one process, bit for bit; N from 2 to more processes
+// than rows (some own none), odd sizes.
+TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
+    const int w = 13, h = 11;
+    Scene authored = brief_scene(6, w);
+    authored.renderer.height = h;
+    const RenderScene scene = prepare_scene(authored);
+    const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    StopRule rule;
+    rule.max_passes = 18;
+    rule.noise = 0.04;  // the mask set at pass 16
+    RenderState rendered(w, h);
+    render_until(scene, settings, rendered, rule);
+    // One process: the estimate, the mask's update and the next plan, in the driver's order.
+    RenderState whole = rendered;
+    const double error = whole.relative_error();
+    const size_t active = whole.update_adaptive(0.1, 16);
+    whole.plan_pass(settings);
+    ASSERT_FALSE(whole.pass_samples().empty());
+    ASSERT_GT(active, 0u);
+    ASSERT_LT(active, size_t(w * h));  // the mask leaves some pixels out
+    for (const bool held : {true, false})
+    for (int count : {2, 3, 4, 5, 12}) {
+        SCOPED_TRACE(count);
+        SCOPED_TRACE(held ? "held rows" : "poisoned rows");
+        std::vector<RenderState> states(size_t(count), rendered);
+        std::vector<double> errors(static_cast<size_t>(count)), table(3 * static_cast<size_t>(h));
+        std::vector<size_t> actives(static_cast<size_t>(count));
+        std::barrier<> sync(count);
+        std::vector<std::thread> threads;
+        for (int r = 0; r < count; ++r)
+            threads.emplace_back([&, r] {
+                const ThreadRows share(r, count, sync, table);
+                RenderState& s = states[size_t(r)];
+                const std::vector<int> guarded = rows_guarded(&share, h);
+                if (held) {  // the held rows' sums, counts and carried fractions
+                    s.reset(w, h, guarded);
+                    s.passes = rendered.passes;
+                    s.buffers().sample_credit.resize(s.sample_count().size());
+                    for (int y : guarded)
+                        for (size_t x = 0; x < size_t(w); ++x) {
+                            const size_t from = size_t(y) * w + x, to = s.row_start(y) + x;
+                            s.buffers().radiance_sum[to] = rendered.radiance_sum()[from];
+                            s.buffers().luminance_sq_sum[to] = rendered.luminance_sq_sum()[from];
+                            s.buffers().sample_count[to] = rendered.sample_count()[from];
+                            s.buffers().sample_credit[to] = rendered.sample_credit()[from];
+                        }
+                } else {
+                    for (int y = 0; y < h; ++y) {
+                        if (std::find(guarded.begin(), guarded.end(), y) != guarded.end()) continue;
+                        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+                            s.buffers().radiance_sum[i] = Color(std::nan(""));
+                            s.buffers().luminance_sq_sum[i] = std::nan("");
+                            s.buffers().sample_count[i] = 3;
+                        }
+                    }
+                }
+                errors[size_t(r)] = s.relative_error(&share);
+                actives[size_t(r)] = s.update_adaptive(0.1, 16, &share);
+                s.plan_pass(settings, &share);
+            });
+        for (std::thread& t : threads) t.join();
+        for (int r = 0; r < count; ++r) {
+            SCOPED_TRACE(r);
+            const RenderState& s = states[size_t(r)];
+            EXPECT_EQ(errors[size_t(r)], error);
+            EXPECT_EQ(actives[size_t(r)], active);
+            for (int y = r; y < h; y += count)
+                for (size_t x = 0; x < size_t(w); ++x) {
+                    const size_t i = s.row_start(y) + x, at = size_t(y) * w + x;
+                    EXPECT_EQ(s.active()[i], whole.active()[at]) << at;
+                    EXPECT_EQ(s.pass_samples()[i], whole.pass_samples()[at]) << at;
+                    EXPECT_EQ(s.sample_credit()[i], whole.sample_credit()[at]) << at;
+                }
+        }
+    }
 }

@@ -1,7 +1,11 @@
-// keithray under mpirun (issue 26; app/cluster.h): the bytes of the render without MPI at 1,
-// 2 and 3 ranks for every integrator, estimator and allocation and the noise rule; a bad
-// scene ends every rank with one error line; a rank killed mid-render ends the job non-zero
-// with no image and a checkpoint that resumes to the uninterrupted image. Every run is under
+// keithray under mpirun (issues 26 and 36; app/cluster.h): the bytes of the render without
+// MPI at 1 to 4 ranks for every integrator, estimator and allocation and the noise rule, also
+// where a rank owns one row or none; the checkpoint of one process at any rank count; each
+// rank's memory check of the rows it holds; each
+// rank receives only its rows' neighbours and the per-row sums between passes; a plain run
+// never starts MPI; a bad scene
+// ends every rank with one error line; a rank killed mid-render ends the job non-zero with no
+// image and a checkpoint that resumes to the uninterrupted image. Every run is under
 // `timeout`: a hang fails the test instead of the suite.
 #include <gtest/gtest.h>
 
@@ -14,6 +18,8 @@
 #include <string>
 #include <thread>
 
+#include "core/memory.h"
+#include "render/render_state.h"
 #include "scene/save.h"
 #include "test_util.h"
 
@@ -44,19 +50,42 @@ protected:
         return test::run_command("cd '" + dir.string() + "' && " + command, dir);
     }
     std::string keithray() const { return std::string("timeout ") + std::to_string(kTimeoutSeconds) + " '" + KEITHRAY_EXE + "' "; }
-    // Scene `n` of the brief at size x size pixels, written to the scratch folder.
-    std::string scene(int n, int size, const std::string& name, const std::string& output = "out.ppm") {
+    // Scene `n` of the brief at size x size pixels (size x height), written to the scratch folder.
+    std::string scene(int n, int size, const std::string& name, const std::string& output = "out.ppm", int height = 0) {
         Scene s = test::brief_scene(n, size);
+        if (height > 0) s.renderer.height = height;
         s.renderer.output = (dir / output).string();  // beside the scene file
         save_scene_json(s, dir / name);
         return name;
+    }
+    // `args` rendered by one process of 2 threads, then by 1 to `max_ranks` ranks: the same bytes.
+    void expect_same_bytes(const std::string& args, const std::string& output, int max_ranks = 4) {
+        const test::CommandResult single = here(keithray() + "render -q --threads 2 " + args + " -o single-" + output);
+        ASSERT_EQ(single.status, 0) << single.err;
+        for (int ranks = 1; ranks <= max_ranks; ++ranks) {
+            SCOPED_TRACE(ranks);
+            const std::string out = std::to_string(ranks) + "-" + output;
+            const test::CommandResult r = here(mpirun(ranks) + "render -q " + args + " -o " + out);
+            ASSERT_EQ(r.status, 0) << r.err;
+            EXPECT_EQ(bytes(out), bytes("single-" + output));
+            const std::string stem = output.substr(0, output.rfind('.'));
+            if (output.ends_with(".ppm"))
+                EXPECT_EQ(bytes(std::to_string(ranks) + "-" + stem + "-depth.ppm"), bytes("single-" + stem + "-depth.ppm"));
+            // Rank 0 prints the summary once, with each rank's busy time.
+            EXPECT_NE(r.out.find(std::to_string(ranks) + " ranks: busy s"), std::string::npos) << r.out;
+        }
+    }
+    // How many passes the noise rule took, from the stop line of a run's stderr (-1: none).
+    static int noise_passes(const std::string& err) {
+        const size_t at = err.find("stopped by --noise after ");
+        return at == std::string::npos ? -1 : std::stoi(err.substr(at + 25));
     }
     std::string bytes(const std::string& name) { return test::read_file(dir / name); }
 };
 
 }  // namespace
 
-TEST_F(Mpi, SameBytesAtOneTwoAndThreeRanks) {
+TEST_F(Mpi, SameBytesAtOneToFourRanks) {
     const std::string wrt = scene(1, 32, "wrt.json"), pt = scene(6, 32, "pt.json");
     struct Case {
         const char* name;
@@ -64,29 +93,101 @@ TEST_F(Mpi, SameBytesAtOneTwoAndThreeRanks) {
     };
     for (const Case& c : {Case{"wrt uniform", wrt + " --spp 6 --allocation uniform", "a.ppm"},
                           Case{"pt uniform", pt + " --spp 10 --allocation uniform", "a.ppm"},
-                          Case{"pt adaptive", pt + " --spp 24", "a.ppm"},
+                          Case{"pt uniform sobol", pt + " --spp 10 --allocation uniform --estimator sobol", "a.ppm"},
+                          Case{"pt adaptive", pt + " --spp 24 --estimator uniform", "a.ppm"},
+                          Case{"pt adaptive sobol", pt + " --spp 24 --estimator sobol", "a.ppm"},
                           Case{"pt noise", pt + " --noise 0.03 --spp 400", "a.ppm"},
+                          Case{"pt noise uniform allocation", pt + " --noise 0.03 --spp 400 --allocation uniform", "a.ppm"},
                           Case{"pt stratified, every layer", pt + " --spp 9 --estimator stratified", "a.exr"}}) {
         SCOPED_TRACE(c.name);
-        const test::CommandResult single = here(keithray() + "render -q --threads 2 " + c.args + " -o single-" + c.output);
-        ASSERT_EQ(single.status, 0) << single.err;
         // The noise rule stops it, after its mask has steered passes (from pass 16 on).
         if (c.args.find("--noise") != std::string::npos) {
-            const size_t at = single.err.find("stopped by --noise after ");
-            ASSERT_NE(at, std::string::npos) << single.err;
-            EXPECT_GT(std::stoi(single.err.substr(at + 25)), 16) << single.err;
+            const test::CommandResult single = here(keithray() + "render -q " + c.args + " -o probe.ppm");
+            EXPECT_GT(noise_passes(single.err), 16) << single.err;
         }
-        for (int ranks : {1, 2, 3}) {
-            SCOPED_TRACE(ranks);
-            const std::string out = std::to_string(ranks) + "-" + c.output;
-            const test::CommandResult r = here(mpirun(ranks) + "render -q " + c.args + " -o " + out);
-            ASSERT_EQ(r.status, 0) << r.err;
-            EXPECT_EQ(bytes(out), bytes("single-" + c.output));
-            if (c.output.ends_with(".ppm")) EXPECT_EQ(bytes(std::to_string(ranks) + "-a-depth.ppm"), bytes("single-a-depth.ppm"));
-            // Rank 0 prints the summary once, with each rank's busy time.
-            EXPECT_NE(r.out.find(std::to_string(ranks) + " ranks: busy s"), std::string::npos) << r.out;
-        }
+        expect_same_bytes(c.args, c.output);
     }
+}
+
+// Row partitions where a rank owns one row or none (3 rows at 4 ranks), unequal shares and
+// odd sizes (5 rows of 7 pixels), with the adaptive plan and the noise rule reading the 3x3
+// guard across the ranks' rows.
+TEST_F(Mpi, SameBytesWhereARankOwnsOneRowOrNone) {
+    for (int height : {3, 5}) {
+        SCOPED_TRACE(height);
+        const std::string s = scene(6, 7, "rows" + std::to_string(height) + ".json", "out.ppm", height);
+        expect_same_bytes(s + " --spp 20", "adaptive.ppm");
+        expect_same_bytes(s + " --spp 60 --noise 0.05 --estimator sobol", "noise.ppm");
+    }
+}
+
+// The checkpoint after the last pass of a render under the noise rule (its mask, set at pass
+// 28, and the plan's carried fractions, both planned by each rank on its own rows) is the one
+// process's file, byte for byte, at 2 to 4 ranks.
+TEST_F(Mpi, CheckpointIsOneProcesssAtAnyRankCount) {
+    const std::string s = scene(6, 24, "scene.json", "out.ppm", 19);
+    const std::string args = "render -q " + s + " --spp 30 --noise 0.01 --every 0 ";
+    const test::CommandResult single = here(keithray() + args + "--threads 2 -o single.ppm --checkpoint single.ckpt");
+    ASSERT_EQ(single.status, 0) << single.err;
+    ASSERT_EQ(noise_passes(single.err), -1) << single.err;  // the mask steered passes 17 to 30
+    for (int ranks : {2, 3, 4}) {
+        SCOPED_TRACE(ranks);
+        const std::string name = std::to_string(ranks);
+        const test::CommandResult r = here(mpirun(ranks) + args + "-o " + name + ".ppm --checkpoint " + name + ".ckpt");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(bytes(name + ".ckpt"), bytes("single.ckpt"));
+        EXPECT_EQ(bytes(name + ".ppm"), bytes("single.ppm"));
+    }
+}
+
+// Between passes a rank receives its rows' neighbouring rows (36 bytes a pixel, from two
+// ranks) and the per-row sums, not the whole image's statistics: at 4 ranks, 64x64, 24 spp
+// (16 passes planned), at most 2 x 16 rows x 64 pixels x 36 bytes and 64 rows x 2 sums x 8
+// bytes a pass, under the 36 x 4096 x 3/4 bytes of the whole image's.
+TEST_F(Mpi, RanksReceiveOnlyTheirNeighbourRowsAndRowSums) {
+    scene(6, 64, "scene.json");
+    const test::CommandResult r = here(mpirun(4) + "render -q scene.json --spp 24 -o out.ppm");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const size_t at = r.out.find(" MB received after ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const double megabytes = std::stod(r.out.substr(r.out.rfind(' ', at - 1) + 1));
+    const int passes = std::stoi(r.out.substr(at + 19));
+    EXPECT_EQ(passes, 24 - 8 + 1) << r.out;  // after passes 8 to 24 (the last for its summary)
+    const double per_pass = megabytes * 1e6 / passes;
+    EXPECT_GT(per_pass, 16 * 64 * 36) << r.out;
+    EXPECT_LE(per_pass, 2 * 16 * 64 * 36 + 64 * 2 * 8) << r.out;
+}
+
+// Rank 0 holds the whole state (it gathers it and writes the outputs); every other rank only
+// its rows and their neighbours': the memory check of each says so, here refused under a
+// 16 GiB address-space limit for a 32768x32768 image (each rank of 4 holds 3 rows in 4).
+TEST_F(Mpi, EachRankChecksTheMemoryOfTheRowsItHolds) {
+    scene(6, 32768, "huge.json");
+    const test::CommandResult r = here("ulimit -v 16777216; " + mpirun(4) + "render -q huge.json -o huge.ppm");
+    EXPECT_NE(r.status, 0);
+    const std::string rank0 = "needs about " + format_bytes(render_memory_bytes(32768, 32768, false)) + ", above the "
+                              "address-space limit (ulimit -v) (16.0 GiB) on rank 0";
+    EXPECT_NE(r.err.find(rank0), std::string::npos) << r.err;
+    const std::string others = "needs about " + format_bytes(render_state_bytes(32768, 3 * 32768 / 4));
+    for (int rank : {1, 2, 3})
+        EXPECT_NE(r.err.find(others + ", above the address-space limit (ulimit -v) (16.0 GiB) on rank " +
+                             std::to_string(rank)),
+                  std::string::npos)
+            << r.err;
+    EXPECT_FALSE(fs::exists(dir / "huge.ppm"));
+}
+
+// Run plainly (no launcher in the environment), keithray never calls MPI_Init: Open MPI's
+// initialisation, even as a singleton, leaves its session folder (ompi.HOST.UID) in TMPDIR.
+TEST_F(Mpi, PlainRunNeverStartsMpi) {
+    scene(6, 16, "scene.json");
+    fs::create_directories(dir / "tmp");
+    const test::CommandResult r =
+        here("env -u OMPI_COMM_WORLD_SIZE -u PMIX_RANK -u PMI_RANK TMPDIR='" + (dir / "tmp").string() + "' " +
+             keithray() + "render -q scene.json --spp 12 --noise 0.05 -o plain.ppm");
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.out.find("ranks: busy"), std::string::npos) << r.out;
+    for (const auto& entry : fs::directory_iterator(dir / "tmp")) ADD_FAILURE() << "MPI started: " << entry.path();
 }
 
 // A bad scene beside a good one: one error line, a non-zero exit from every rank (no hang),

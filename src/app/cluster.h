@@ -4,10 +4,12 @@
 //
 // How a render is shared (docs/scaling.md): rank r renders the pixel rows y with
 // y mod N == r, every pixel's samples in the single-process order, so each pixel's sums are
-// those of one process bit for bit. After a pass whose next step reads the image's statistics
-// (adaptive allocation, the noise rule), every rank receives every other rank's rows of the
-// three sums those read; each rank then plans the next pass itself, identically. Rank 0
-// gathers the whole state for the outputs and checkpoints.
+// those of one process bit for bit. Each rank plans its own rows (render/render_state.h,
+// RowShare): after a pass whose next step reads the statistics (adaptive allocation, the
+// noise rule), it receives the three sums of its rows' neighbouring rows (the 3x3 guard's)
+// from the ranks r - 1 and r + 1, and the image-wide sums are gathered as per-row sums that
+// every rank adds in row order. Rank 0 holds the whole state, gathered for the outputs and
+// checkpoints; every other rank holds only its rows and their neighbours (held_rows).
 #pragma once
 
 #include <memory>
@@ -21,10 +23,11 @@ namespace kr {
 // Per rank, what a render cost it, for the summary.
 struct RankCost {
     double busy_seconds = 0;     // CPU time spent in render_pass (the rank's share of the work)
-    double combine_seconds = 0;  // wall time spent exchanging rows (and waiting for the others)
-    double between_seconds = 0;  // wall time between passes: every rank plans the whole image
-    int exchanges = 0;           // passes after which the statistics were exchanged
+    double combine_seconds = 0;  // wall time in the exchanges and the --time agreement (waiting included)
+    double between_seconds = 0;  // wall time between passes less its exchanges: planning, the noise rule
+    int exchanges = 0;           // passes after which the guard rows' statistics were exchanged
     uint64_t rays = 0;
+    double received_bytes = 0;   // received in the exchanges between passes
 };
 
 class Cluster {
@@ -52,15 +55,20 @@ public:
     int any_flags(int flags) const;
     // At rank 0, every rank's `cost` (rank order); elsewhere empty.
     std::vector<RankCost> gather(const RankCost& cost) const;
+    // The rows this rank's RenderState holds (RenderState::reset): its own and their
+    // neighbours; every row (empty) at rank 0, which gathers the whole state, and alone.
+    std::vector<int> held_rows(int height) const;
+    // After rank 0 decoded a checkpoint into `state` (every row): every other rank's state
+    // (reset to its held_rows) gets its rows of it, with the passes; the rays and dropped
+    // samples stay counted at rank 0.
+    void scatter_state(RenderState& state) const;
     // Makes rank 0's `state` whole (every pixel's sums and counts from the rank that drew
     // them) and returns the job's rays and dropped samples there; the other ranks' states are
     // unchanged.
     void gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const;
 
-    // The driver's hooks that deal rows to the ranks (nullptr for a cluster of one). When
-    // `always_combine`, the statistics are exchanged after every pass (the progress line of
-    // an open-ended render shows the estimated error).
-    std::unique_ptr<PassHooks> deal_rows(bool always_combine) const;
+    // The driver's hooks that deal rows to the ranks (nullptr for a cluster of one).
+    std::unique_ptr<PassHooks> deal_rows() const;
     // What the hooks measured in this rank so far.
     static RankCost cost(const PassHooks& hooks);
 

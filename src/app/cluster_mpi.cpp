@@ -74,15 +74,15 @@ struct RowDeal {
         for (size_t r = 1; r < counts.size(); ++r) o[r] = o[r - 1] + counts[r - 1];
         return o;
     }
-    // This rank's rows of `field`, packed in order into `out`.
+    // This rank's rows of `field` (of `state`'s buffers), packed in order into `out`.
     template <class T>
-    void pack(const std::vector<T>& field, std::vector<char>& out) const {
+    void pack(const RenderState& state, const std::vector<T>& field, std::vector<char>& out) const {
         const size_t row = size_t(width) * sizeof(T);
         const int rows = rows_of(rank);
         out.resize(size_t(rows) * row);
 #pragma omp parallel for schedule(static)
         for (int k = 0; k < rows; ++k)
-            std::memcpy(out.data() + size_t(k) * row, field.data() + size_t(rank + k * size) * size_t(width), row);
+            std::memcpy(out.data() + size_t(k) * row, field.data() + state.row_start(rank + k * size), row);
     }
     template <class T>
     void unpack(const std::vector<char>& all, const std::vector<int>& offsets, std::vector<T>& field) const {
@@ -93,81 +93,168 @@ struct RowDeal {
             std::memcpy(field.data() + size_t(y) * size_t(width),
                         all.data() + size_t(offsets[size_t(y % size)]) * sizeof(T) + size_t(y / size) * row, row);
     }
-    // Every rank's rows of `field` in every rank (all) or in rank 0 only. `mine` and
+    // Every rank's rows of `field` in rank 0, whose state holds every row. `mine` and
     // `gathered` are buffers kept between calls: fresh pages cost more than the copy.
     template <class T>
-    void exchange(std::vector<T>& field, bool all, std::vector<char>& mine, std::vector<char>& gathered) const {
-        const Counted<T> as(field.size());
+    void gather(const RenderState& state, std::vector<T>& field, std::vector<char>& mine,
+                std::vector<char>& gathered) const {
+        const Counted<T> as(size_t(width) * size_t(height));  // the same in every rank
         const std::vector<int> counts = this->counts(), offsets = this->offsets(counts);
         const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
-        if (all || rank == 0) gathered.resize(field.size() * sizeof(T));
-        pack(field, mine);
-        if (all)
-            MPI_Allgatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(),
-                           mpi_counts.data(), mpi_offsets.data(), as.type(), MPI_COMM_WORLD);
-        else
-            MPI_Gatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(), mpi_counts.data(),
-                        mpi_offsets.data(), as.type(), 0, MPI_COMM_WORLD);
-        if (all || rank == 0) unpack(gathered, offsets, field);
+        if (rank == 0) gathered.resize(field.size() * sizeof(T));
+        pack(state, field, mine);
+        MPI_Gatherv(mine.data(), as.count(mine.size() / sizeof(T)), as.type(), gathered.data(), mpi_counts.data(),
+                    mpi_offsets.data(), as.type(), 0, MPI_COMM_WORLD);
+        if (rank == 0) unpack(gathered, offsets, field);
+    }
+    // Rank 0's `field` (every row) to every other rank, each receiving the rows its state
+    // holds (rows_guarded), in order: its buffers' layout.
+    template <class T>
+    void scatter(std::vector<T>& field) const {
+        const Counted<T> as(3 * size_t(width) * size_t(height));  // a rank's rows and their neighbours
+        std::vector<int> counts(static_cast<size_t>(size)), offsets(static_cast<size_t>(size), 0);
+        for (int r = 0; r < size; ++r) {
+            counts[size_t(r)] = r == 0 ? 0 : int(rows_guarded(r, size, height).size()) * width;
+            if (r > 0) offsets[size_t(r)] = offsets[size_t(r - 1)] + counts[size_t(r - 1)];
+        }
+        std::vector<T> sent;
+        if (rank == 0) {
+            sent.reserve(size_t(offsets.back()) + size_t(counts.back()));
+            for (int r = 1; r < size; ++r)
+                for (int y : rows_guarded(r, size, height))
+                    sent.insert(sent.end(), field.begin() + ptrdiff_t(y) * width, field.begin() + ptrdiff_t(y + 1) * width);
+        }
+        const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
+        MPI_Scatterv(sent.data(), mpi_counts.data(), mpi_offsets.data(), as.type(), rank == 0 ? MPI_IN_PLACE : field.data(),
+                     as.count(rank == 0 ? 0 : field.size()), as.type(), 0, MPI_COMM_WORLD);
     }
 };
 
-class DealtRows final : public PassHooks {
+class DealtRows final : public PassHooks, public RowShare {
 public:
-    DealtRows(int rank, int size, bool always_combine) : rank_(rank), size_(size), always_combine_(always_combine) {}
+    DealtRows(int rank, int size) : RowShare(rank, size) {}
 
     void before_pass(RenderState& state) override {
-        // render_pass skips pixels whose mask entry is 0: this rank's rows of the noise
-        // rule's mask (all rows' pixels where there is none).
-        const size_t w = size_t(state.width), pixels = w * size_t(state.height);
-        if (owned_.size() != pixels) {
-            owned_.assign(pixels, 0);
-            for (int y = rank_; y < state.height; y += size_) std::fill_n(owned_.begin() + ptrdiff_t(size_t(y) * w), w, 1);
+        // render_pass samples only this rank's rows (of the noise rule's mask, if any).
+        if (owned_rows_.size() != size_t(state.height)) {
+            owned_rows_.assign(size_t(state.height), 0);
+            for (int y : rows_owned(this, state.height)) owned_rows_[size_t(y)] = 1;
         }
-        noise_mask_.swap(state.buffers().active);
-        if (noise_mask_.empty()) {
-            state.buffers().active = owned_;
-        } else {
-            state.buffers().active.resize(pixels);
-#pragma omp parallel for schedule(static)
-            for (size_t i = 0; i < pixels; ++i) state.buffers().active[i] = owned_[i] & noise_mask_[i];
-        }
-        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_;
+        state.buffers().active_rows = owned_rows_;
+        // Planning and the noise rule since the last pass, less their exchanges.
+        if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_ - (cost_.combine_seconds - combine_mark_);
         cpu_start_ = cpu_seconds();
     }
 
     void after_pass(RenderState& state, bool statistics) override {
         cost_.busy_seconds += cpu_seconds() - cpu_start_;
-        state.buffers().active.swap(noise_mask_);
-        noise_mask_.clear();
+        state.buffers().active_rows.clear();
         ++passes_;
         pass_end_ = wall_seconds();
-        if (!statistics && !always_combine_) return;
-        const double start = pass_end_;
-        const RowDeal deal{rank_, size_, state.width, state.height};
-        deal.exchange(state.buffers().radiance_sum, true, mine_, gathered_);
-        deal.exchange(state.buffers().luminance_sq_sum, true, mine_, gathered_);
-        deal.exchange(state.buffers().sample_count, true, mine_, gathered_);
-        pass_end_ = wall_seconds();
-        cost_.combine_seconds += pass_end_ - start;
-        ++cost_.exchanges;
+        combine_mark_ = cost_.combine_seconds;
+        if (statistics) {
+            receive_guard_rows(state);
+            ++cost_.exchanges;
+        }
     }
 
     bool any(bool stop) override {
+        const double start = wall_seconds();  // mostly waiting for the slowest rank's pass
         int flag = stop, result = 0;
         MPI_Allreduce(&flag, &result, 1, MPI_INT, MPI_LOR, MPI_COMM_WORLD);
+        cost_.combine_seconds += wall_seconds() - start;
         return result != 0;
     }
 
-    RankCost cost_;
+    const RowShare* rows() const override { return this; }
+
+    // Every rank's rows of `values` (`fields` doubles a row), gathered and put in row order.
+    void combine(std::vector<double>& values, int fields) const override {
+        const double start = wall_seconds();
+        const int height = int(values.size() / size_t(fields));
+        const RowDeal deal{index(), count(), fields, height};
+        std::vector<double> mine;
+        for (int y : rows_owned(this, height))
+            mine.insert(mine.end(), values.begin() + ptrdiff_t(y) * fields, values.begin() + ptrdiff_t(y + 1) * fields);
+        const std::vector<int> counts = deal.counts(), offsets = deal.offsets(counts);
+        std::vector<double> all(values.size());
+        MPI_Allgatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
+                       MPI_DOUBLE, MPI_COMM_WORLD);
+        // Row y is rank (y mod N)'s row y div N.
+        for (int y = 0; y < height; ++y)
+            std::copy_n(all.begin() + offsets[size_t(y % count())] + ptrdiff_t(y / count()) * fields, fields,
+                        values.begin() + ptrdiff_t(y) * fields);
+        cost_.received_bytes += double((values.size() - mine.size()) * sizeof(double));
+        cost_.combine_seconds += wall_seconds() - start;
+    }
+
+    mutable RankCost cost_;
 
 private:
-    int rank_, size_;
-    bool always_combine_;
-    std::vector<uint8_t> noise_mask_;
-    std::vector<uint8_t> owned_;  // 1 on this rank's rows
-    std::vector<char> mine_, gathered_;  // exchange buffers, kept between passes
-    double cpu_start_ = 0, pass_end_ = 0;
+    // The rows the 3x3 guard reads besides this rank's own: rows y - 1 and y + 1 of each own
+    // row y, which ranks r - 1 and r + 1 (mod N) own. Each rank sends its rows' three sums to
+    // both and receives theirs (from the one other rank when N = 2).
+    void receive_guard_rows(RenderState& state) {
+        if (count() == 1) return;
+        const double start = wall_seconds();
+        const int width = state.width, height = state.height;
+        const RowDeal deal{index(), count(), width, height};
+        PixelBuffers& px = state.buffers();
+        const size_t w = size_t(width);
+        const size_t row_bytes = w * kGuardRowBytesPerPixel;
+        const std::vector<int> own = rows_owned(this, height);
+        send_.resize(own.size() * row_bytes);
+#pragma omp parallel for schedule(static)
+        for (size_t k = 0; k < own.size(); ++k) {
+            char* at = send_.data() + k * row_bytes;
+            const size_t first = state.row_start(own[k]);
+            at = std::copy_n(reinterpret_cast<const char*>(&px.radiance_sum[first]), w * sizeof(Color), at);
+            at = std::copy_n(reinterpret_cast<const char*>(&px.luminance_sq_sum[first]), w * sizeof(double), at);
+            std::copy_n(reinterpret_cast<const char*>(&px.sample_count[first]), w * sizeof(uint32_t), at);
+        }
+        MPI_Datatype row;
+        MPI_Type_contiguous(int(row_bytes), MPI_BYTE, &row);
+        MPI_Type_commit(&row);
+        const int before = (index() + count() - 1) % count(), after = (index() + 1) % count();
+        std::vector<int> neighbours = {before};
+        if (after != before) neighbours.push_back(after);
+        received_.resize(neighbours.size());
+        std::vector<MPI_Request> requests;
+        for (size_t n = 0; n < neighbours.size(); ++n) {
+            received_[n].resize(size_t(deal.rows_of(neighbours[n])) * row_bytes);
+            requests.emplace_back();
+            MPI_Irecv(received_[n].data(), deal.rows_of(neighbours[n]), row, neighbours[n], 0, MPI_COMM_WORLD,
+                      &requests.back());
+        }
+        for (int to : neighbours) {
+            requests.emplace_back();
+            MPI_Isend(send_.data(), int(own.size()), row, to, 0, MPI_COMM_WORLD, &requests.back());
+        }
+        MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
+        MPI_Type_free(&row);
+        for (size_t n = 0; n < neighbours.size(); ++n) {
+            const int rows = deal.rows_of(neighbours[n]);
+#pragma omp parallel for schedule(static)
+            for (int k = 0; k < rows; ++k) {
+                const int y = neighbours[n] + k * count();
+                if (!state.holds_row(y)) continue;  // the last row, where the neighbour owns it
+                const char* at = received_[n].data() + size_t(k) * row_bytes;
+                const size_t first = state.row_start(y);
+                std::copy_n(at, w * sizeof(Color), reinterpret_cast<char*>(&px.radiance_sum[first]));
+                at += w * sizeof(Color);
+                std::copy_n(at, w * sizeof(double), reinterpret_cast<char*>(&px.luminance_sq_sum[first]));
+                at += w * sizeof(double);
+                std::copy_n(at, w * sizeof(uint32_t), reinterpret_cast<char*>(&px.sample_count[first]));
+            }
+            cost_.received_bytes += double(received_[n].size());
+        }
+        cost_.combine_seconds += wall_seconds() - start;
+    }
+
+    std::vector<uint8_t> owned_rows_;  // 1 for this rank's rows
+    std::vector<char> send_;      // the guard rows' buffers, kept between passes
+    std::vector<std::vector<char>> received_;
+    double cpu_start_ = 0, pass_end_ = 0, combine_mark_ = 0;
     int passes_ = 0;
 };
 
@@ -222,14 +309,14 @@ int Cluster::any_flags(int flags) const {
 
 std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
     if (!mpi_) return {cost};
-    constexpr int kFields = 5;
-    const double mine[kFields] = {cost.busy_seconds, cost.combine_seconds, cost.between_seconds,
-                                  double(cost.exchanges), double(cost.rays)};
+    constexpr int kFields = 6;
+    const double mine[kFields] = {cost.busy_seconds,       cost.combine_seconds, cost.between_seconds,
+                                  double(cost.exchanges), double(cost.rays),    cost.received_bytes};
     std::vector<double> all(leader() ? kFields * size_t(size_) : 0);
     MPI_Gather(mine, kFields, MPI_DOUBLE, all.data(), kFields, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     std::vector<RankCost> costs;
     for (size_t r = 0; r < all.size(); r += kFields)
-        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4])});
+        costs.push_back({all[r], all[r + 1], all[r + 2], int(all[r + 3]), uint64_t(all[r + 4]), all[r + 5]});
     return costs;
 }
 
@@ -239,13 +326,17 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     if (!mpi_) return;
     const RowDeal deal{rank_, size_, state.width, state.height};
     std::vector<char> mine, gathered;
-    deal.exchange(state.buffers().radiance_sum, false, mine, gathered);
-    deal.exchange(state.buffers().radiance_compensation, false, mine, gathered);
-    deal.exchange(state.buffers().depth_sum, false, mine, gathered);
-    deal.exchange(state.buffers().luminance_sq_sum, false, mine, gathered);
-    deal.exchange(state.buffers().radiance_sq_sum, false, mine, gathered);
-    deal.exchange(state.buffers().sample_count, false, mine, gathered);
-    deal.exchange(state.buffers().sample_index, false, mine, gathered);
+    PixelBuffers& px = state.buffers();
+    deal.gather(state, px.radiance_sum, mine, gathered);
+    deal.gather(state, px.radiance_compensation, mine, gathered);
+    deal.gather(state, px.depth_sum, mine, gathered);
+    deal.gather(state, px.luminance_sq_sum, mine, gathered);
+    deal.gather(state, px.radiance_sq_sum, mine, gathered);
+    deal.gather(state, px.sample_count, mine, gathered);
+    deal.gather(state, px.sample_index, mine, gathered);
+    // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
+    if (!px.active.empty()) deal.gather(state, px.active, mine, gathered);
+    if (!px.sample_credit.empty()) deal.gather(state, px.sample_credit, mine, gathered);
     const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
     unsigned long long sum[2] = {0, 0};
     MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);
@@ -253,9 +344,40 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     nonfinite = sum[1];
 }
 
-std::unique_ptr<PassHooks> Cluster::deal_rows(bool always_combine) const {
+void Cluster::scatter_state(RenderState& state) const {
+    if (!mpi_) return;
+    const RowDeal deal{rank_, size_, state.width, state.height};
+    PixelBuffers& px = state.buffers();
+    // The counters and which optional buffers are in use, then each buffer.
+    long long counters[4] = {state.passes, (long long)state.nonfinite_samples, !px.active.empty(),
+                             !px.sample_credit.empty()};
+    MPI_Bcast(counters, 4, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    if (!leader()) {
+        state.passes = int(counters[0]);
+        state.nonfinite_samples = 0;  // counted once, at rank 0
+        state.rays = 0;
+        if (counters[2]) px.active.resize(px.sample_count.size());
+        if (counters[3]) px.sample_credit.resize(px.sample_count.size());
+    }
+    deal.scatter(px.radiance_sum);
+    deal.scatter(px.radiance_compensation);
+    deal.scatter(px.depth_sum);
+    deal.scatter(px.luminance_sq_sum);
+    deal.scatter(px.radiance_sq_sum);
+    deal.scatter(px.sample_count);
+    deal.scatter(px.sample_index);
+    if (counters[2]) deal.scatter(px.active);
+    if (counters[3]) deal.scatter(px.sample_credit);
+}
+
+std::vector<int> Cluster::held_rows(int height) const {
+    if (!mpi_ || leader()) return {};
+    return rows_guarded(rank_, size_, height);
+}
+
+std::unique_ptr<PassHooks> Cluster::deal_rows() const {
     if (!mpi_) return nullptr;
-    return std::make_unique<DealtRows>(rank_, size_, always_combine);
+    return std::make_unique<DealtRows>(rank_, size_);
 }
 
 RankCost Cluster::cost(const PassHooks& hooks) {

@@ -23,7 +23,9 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     rays = state.rays;
     nonfinite = state.nonfinite_samples;
 }
-std::unique_ptr<PassHooks> Cluster::deal_rows(bool) const { return nullptr; }
+std::vector<int> Cluster::held_rows(int) const { return {}; }
+void Cluster::scatter_state(RenderState&) const {}
+std::unique_ptr<PassHooks> Cluster::deal_rows() const { return nullptr; }
 RankCost Cluster::cost(const PassHooks&) { return {}; }
 
 }  // namespace kr

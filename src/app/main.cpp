@@ -179,11 +179,13 @@ bool write_checkpoint(const Cluster& cluster, const fs::path& path, const Checkp
 }
 
 // The per-rank line of the summary: busy time (CPU seconds in render_pass), its spread, each
-// rank's Mrays/s, the rows' exchange (the slowest rank's wall time in it, waiting included)
-// and the time between passes (planning, the noise rule: every rank does it for the image).
+// rank's Mrays/s, the exchange between passes (the slowest rank's wall time in it, waiting
+// included, and the most bytes a rank received) and the time between passes less the
+// exchange (planning and the noise rule, each rank on its own rows).
 void print_rank_costs(const std::vector<RankCost>& costs) {
-    double total = 0, slowest = 0, combine = 0, between = 0;
+    double total = 0, slowest = 0, combine = 0, between = 0, received = 0;
     for (const RankCost& c : costs) {
+        received = std::max(received, c.received_bytes);
         total += c.busy_seconds;
         slowest = std::max(slowest, c.busy_seconds);
         combine = std::max(combine, c.combine_seconds);
@@ -199,9 +201,9 @@ void print_rank_costs(const std::vector<RankCost>& costs) {
         speed += buf;
     }
     std::printf("  %zu ranks: busy s%s (slowest %+.1f%% of the mean); Mrays/s per busy s%s; exchange %.3f s "
-                "after %d passes; between passes %.3f s\n",
+                "and %.3f MB received after %d passes; between passes %.3f s\n",
                 costs.size(), busy.c_str(), mean > 0 ? 100 * (slowest / mean - 1) : 0.0, speed.c_str(), combine,
-                costs.front().exchanges, between);
+                received * 1e-6, costs.front().exchanges, between);
 }
 
 // One scene's render, in the order its steps run: load, check the outputs, check the memory,
@@ -317,14 +319,18 @@ private:
     bool check_memory() {
         const int width = scene_.renderer.width, height = scene_.renderer.height;
         image_ = std::to_string(width) + "x" + std::to_string(height) + " image";
-        const std::string shortfall =
-            memory_shortfall(render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off), "the render of a " + image_);
-        if (!shortfall.empty())  // every rank holds the whole state: each checks its own machine
+        // Rank 0 holds the whole state and writes the outputs; another rank holds its rows and
+        // their neighbours only. Each checks its own machine.
+        std::vector<int> held = cluster_.held_rows(height);
+        const uint64_t bytes = held.empty() ? render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off)
+                                            : render_state_bytes(width, held.size());
+        const std::string shortfall = memory_shortfall(bytes, "the render of a " + image_);
+        if (!shortfall.empty())
             std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
                          cluster_.distributed() ? (" on rank " + std::to_string(cluster_.rank())).c_str() : "");
         if (cluster_.any_flags(!shortfall.empty())) return false;
         stage_ = "the render state of a " + image_;
-        state_.reset(width, height);
+        state_.reset(width, height, std::move(held));
         show_progress_ = leader_ && !opt_.quiet && ::isatty(STDERR_FILENO);
         return true;
     }
@@ -338,30 +344,22 @@ private:
         key_ = checkpoint_key(loaded_.scene, scene_, settings_, rule_);
     }
 
-    // --resume: every rank decodes rank 0's bytes and so comes to the same verdict; rank 0
-    // says it.
+    // --resume: rank 0 reads and decodes the checkpoint and says its verdict; every other
+    // rank receives its rows of it.
     bool resume() {
         if (opt_.resume) {
             stage_ = "the checkpoint of a " + image_;
-            std::string bytes, error;
+            std::string error;
             if (leader_) try {
-                    bytes = read_checkpoint_file(*opt_.resume, key_);
+                    decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
                 } catch (const std::runtime_error& e) {
                     error = e.what();
                 }
-            if (error.empty()) {
-                cluster_.broadcast(bytes);
-                try {
-                    decode_checkpoint(bytes, *opt_.resume, key_, state_);
-                } catch (const std::runtime_error& e) {
-                    error = e.what();
-                }
-            }
             if (cluster_.broadcast(!error.empty())) {
                 if (leader_) std::fprintf(stderr, "error: --resume %s; nothing rendered\n", error.c_str());
                 return false;
             }
-            if (!leader_) state_.rays = state_.nonfinite_samples = 0;  // counted once, at rank 0
+            cluster_.scatter_state(state_);
         }
         rays_before_ = state_.rays;
         return true;
@@ -383,7 +381,11 @@ private:
                 std::fprintf(stderr, "note: %s: under MPI --denoise filters without the two halves of the samples "
                                      "(docs/denoising.md)\n", file_.c_str());
         }
-        hooks_ = cluster_.deal_rows(open_ended_);
+        hooks_ = cluster_.deal_rows();
+        const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
+        // The progress line's estimated error is added up from every rank's rows: every rank
+        // takes part where rank 0 shows it.
+        const bool estimate_error = cluster_.broadcast(show_progress_) && rule_.noise > 0;
         stage_ = "rendering a " + image_;
         StopReason reason = render_until(scene_, settings_, state_, rule_, [&](const RenderState& s) {
             if (opt_.checkpoint) {
@@ -397,9 +399,9 @@ private:
                 }
                 if (flags & 2) return false;
             }
+            const double noise = estimate_error ? s.relative_error(share) : 0;
             if (show_progress_ && elapsed() - last_draw > 0.1) {
                 // The bar goes towards the rule nearest to ending the render.
-                const double noise = rule_.noise > 0 ? s.relative_error() : 0;
                 const StopProgress progress = stop_progress(rule_, s.passes, elapsed(), noise);
                 char what[96];
                 if (open_ended_) std::snprintf(what, sizeof what, "%d passes", s.passes);

@@ -9,7 +9,7 @@ ProgressiveDriver::ProgressiveDriver(const RenderScene& scene, const RenderSetti
     : scene_(scene), settings_(settings), state_(state), hooks_(hooks) {
     if (state.passes > 0 && noise_check_due(rule, state.passes)) {
         noise_checked_ = rule.noise;
-        noise_met_ = noise_target_met(state, rule);
+        noise_met_ = noise_target_met(state, rule, hooks ? hooks->rows() : nullptr);
     }
 }
 
@@ -20,14 +20,15 @@ bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* canc
     }
     noise_checked_ = rule.noise;
     const auto start = std::chrono::steady_clock::now();
-    state_.plan_pass(settings_);
+    const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
+    state_.plan_pass(settings_, share);
     if (hooks_) hooks_->before_pass(state_);
     state_.begin_half_pass();
     if (!render_pass(scene_, settings_, state_, cancel)) return false;
     state_.end_half_pass();
     const bool noise_check = noise_check_due(rule, state_.passes);
     if (hooks_) hooks_->after_pass(state_, noise_check || plan_reads_statistics(settings_, state_));
-    if (noise_check) noise_met_ = noise_target_met(state_, rule);
+    if (noise_check) noise_met_ = noise_target_met(state_, rule, share);
     seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (hooks_) time_agreed_ = hooks_->any(rule.seconds > 0 && seconds_ >= rule.seconds);
     return true;

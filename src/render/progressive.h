@@ -24,12 +24,15 @@ public:
     virtual ~PassHooks() = default;
     // After plan_pass, before render_pass: narrows the pass to this process's pixels.
     virtual void before_pass(RenderState& state) = 0;
-    // After render_pass: undoes before_pass; when `statistics`, the next step reads the whole
-    // image's statistics (plan_pass, update_adaptive, relative_error), so every process must
-    // then hold every pixel's radiance_sum, luminance_sq_sum and sample_count.
+    // After render_pass: undoes before_pass; when `statistics`, the next step reads the
+    // statistics of this process's rows and their neighbours (plan_pass, update_adaptive), so
+    // the process must then hold those rows' radiance_sum, luminance_sq_sum and sample_count.
     virtual void after_pass(RenderState& state, bool statistics) = 0;
     // One stop decision for all processes: whether any of them says `stop` (e.g. --time).
     virtual bool any(bool stop) = 0;
+    // The rows this process plans and samples, and the exchange of the per-row sums that the
+    // plan, the noise rule and the estimated error add up (nullptr: every row, one process).
+    virtual const RowShare* rows() const { return nullptr; }
 };
 
 // The one driver of progressive passes (yocto-gl's trace_samples): each pass() plans the

@@ -78,17 +78,23 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     uint64_t rays = 0, nonfinite = 0;
     bool stopped = false;
     const bool sobol = settings.estimator == Estimator::sobol;
-    const size_t pixels = static_cast<size_t>(width) * static_cast<size_t>(height);
+    const size_t pixels = px.sample_count.size();  // the held rows' (RenderState::reset)
     if (sobol && (px.sobol_keys.size() != pixels || px.sobol_keys_seed != settings.seed)) {
         px.sobol_keys.resize(pixels);
         px.sobol_keys_seed = settings.seed;
-        const long n = long(pixels);
+        // Each key from the pixel's place in the image.
 #pragma omp parallel for schedule(static)
-        for (long i = 0; i < n; ++i) px.sobol_keys[size_t(i)] = Sampler::pixel_key(settings.seed, uint64_t(i));
+        for (int y = 0; y < height; ++y) {
+            if (!state.holds_row(y)) continue;
+            const size_t start = state.row_start(y), first = size_t(y) * size_t(width);
+            for (size_t x = 0; x < size_t(width); ++x)
+                px.sobol_keys[start + x] = Sampler::pixel_key(settings.seed, uint64_t(first + x));
+        }
     }
     const PixelSums pixel_sums{px.radiance_sum.data(), px.radiance_compensation.data(), px.depth_sum.data(),
                                px.luminance_sq_sum.data(), px.radiance_sq_sum.data(), px.sample_count.data()};
     const uint8_t* const pixel_active = px.active.empty() ? nullptr : px.active.data();
+    const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
     const uint8_t* const pixel_pass_samples = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
@@ -116,6 +122,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < h; ++y) {
+            if ((rows_active && !rows_active[y]) || !state.holds_row(y)) continue;
             if (stop && stop->load(std::memory_order_relaxed)) {
                 stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
                 continue;
@@ -132,29 +139,30 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
             // One sample into the batch. In a pass of one sample per pixel every pixel has the
             // same sample index, so its bit reversal is kept from the pixel before.
             uint32_t last_index = 0, last_reversed = 0;
-            const auto draw = [&](int x, size_t pixel) {
+            // `pixel`: the pixel's place in the buffers; `image_pixel`: in the image.
+            const auto draw = [&](int x, size_t pixel, size_t image_pixel) {
                 const uint32_t index = sample_index[pixel]++;
                 if (sobol) {
                     if (index != last_index) last_index = index, last_reversed = reverse_bits(index);
                     new (&slots[pending].sampler) Sampler(sobol_keys[pixel], index, last_reversed);
                 } else {
                     new (&slots[pending].sampler)
-                        Sampler(settings.estimator, settings.seed, pixel, index, settings.target_spp);
+                        Sampler(settings.estimator, settings.seed, image_pixel, index, settings.target_spp);
                 }
                 batch_x[pending] = x;
                 batch_y[pending] = y;
                 batch_pixels[pending] = pixel;
                 if (++pending == kSampleBatch) flush();
             };
-            const size_t row = static_cast<size_t>(y) * w;
+            const size_t row = state.row_start(y), image_row = static_cast<size_t>(y) * w;
             for (int x = 0; x < w; ++x) {
                 const size_t pixel = row + x;
                 if (active && !active[pixel]) continue;
                 if (!pass_samples) {
-                    draw(x, pixel);
+                    draw(x, pixel, image_row + x);
                     continue;
                 }
-                for (int k = 0; k < pass_samples[pixel]; ++k) draw(x, pixel);
+                for (int k = 0; k < pass_samples[pixel]; ++k) draw(x, pixel, image_row + x);
             }
             if (pending > 0) flush();
         }

@@ -8,10 +8,16 @@
 
 namespace kr {
 
-void RenderState::reset(int w, int h) {
+void RenderState::reset(int w, int h, std::vector<int> held) {
     width = w;
     height = h;
-    const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+    held_ = std::move(held);
+    slot_.clear();
+    if (!held_.empty()) {
+        slot_.assign(size_t(h), -1);
+        for (size_t k = 0; k < held_.size(); ++k) slot_[size_t(held_[k])] = int(k);
+    }
+    const size_t n = static_cast<size_t>(w) * (held_.empty() ? static_cast<size_t>(h) : held_.size());
     px_.radiance_sum.assign(n, Color());
     px_.radiance_compensation.assign(n, Color());
     px_.depth_sum.assign(n, 0.0);
@@ -23,6 +29,7 @@ void RenderState::reset(int w, int h) {
     rays = 0;
     nonfinite_samples = 0;
     px_.active.clear();
+    px_.active_rows.clear();
     px_.pass_samples.clear();
     px_.sample_credit.clear();
     for (auto& scratch : px_.allocation_scratch) scratch.clear();
@@ -116,29 +123,54 @@ double RenderState::pixel_standard_error(size_t i) const {
     return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
 }
 
-double RenderState::relative_error() const {
-    // Per-row sums in parallel, added in row order: the same estimate for any thread count.
-    // (The viewer shows it after every pass.)
-    const size_t w = size_t(width);
-    std::vector<double> row_error(size_t(height), 0.0), row_signal(size_t(height), 0.0);
-    std::vector<uint8_t> row_unknown(size_t(height), 0);
-#pragma omp parallel for schedule(static)
+std::vector<int> rows_owned(const RowShare* share, int height) {
+    std::vector<int> rows;
+    for (int y = share ? share->index() : 0; y < height; y += share ? share->count() : 1) rows.push_back(y);
+    return rows;
+}
+
+std::vector<int> rows_guarded(int index, int count, int height) {
+    std::vector<int> rows;
+    const auto owns = [&](int y) { return y >= 0 && y < height && y % count == index; };
     for (int y = 0; y < height; ++y)
-        for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+        if (owns(y) || owns(y - 1) || owns(y + 1)) rows.push_back(y);
+    return rows;
+}
+
+std::vector<int> rows_guarded(const RowShare* share, int height) {
+    return share ? rows_guarded(share->index(), share->count(), height) : rows_guarded(0, 1, height);
+}
+
+double RenderState::relative_error(const RowShare* share) const {
+    // Per-row sums in parallel, added in row order: the same estimate for any thread or
+    // process count. (The viewer shows it after every pass.) Per row: the error, the signal,
+    // and whether a pixel's error is unknown.
+    const size_t w = size_t(width);
+    const std::vector<int> own = rows_owned(share, height);
+    std::vector<double> rows(3 * size_t(height), 0.0);
+#pragma omp parallel for schedule(static)
+    for (size_t k = 0; k < own.size(); ++k) {
+        const size_t y = size_t(own[k]), start = row_start(own[k]);
+        double error = 0, signal = 0;
+        for (size_t i = start; i < start + w; ++i) {
             const double se = pixel_standard_error(i);
             if (!std::isfinite(se)) {
-                row_unknown[size_t(y)] = 1;
+                rows[3 * y + 2] = 1;
                 break;
             }
-            row_error[size_t(y)] += se * se;
+            error += se * se;
             const double mean = luminance(px_.radiance_sum[i]) / px_.sample_count[i];
-            row_signal[size_t(y)] += mean * mean;
+            signal += mean * mean;
         }
+        rows[3 * y] = error;
+        rows[3 * y + 1] = signal;
+    }
+    if (share) share->combine(rows, 3);
     double error_sq = 0, signal_sq = 0;
     for (size_t y = 0; y < size_t(height); ++y) {
-        if (row_unknown[y]) return kInfinity;
-        error_sq += row_error[y];
-        signal_sq += row_signal[y];
+        if (rows[3 * y + 2] != 0) return kInfinity;
+        error_sq += rows[3 * y];
+        signal_sq += rows[3 * y + 1];
     }
     if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
     return std::sqrt(error_sq / signal_sq);

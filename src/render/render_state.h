@@ -31,6 +31,9 @@ struct PixelBuffers {
     // The noise rule (update_adaptive): render_pass samples only pixels whose entry is 1
     // (empty: all of them).
     std::vector<uint8_t> active;
+    // Per row, whether render_pass samples it at all (empty: every row): a process's share of
+    // the rows, set around each pass by its PassHooks.
+    std::vector<uint8_t> active_rows;
     // Samples per pixel in the next pass, set by plan_pass (empty: one each).
     std::vector<uint8_t> pass_samples;
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
@@ -45,6 +48,34 @@ struct PixelBuffers {
     std::vector<Color> half_sum;
     std::vector<uint32_t> half_count;
 };
+
+// The rows of an image shared between processes (app/cluster.h deals them through the
+// driver's PassHooks). This process owns the rows y with y mod count == index: it samples and
+// plans them, and holds the statistics of their neighbours too (the 3x3 guard reads them).
+// The image-wide sums (of the plan, the noise rule, the estimated error) are taken per row,
+// made known to every process by combine() and added in row order by each: the same plan and
+// verdicts, bit for bit, as one process that owns every row (no RowShare).
+class RowShare {
+public:
+    RowShare(int index, int count) : index_(index), count_(count) {}
+    virtual ~RowShare() = default;
+    int index() const { return index_; }
+    int count() const { return count_; }
+    bool owns(int y) const { return y % count_ == index_; }
+    // `values` holds `fields` numbers per row, rows in order, this process's own rows filled
+    // in: replaces every other row's with the numbers of the process that owns it.
+    virtual void combine(std::vector<double>& values, int fields) const = 0;
+
+private:
+    int index_, count_;
+};
+
+// The rows `share` gives this process, in order (every row without a share), and those its
+// 3x3 guard reads: its own and their neighbours.
+std::vector<int> rows_owned(const RowShare* share, int height);
+std::vector<int> rows_guarded(const RowShare* share, int height);
+// Those of process `index` of `count`.
+std::vector<int> rows_guarded(int index, int count, int height);
 
 class RenderState {
 public:
@@ -70,35 +101,50 @@ public:
 
     RenderState() = default;
     RenderState(int w, int h) { reset(w, h); }
-    void reset(int w, int h);
+    // A w x h render's state holding the image rows `held` (in order; empty: every row). A
+    // process of a shared render holds its own rows and their neighbours (rows_guarded): its
+    // buffers have those rows only, each pixel's sums at row_start(y) + x.
+    void reset(int w, int h, std::vector<int> held = {});
+    const std::vector<int>& held_rows() const { return held_; }
+    bool holds_row(int y) const { return held_.empty() || slot_[size_t(y)] >= 0; }
+    // Where the buffers hold pixel (0, y) of a held row.
+    size_t row_start(int y) const { return size_t(held_.empty() ? y : slot_[size_t(y)]) * size_t(width); }
+
+    // The images and the halves below read a state that holds every row.
     Image radiance() const;                  // per-pixel mean radiance (compensated sums)
     std::vector<double> mean_depth() const;  // per-pixel mean primary distance
     // Per pixel and channel, the variance of the mean radiance: the unbiased sample variance
     // over the count (infinite below two samples). What `keithray compare --statistical` tests.
     std::vector<Color> variance_of_mean() const;
 
-    // Unbiased variance of one sample's luminance in pixel `i` (infinite below two samples).
+    // Unbiased variance of one sample's luminance in the buffers' pixel `i` (infinite below
+    // two samples).
     double sample_variance(size_t i) const;
     // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
     // two samples).
     double pixel_standard_error(size_t i) const;
     // Estimated relative RMS error of the whole image: sqrt(sum of per-pixel variances of the
     // mean) / sqrt(sum of squared mean luminances). Infinite before two samples per pixel.
-    double relative_error() const;
+    // With `share`, every process calls it after the same pass and gets the same estimate.
+    double relative_error(const RowShare* share = nullptr) const;
 
     // Adaptive sampling towards an image relative error `target` (as relative_error()): a
     // pixel stays active while the variance of its mean exceeds an equal share of the allowed
     // total, target^2 * sum(mean^2) / pixels, or it has fewer than `min_samples` samples.
-    // When no pixel is active the image meets the target. Returns the active count.
-    size_t update_adaptive(double target, uint32_t min_samples = 16);
+    // When no pixel is active the image meets the target. Returns the active count. With
+    // `share`, the mask is set on this process's rows (from their and their neighbours'
+    // statistics) and the count is the image's.
+    size_t update_adaptive(double target, uint32_t min_samples = 16, const RowShare* share = nullptr);
 
     // Plans the next pass for `settings.allocation` (fills pass_samples). Adaptive: after
     // kAllocationWarmup passes, each active pixel's share of the pass (as many samples as
     // active pixels) is proportional to its estimated standard deviation (3x3 guarded, as
     // update_adaptive) plus a floor, which minimises the summed variance of the pixel means
     // for the budget; fractions carry over between passes. Parallel over rows, with the rows'
-    // sums added in order: the plan does not depend on threads.
-    void plan_pass(const RenderSettings& settings);
+    // sums added in order: the plan does not depend on threads. With `share`, only this
+    // process's rows are planned (their pass_samples and sample_credit), from their and their
+    // neighbours' statistics and the image's sums.
+    void plan_pass(const RenderSettings& settings, const RowShare* share = nullptr);
 
     // Samples every pixel again (no adaptive mask).
     void clear_adaptive() { px_.active.clear(); }
@@ -125,6 +171,8 @@ public:
 private:
     void add_sums_to_half(int sign);
     PixelBuffers px_;
+    std::vector<int> held_;  // the rows held (empty: all)
+    std::vector<int> slot_;  // per image row, its place among held_ (-1: not held); empty with held_
 };
 
 // The bytes per pixel a RenderState holds once every buffer is in use: the seven sums and
@@ -141,6 +189,16 @@ inline constexpr uint64_t kRenderStateBytesPerPixel =
 // A denoised render adds its halves (render_state), its feature buffers and the denoiser's
 // working images (render/denoise.h: kDenoiseBytesPerPixel).
 uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised = false);
+// The three sums of a pixel that the 3x3 guard reads (radiance_sum, luminance_sq_sum,
+// sample_count): what a process of a shared render sends its neighbours of its rows.
+inline constexpr uint64_t kGuardRowBytesPerPixel = sizeof(Color) + sizeof(double) + sizeof(uint32_t);
+
+// The memory of a process of a shared render that holds `rows` rows of `width` pixels and
+// writes nothing (RenderState::reset's held rows): their state, and the buffers in which it
+// sends its own rows' guard sums and receives its neighbours'.
+inline uint64_t render_state_bytes(int width, size_t rows) {
+    return uint64_t(width) * uint64_t(rows) * (kRenderStateBytesPerPixel + kGuardRowBytesPerPixel);
+}
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
 inline constexpr double kAllocationFloor = 0.25;   // every pixel's share is at least this x mean

@@ -8,9 +8,9 @@ bool noise_check_due(const StopRule& rule, int passes) {
     return rule.noise > 0 && passes >= int(rule.min_samples) && passes % rule.adapt_every == 0;
 }
 
-bool noise_target_met(RenderState& state, const StopRule& rule) {
+bool noise_target_met(RenderState& state, const StopRule& rule, const RowShare* share) {
     // Every pixel within its share means the whole image is within the target too.
-    return state.relative_error() <= rule.noise || state.update_adaptive(rule.noise, rule.min_samples) == 0;
+    return state.relative_error(share) <= rule.noise || state.update_adaptive(rule.noise, rule.min_samples, share) == 0;
 }
 
 StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise) {

@@ -39,8 +39,9 @@ inline constexpr EnumNames<StopReason, 4> stop_reason_names{{"spp", "time", "noi
 // passes (the adaptive mask is updated at the same checks).
 bool noise_check_due(const StopRule& rule, int passes);
 // The check itself: true when the image's estimated relative error is within the target, or
-// no pixel is above its share of it; otherwise updates `state`'s adaptive mask.
-bool noise_target_met(RenderState& state, const StopRule& rule);
+// no pixel is above its share of it; otherwise updates `state`'s adaptive mask (with
+// `share`: on this process's rows, every process calling it after the same pass).
+bool noise_target_met(RenderState& state, const StopRule& rule, const RowShare* share = nullptr);
 
 // Where a render stands against its StopRule, for a progress bar and its ETA.
 struct StopProgress {
