@@ -288,6 +288,33 @@ TEST(Denoise, ConvergedImageIsLeftAsItIs) {
     }
 }
 
+// A Whitted render's anti-aliasing error falls about as 1/spp, and both filters only soften
+// its edges past the first passes (docs/denoising.md): the display's filter smooths its first
+// pass and leaves it raw from kWhittedRawSpp on; the final filter always leaves it raw.
+TEST(Denoise, WhittedRenderIsRawPastItsFirstPasses) {
+    const Scene scene = test::brief_scene(1, 32);
+    ASSERT_EQ(scene.renderer.type, RendererType::wrt);
+    const RenderScene rs = prepare_scene(scene);
+    const RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    auto changed_pixels = [&](int passes, bool interactive) {
+        RenderState state(32, 32);
+        StopRule rule;
+        rule.max_passes = passes;
+        render_until(rs, settings, state, rule);
+        DevelopOptions options;
+        options.denoise = Denoise::on;
+        options.interactive = interactive;
+        options.sampling = settings;
+        const Developed d = develop(rs, render_estimates(state, kLayerRadiance | develop_reads(options)), options, kLayerRadiance);
+        int changed = 0;
+        for (size_t i = 0; i < d.radiance.pixels.size(); ++i) changed += d.radiance.pixels[i] != d.raw.pixels[i];
+        return changed;
+    };
+    EXPECT_GT(changed_pixels(1, true), 0);                              // the first pass is smoothed
+    EXPECT_EQ(changed_pixels(int(kWhittedRawSpp), true), 0);            // then raw, bit for bit
+    EXPECT_EQ(changed_pixels(1, false), 0);                             // the final filter: raw
+}
+
 TEST(Denoise, FeatureBuffersAverageTheCameraSamples) {
     // Scene 3 at 24x24: the averaged albedo lies between the centre ray's on edge pixels, and
     // equals it on flat ones; normals are unit inside surfaces, shorter nowhere else than at

@@ -24,6 +24,14 @@ unsigned layers_for(const OutputRequest& request) {
     return request.develop.blur > 0 ? layers & ~unsigned(kLayerVariance) : layers;
 }
 
+// The mean samples per pixel (1 where the estimates carry no counts: a preview).
+double mean_samples(const std::vector<uint32_t>& samples) {
+    if (samples.empty()) return 1;
+    double sum = 0;
+    for (const uint32_t n : samples) sum += n;
+    return sum / double(samples.size());
+}
+
 }  // namespace
 
 RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
@@ -46,7 +54,10 @@ void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, i
 }
 
 unsigned develop_reads(const DevelopOptions& options) {
-    return options.denoise != Denoise::off ? unsigned(kLayerDepth | kLayerVariance) : 0u;
+    if (options.denoise == Denoise::off) return 0;
+    // The interactive filter leaves a Whitted render raw past its first passes: it counts them.
+    const bool counts = options.interactive && options.sampling.integrator == Integrator::wrt;
+    return unsigned(kLayerDepth | kLayerVariance) | (counts ? unsigned(kLayerSamples) : 0u);
 }
 
 Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,
@@ -69,11 +80,15 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
                 input.half[h] = &estimates.halves.mean[h];
                 input.half_count[h] = estimates.halves.count[h];
             }
-        // A Whitted render's only noise is the pixel's anti-aliasing: the final filter would
-        // only soften its edges (docs/denoising.md), so it keeps the raw image.
-        Image denoised = options.interactive ? denoise_atrous(input, {}, options.workspace)
-                         : options.sampling.integrator == Integrator::wrt ? out.radiance
-                                                                          : denoise_nlmeans(input, {}, options.workspace);
+        // A Whitted render's only noise is the pixel's anti-aliasing, whose error falls about
+        // as 1/spp: the final filter would only soften its edges (docs/denoising.md), and the
+        // interactive one helps only its first passes, so both keep the raw image from
+        // kWhittedRawSpp samples per pixel on.
+        const bool whitted_raw = options.sampling.integrator == Integrator::wrt &&
+                                 (!options.interactive || mean_samples(estimates.samples) >= kWhittedRawSpp);
+        Image denoised = whitted_raw            ? out.radiance
+                         : options.interactive ? denoise_atrous(input, {}, options.workspace)
+                                               : denoise_nlmeans(input, {}, options.workspace);
         out.raw = std::exchange(out.radiance, std::move(denoised));
         // An output with first-surface layers keeps the feature buffers the denoiser read.
         if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);

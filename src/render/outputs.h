@@ -57,6 +57,8 @@ struct DevelopOptions {
 };
 // The feature buffers' camera samples per pixel (render/aov.h averaged_surface_layers).
 inline constexpr int kFeatureSamples = 8;
+// A Whitted render is denoised (by the interactive filter only) below this mean spp.
+inline constexpr double kWhittedRawSpp = 4;
 // The denoiser's feature buffers of a width x height render with `sampling`'s camera
 // samples: albedo and normal, 3 floats per pixel, as develop makes them (the viewer's
 // albedo and normal views show them).

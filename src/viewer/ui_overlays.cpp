@@ -99,8 +99,8 @@ void draw_status_bar(PanelContext& ctx) {
     // A fixed width, so the figure after it never runs into it. With a render region, the
     // region's own samples and noise instead (the whole image's in the tooltip): the spp and
     // the stop rules count the whole image.
-    const std::optional<RegionStatus> region =
-        ctx.ui.region && current ? region_status(*current, *ctx.ui.region) : std::nullopt;
+    std::optional<RegionStatus> region;
+    if (ctx.ui.region && current) region = region_status(*current, *ctx.ui.region);
     const std::string noise = st.noise >= 0 ? "noise " + format_noise(st.noise) : "noise: needs 2 spp";
     if (region) {
         const std::string region_noise = region->noise >= 0 ? format_noise(region->noise) : "needs 2 spp";
