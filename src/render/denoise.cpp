@@ -468,7 +468,8 @@ void nlm_filter(const NlmParams& params, float k, Planes& p) {
 #pragma omp for schedule(static)
                 for (int y = y0; y < y1; ++y) {
                     const size_t row = size_t(y) * size_t(w);
-                    const size_t qrow = size_t(ptrdiff_t(row) + off);
+                    // Signed: q's row start lies before the plane's first pixel where x0 > 0.
+                    const ptrdiff_t qrow = ptrdiff_t(row) + off;
                     const float *f0 = p.f[0].data() + row, *f1 = p.f[1].data() + row, *f2 = p.f[2].data() + row,
                                 *f3 = p.f[3].data() + row, *q0 = p.f[0].data() + qrow, *q1 = p.f[1].data() + qrow,
                                 *q2 = p.f[2].data() + qrow, *q3 = p.f[3].data() + qrow;
