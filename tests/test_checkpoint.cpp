@@ -353,6 +353,38 @@ TEST_F(CheckpointCli, SecondSignalDuringACheckpointWriteLeavesTheOldOneWhole) {
     EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
 }
 
+// --denoise: the checkpoint holds the final denoiser's two halves of the samples, so the
+// resumed render's denoised image is the uninterrupted one's, float for float; a checkpoint
+// without them (rendered without --denoise) is refused with --denoise, one line.
+TEST_F(CheckpointCli, DenoisedRenderResumesToTheWholeRendersBytes) {
+    const fs::path scene = small_scene(12);
+    const std::string common = "render '" + scene.string() + "' --spp 40 --denoise -q --threads 1 ";
+    ASSERT_EQ(cli_here(common + "-o whole.pfm").status, 0);
+    int status = 0;
+    const pid_t child = start_stopped_in_write(dir, common + "-o cut.pfm --checkpoint r.ckpt --every 0", "r.ckpt:2", status);
+    ASSERT_GT(child, 0) << "ended before its second checkpoint: " << status << test::read_file(dir / "err.txt");
+    status = signal_and_wait(child, {SIGTERM});
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status << test::read_file(dir / "err.txt");
+    ASSERT_FALSE(fs::exists(dir / "cut.pfm"));
+    const test::CommandResult resumed = cli_here(common + "-o cut.pfm --resume r.ckpt");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(resumed.err, "");
+    EXPECT_EQ(test::read_file(dir / "cut.pfm"), test::read_file(dir / "whole.pfm"));
+
+    const std::string plain = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
+    const pid_t raw = start_stopped_in_write(dir, plain + "-o raw.pfm --checkpoint raw.ckpt --every 0", "raw.ckpt:2", status);
+    ASSERT_GT(raw, 0) << status << test::read_file(dir / "err.txt");
+    status = signal_and_wait(raw, {SIGTERM});
+    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status;
+    const test::CommandResult refused = cli_here(common + "-o other.pfm --resume raw.ckpt");
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_EQ(refused.err, "error: --resume raw.ckpt: checkpoint of a render without --denoise (or under MPI): "
+                           "it lacks the two halves of the samples that --denoise reads; nothing rendered\n");
+    EXPECT_FALSE(fs::exists(dir / "other.pfm"));
+    // Without --denoise it goes on as before.
+    EXPECT_EQ(cli_here(plain + "-o raw.pfm --resume raw.ckpt").status, 0);
+}
+
 // The image is written after checkpoints were: a signal inside that write still finds the
 // cleanup handler (the render's stop handling ended with its passes): no temporary, the old
 // image untouched, the checkpoint whole, the process ended by the signal.
