@@ -358,25 +358,26 @@ TEST_F(CheckpointCli, SecondSignalDuringACheckpointWriteLeavesTheOldOneWhole) {
 // without them (rendered without --denoise) is refused with --denoise, one line.
 TEST_F(CheckpointCli, DenoisedRenderResumesToTheWholeRendersBytes) {
     const fs::path scene = small_scene(12);
-    const std::string common = "render '" + scene.string() + "' --spp 40 --denoise -q --threads 1 ";
-    ASSERT_EQ(cli_here(common + "-o whole.pfm").status, 0);
-    int status = 0;
-    const pid_t child = start_stopped_in_write(dir, common + "-o cut.pfm --checkpoint r.ckpt --every 0", "r.ckpt:2", status);
-    ASSERT_GT(child, 0) << "ended before its second checkpoint: " << status << test::read_file(dir / "err.txt");
-    status = signal_and_wait(child, {SIGTERM});
-    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status << test::read_file(dir / "err.txt");
+    const std::string plain = "render '" + scene.string() + "' --spp 40 -q --threads 1 ", denoised = plain + "--denoise ";
+    // The render of `args` stopped by SIGTERM during its second checkpoint's write.
+    auto stop_at_second_checkpoint = [&](const std::string& args, const std::string& checkpoint) {
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, args + " --checkpoint " + checkpoint + " --every 0",
+                                                   checkpoint + ":2", status);
+        ASSERT_GT(child, 0) << status << test::read_file(dir / "err.txt");
+        status = signal_and_wait(child, {SIGTERM});
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status << test::read_file(dir / "err.txt");
+    };
+    ASSERT_EQ(cli_here(denoised + "-o whole.pfm").status, 0);
+    stop_at_second_checkpoint(denoised + "-o cut.pfm", "r.ckpt");
     ASSERT_FALSE(fs::exists(dir / "cut.pfm"));
-    const test::CommandResult resumed = cli_here(common + "-o cut.pfm --resume r.ckpt");
+    const test::CommandResult resumed = cli_here(denoised + "-o cut.pfm --resume r.ckpt");
     ASSERT_EQ(resumed.status, 0) << resumed.err;
     EXPECT_EQ(resumed.err, "");
     EXPECT_EQ(test::read_file(dir / "cut.pfm"), test::read_file(dir / "whole.pfm"));
 
-    const std::string plain = "render '" + scene.string() + "' --spp 40 -q --threads 1 ";
-    const pid_t raw = start_stopped_in_write(dir, plain + "-o raw.pfm --checkpoint raw.ckpt --every 0", "raw.ckpt:2", status);
-    ASSERT_GT(raw, 0) << status << test::read_file(dir / "err.txt");
-    status = signal_and_wait(raw, {SIGTERM});
-    ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status;
-    const test::CommandResult refused = cli_here(common + "-o other.pfm --resume raw.ckpt");
+    stop_at_second_checkpoint(plain + "-o raw.pfm", "raw.ckpt");
+    const test::CommandResult refused = cli_here(denoised + "-o other.pfm --resume raw.ckpt");
     EXPECT_EQ(refused.status, 1);
     EXPECT_EQ(refused.err, "error: --resume raw.ckpt: checkpoint of a render without --denoise (or under MPI): "
                            "it lacks the two halves of the samples that --denoise reads; nothing rendered\n");
