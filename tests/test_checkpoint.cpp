@@ -353,6 +353,39 @@ TEST_F(CheckpointCli, SecondSignalDuringACheckpointWriteLeavesTheOldOneWhole) {
     EXPECT_EQ(test::read_file(dir / "cut.ppm"), test::read_file(dir / "whole.ppm"));
 }
 
+// --denoise: the checkpoint holds the final denoiser's two halves of the samples, so the
+// resumed render's denoised image is the uninterrupted one's, float for float; a checkpoint
+// without them (rendered without --denoise) is refused with --denoise, one line.
+TEST_F(CheckpointCli, DenoisedRenderResumesToTheWholeRendersBytes) {
+    const fs::path scene = small_scene(12);
+    const std::string plain = "render '" + scene.string() + "' --spp 40 -q --threads 1 ", denoised = plain + "--denoise ";
+    // The render of `args` stopped by SIGTERM during its second checkpoint's write.
+    auto stop_at_second_checkpoint = [&](const std::string& args, const std::string& checkpoint) {
+        int status = 0;
+        const pid_t child = start_stopped_in_write(dir, args + " --checkpoint " + checkpoint + " --every 0",
+                                                   checkpoint + ":2", status);
+        ASSERT_GT(child, 0) << status << test::read_file(dir / "err.txt");
+        status = signal_and_wait(child, {SIGTERM});
+        ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM) << status << test::read_file(dir / "err.txt");
+    };
+    ASSERT_EQ(cli_here(denoised + "-o whole.pfm").status, 0);
+    stop_at_second_checkpoint(denoised + "-o cut.pfm", "r.ckpt");
+    ASSERT_FALSE(fs::exists(dir / "cut.pfm"));
+    const test::CommandResult resumed = cli_here(denoised + "-o cut.pfm --resume r.ckpt");
+    ASSERT_EQ(resumed.status, 0) << resumed.err;
+    EXPECT_EQ(resumed.err, "");
+    EXPECT_EQ(test::read_file(dir / "cut.pfm"), test::read_file(dir / "whole.pfm"));
+
+    stop_at_second_checkpoint(plain + "-o raw.pfm", "raw.ckpt");
+    const test::CommandResult refused = cli_here(denoised + "-o other.pfm --resume raw.ckpt");
+    EXPECT_EQ(refused.status, 1);
+    EXPECT_EQ(refused.err, "error: --resume raw.ckpt: checkpoint of a render without --denoise (or under MPI): "
+                           "it lacks the two halves of the samples that --denoise reads; nothing rendered\n");
+    EXPECT_FALSE(fs::exists(dir / "other.pfm"));
+    // Without --denoise it goes on as before.
+    EXPECT_EQ(cli_here(plain + "-o raw.pfm --resume raw.ckpt").status, 0);
+}
+
 // The image is written after checkpoints were: a signal inside that write still finds the
 // cleanup handler (the render's stop handling ended with its passes): no temporary, the old
 // image untouched, the checkpoint whole, the process ended by the signal.

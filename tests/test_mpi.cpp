@@ -121,6 +121,24 @@ TEST_F(Mpi, SameBytesWhereARankOwnsOneRowOrNone) {
     }
 }
 
+// A checkpoint of an image with fewer rows than ranks (1 and 2 rows at 4 ranks) resumes:
+// a rank without rows receives none of rank 0's rows, where it waited for them for ever.
+TEST_F(Mpi, ResumeWhereARankOwnsNoRow) {
+    for (int height : {1, 2}) {
+        SCOPED_TRACE(height);
+        const std::string s = scene(6, 7, "rows" + std::to_string(height) + ".json", "out.ppm", height);
+        const std::string args = "render -q " + s + " --spp 6 --every 0 ";
+        const test::CommandResult single = here(keithray() + args + "--threads 2 -o single.ppm --checkpoint r.ckpt");
+        ASSERT_EQ(single.status, 0) << single.err;
+        for (int ranks : {2, 4}) {
+            SCOPED_TRACE(ranks);
+            const test::CommandResult r = here(mpirun(ranks) + args + "-o resumed.ppm --resume r.ckpt");
+            ASSERT_EQ(r.status, 0) << r.err;
+            EXPECT_EQ(bytes("resumed.ppm"), bytes("single.ppm"));
+        }
+    }
+}
+
 // The checkpoint after the last pass of a render under the noise rule (its mask, set at pass
 // 28, and the plan's carried fractions, both planned by each rank on its own rows) is the one
 // process's file, byte for byte, at 2 to 4 ranks.

@@ -125,8 +125,10 @@ struct RowDeal {
                     sent.insert(sent.end(), field.begin() + ptrdiff_t(y) * width, field.begin() + ptrdiff_t(y + 1) * width);
         }
         const std::vector<int> mpi_counts = as.counts(counts), mpi_offsets = as.counts(offsets);
+        // A rank receives what is sent to it: none for one without rows (an image with fewer
+        // rows than ranks), whose state holds every row, or it waits for ever.
         MPI_Scatterv(sent.data(), mpi_counts.data(), mpi_offsets.data(), as.type(), rank == 0 ? MPI_IN_PLACE : field.data(),
-                     as.count(rank == 0 ? 0 : field.size()), as.type(), 0, MPI_COMM_WORLD);
+                     as.count(rank == 0 ? 0 : size_t(counts[size_t(rank)])), as.type(), 0, MPI_COMM_WORLD);
     }
 };
 

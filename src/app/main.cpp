@@ -352,6 +352,15 @@ private:
             std::string error;
             if (leader_) try {
                     decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
+                    // The final denoiser reads the halves of every sample: without them in the
+                    // checkpoint it would not make the uninterrupted render's image.
+                    if (denoise() != Denoise::off && !cluster_.distributed() && !state_.tracks_halves() &&
+                        state_.passes > 0)
+                        error = show_user_text(opt_.resume->string()) +
+                                ": checkpoint of a render without --denoise (or under MPI): it lacks the two halves "
+                                "of the samples that --denoise reads";
+                    // Under MPI the halves are not kept (render()): stale ones would be written on.
+                    if (cluster_.distributed()) state_.untrack_halves();
                 } catch (const std::runtime_error& e) {
                     error = e.what();
                 }
@@ -373,11 +382,12 @@ private:
         auto last_checkpoint = std::chrono::steady_clock::now();
         double last_draw = -1;
         StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
-        // The final denoiser's two halves of the samples, from here on (a checkpoint does not
-        // hold them); under MPI they are not gathered, and it filters without them.
+        // The final denoiser's two halves of the samples, from here on or from the checkpoint
+        // resumed; under MPI they are not gathered, and it filters without them.
         if (denoise() != Denoise::off) {
-            if (!cluster_.distributed()) state_.track_halves();
-            else if (leader_)
+            if (!cluster_.distributed()) {
+                if (!state_.tracks_halves()) state_.track_halves();
+            } else if (leader_)
                 std::fprintf(stderr, "note: %s: under MPI --denoise filters without the two halves of the samples "
                                      "(docs/denoising.md)\n", file_.c_str());
         }

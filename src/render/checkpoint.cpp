@@ -123,9 +123,10 @@ CheckpointKey checkpoint_key(const Scene& scene, const RenderScene& prepared, co
 std::string read_checkpoint_file(const std::filesystem::path& file, const CheckpointKey& expected) {
     const std::string where = show_user_text(file.string());
     const uint64_t pixels = uint64_t(expected.width) * uint64_t(expected.height);
-    // Header, key (bounded generously), sums and counts, the mask and the fractions, checksum.
+    // Header, key (bounded generously), sums and counts, the mask and the fractions, the
+    // halves, checksum.
     const uint64_t largest = kMagic.size() + 1024 + expected.settings.size() +
-                             pixels * (3 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 1 + sizeof(float));
+                             pixels * (4 * sizeof(Color) + 2 * sizeof(double) + 3 * sizeof(uint32_t) + 1 + sizeof(float));
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
         throw std::runtime_error(where + ": cannot read the checkpoint: " +
@@ -164,6 +165,12 @@ std::string encode_checkpoint(const CheckpointKey& key, const RenderState& state
     w.put_all(state.active());
     w.put(uint8_t(!state.sample_credit().empty()));
     w.put_all(state.sample_credit());
+    // The final denoiser's two halves (a render with --denoise): resumed, it reads the same ones.
+    w.put(uint8_t(state.tracks_halves()));
+    if (state.tracks_halves()) {
+        w.put_all(state.buffers().half_sum);
+        w.put_all(state.buffers().half_count);
+    }
     w.put(fnv1a(w.bytes));
     return std::move(w.bytes);
 }
@@ -209,6 +216,10 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     r.get_all(px.sample_index, n);
     if (r.get<uint8_t>()) r.get_all(px.active, n);
     if (r.get<uint8_t>()) r.get_all(px.sample_credit, n);
+    if (r.get<uint8_t>()) {
+        r.get_all(px.half_sum, n);
+        r.get_all(px.half_count, n);
+    }
     if (r.left() != sizeof(uint64_t) || restored.passes < 0) refuse("checkpoint damaged (unexpected layout)");
     state = std::move(restored);
 }

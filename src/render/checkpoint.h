@@ -23,7 +23,7 @@
 
 namespace kr {
 
-inline constexpr uint32_t kCheckpointVersion = 2;
+inline constexpr uint32_t kCheckpointVersion = 3;
 
 // What a checkpoint must match to be resumed: the scene (a fingerprint of its canonical JSON
 // without the output path and display block, which do not change the samples), the settings
