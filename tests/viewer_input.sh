@@ -276,6 +276,9 @@ region)
     xdotool mousemove --window "$wid" $x0 $y0
     wait_for "pointer=$x0,$y0" || exit 1
     xdotool mousedown 1
+    # A frame has seen the press where it was before the pointer moves on (the box starts
+    # at the press as that frame reads it).
+    wait_for 'draft=[0-9]' || exit 1
     xdotool mousemove --window "$wid" $((x0 + 50)) $((y0 + 30))
     wait_for "pointer=$((x0 + 50)),$((y0 + 30))" || exit 1
     xdotool mousemove --window "$wid" $x1 $y1

@@ -259,6 +259,11 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // region: the render region's image pixels x0,y0,x1,y1 ("none": the whole image).
     char region[64] = "none";
     if (ui_.region) std::snprintf(region, sizeof region, "%d,%d,%d,%d", ui_.region->x0, ui_.region->y0, ui_.region->x1, ui_.region->y1);
+    // draft: the region box being drawn (B, then a left drag), as region ("none").
+    char draft[64] = "none";
+    if (ui_.region_draft)
+        std::snprintf(draft, sizeof draft, "%d,%d,%d,%d", ui_.region_draft->x0, ui_.region_draft->y0, ui_.region_draft->x1,
+                      ui_.region_draft->y1);
     // feature: the feature view's readout of the pixel under the pointer, spaces as '_' ("none").
     std::string feature = tool.hover_feature.empty() ? "none" : tool.hover_feature.substr(0, 80);
     std::replace(feature.begin(), feature.end(), ' ', '_');
@@ -266,7 +271,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
                   "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
-                  "feature=%s\n",
+                  "feature=%s draft=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
@@ -274,7 +279,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
-                  feature.c_str());
+                  feature.c_str(), draft);
     if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
