@@ -39,6 +39,17 @@ using ViewRun = kr::test::CommandResult;
 
 bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
 
+// xvfb-run with a screen big enough for the 512x512 image at 1:1 beside the panels.
+// -noreset: a resetting Xvfb signals xvfb-run again after the last client leaves, and if that
+// lands during xvfb-run's clean-up it exits 5 instead of keithray's status. -a searches for a
+// free display from -n: a start of its own per process and call, so that two tests starting
+// together (ctest -j) do not both take the first free number.
+std::string xvfb_run() {
+    static int calls = 0;
+    const int start = 100 + int((unsigned(::getpid()) * 97u + unsigned(calls++) * 13u) % 20000u);
+    return "xvfb-run -a -n " + std::to_string(start) + " -s '-screen 0 1280x1024x24 -noreset' ";
+}
+
 int max_channel_difference(const kr::Rgb8Image& a, const kr::Rgb8Image& b) {
     int worst = 0;
     for (size_t i = 0; i < a.bytes.size(); ++i) worst = std::max(worst, std::abs(int(a.bytes[i]) - int(b.bytes[i])));
@@ -66,10 +77,7 @@ protected:
         // The window's pixels are compared with raw headless renders: the denoised display
         // (the viewer's default) is asked for by the tests about it, by name.
         if (args.rfind("view ", 0) == 0 && args.find("--denoise") == std::string::npos) args += " --denoise off";
-        // A screen big enough for the 512x512 image at 1:1 beside the panels.
-        // -noreset: a resetting Xvfb signals xvfb-run again after the last client leaves, and
-        // if that lands during xvfb-run's clean-up it exits 5 instead of keithray's status.
-        const std::string prefix = window ? "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' " : "";
+        const std::string prefix = window ? xvfb_run() : "";
         return kr::test::run_command(prefix + "'" + KEITHRAY_EXE + "' " + args, dir);
     }
     // `keithray view` of brief scene n for `spp` passes with `flags`, in a window, then the
@@ -332,7 +340,7 @@ std::map<std::string, std::string> drive(const fs::path& dir, const std::string&
     const std::string script = (fs::path(KEITHRAY_RES_DIR) / ".." / "tests" / "viewer_input.sh").string();
     const fs::path file = scene_file.empty() ? kr::test::brief_scene_file(scene_number) : scene_file;
     const kr::test::CommandResult r = kr::test::run_command(
-        "xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' bash '" + script + "' " + scenario + " '" + KEITHRAY_EXE +
+        xvfb_run() + "bash '" + script + "' " + scenario + " '" + KEITHRAY_EXE +
             "' '" + file.string() + "' '" + dir.string() + "'",
         dir);
     std::map<std::string, std::string> out;
