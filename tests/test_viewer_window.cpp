@@ -656,6 +656,16 @@ TEST_F(ViewerWindow, RegionDrawnWithBAndADragClearedWithShiftB) {
     EXPECT_EQ(r["region_cleared"], "none");
 }
 
+// A press, a move and a release sent at once (one frame may see them all): the region runs
+// from the press's position to the release's, as the X events had them, not from where a
+// later frame found the pointer.
+TEST_F(ViewerWindow, RegionDrawnInOneQuickDragRunsFromThePressToTheRelease) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "region_fast", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["region"], "100,120,300,260");
+}
+
 // The render region's picture (scripted --region, the B key's box): inside it the window
 // shows the headless render of the same passes (within 1/255), outside nothing refined
 // (black: the region was set before the first full pass).

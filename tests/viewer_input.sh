@@ -291,6 +291,19 @@ region)
     wait_for 'region=none' || exit 1
     echo "region_cleared=$(field region)"
     ;;
+region_fast)
+    # The same box with no wait between the press, the move and the release, as a quick
+    # hand on a busy machine sends them: one frame may see all three. The box still runs
+    # from where the button went down to where it went up (the events' positions).
+    img=$(field image)
+    read -r x0 y0 x1 y1 < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d %d %d\n", $1 + 100 * s, $2 + 120 * s, $1 + 300 * s, $2 + 260 * s}')
+    xdotool key b
+    xdotool mousemove --window "$wid" $x0 $y0
+    wait_for "pointer=$x0,$y0" || exit 1  # a frame after B's
+    xdotool mousedown 1 mousemove --window "$wid" $x1 $y1 mouseup 1
+    wait_for 'region=[0-9]' || exit 1
+    echo "region=$(field region)"
+    ;;
 feature_views)
     # V from the render to the albedo view (six presses), then normal and depth: once the
     # pointer's pixel reads the view's layer, the window's pixels as X shows them.

@@ -187,6 +187,8 @@ void DragGesture::press(double x, double y) {
 
 bool DragGesture::move(double x, double y, const Camera& camera, double& dx, double& dy) {
     if (!pressed) return false;
+    last_x = x;
+    last_y = y;
     if (!dragging) {
         if (std::hypot(x - press_x, y - press_y) <= kDragThresholdPixels) return false;
         dragging = true;

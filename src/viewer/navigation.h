@@ -70,6 +70,7 @@ struct DragGesture {
     bool pressed = false, dragging = false;
     double press_x = 0, press_y = 0;  // where the button went down
     double start_x = 0, start_y = 0;  // where the drag started (past the threshold)
+    double last_x = 0, last_y = 0;    // the pointer at the last move
     Camera start_camera;              // the camera when the drag started
 
     void press(double x, double y);

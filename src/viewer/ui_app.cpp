@@ -31,8 +31,8 @@ ViewerApp* app_of(GLFWwindow* w) { return static_cast<ViewerApp*>(glfwGetWindowU
 
 // Installed before ImGui's (which chain to them): any input wakes a redraw.
 void install_input_callbacks(GLFWwindow* w) {
-    glfwSetCursorPosCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
-    glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int, int, int) { app_of(win)->note_input(); });
+    glfwSetCursorPosCallback(w, [](GLFWwindow* win, double x, double y) { app_of(win)->note_cursor(x, y); });
+    glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int button, int action, int) { app_of(win)->note_button(button, action); });
     glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
     glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
@@ -335,6 +335,7 @@ bool ViewerApp::draw_frame() {
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();
+    input_.apply_button_positions();
     glfwGetFramebufferSize(window_, &ui_.framebuffer_width, &ui_.framebuffer_height);
     fetch_frame();
     if (model_.has_scene() && inside_checked_generation_ != model_.generation()) {

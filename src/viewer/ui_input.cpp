@@ -24,6 +24,24 @@ void InputState::note_key(int key, int action, int mods) {
     if (action == GLFW_RELEASE || (action == GLFW_PRESS && !chord)) chord_keys.erase(std::remove(chord_keys.begin(), chord_keys.end(), key), chord_keys.end());
 }
 
+void InputState::note_button(int button, int action) {
+    if (button < 0 || button >= 3) return;
+    // The first press since the last frame is the one ImGui sees as the click.
+    if (action == GLFW_PRESS && !press_at[button]) press_at[button] = cursor;
+    if (action == GLFW_PRESS) release_at[button].reset();
+    if (action == GLFW_RELEASE) release_at[button] = cursor;
+}
+
+void InputState::apply_button_positions() {
+    ImGuiIO& io = ImGui::GetIO();
+    for (int b = 0; b < 3; ++b) {
+        if (io.MouseClicked[b] && press_at[b]) io.MouseClickedPos[b] = ImVec2(float(press_at[b]->first), float(press_at[b]->second));
+        press_at[b].reset();
+        released_here[b].reset();
+        if (io.MouseReleased[b]) released_here[b] = std::exchange(release_at[b], std::nullopt);
+    }
+}
+
 bool InputState::held_in_chord(int key) const {
     return std::find(chord_keys.begin(), chord_keys.end(), key) != chord_keys.end();
 }
@@ -69,15 +87,19 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         ctx.ui.selected = in.press_pick;
         ctx.ui.axis_lock = -1;
     }
+    // Where the pointer is for button b: where it went up on the frame that sees its release.
+    auto pointer_of = [&](int b) {
+        return in.released_here[b] ? InputState::Point{in.released_here[b]->first * to_fb, in.released_here[b]->second * to_fb}
+                                   : InputState::Point{mx, my};
+    };
     if (ctx.ui.region_draft && !io.MouseDown[0]) {
-        // The drawn box becomes the render region (an empty one: none).
-        const PixelBox box = *ctx.ui.region_draft;
+        // The drawn box, to where the button went up, becomes the render region (an empty one: none).
+        const auto [ux, uy] = pointer_of(0);
+        const PixelBox box = region_box(io.MouseClickedPos[0].x * to_fb, io.MouseClickedPos[0].y * to_fb, ux, uy, rect, w, h);
         ctx.ui.region = box.x1 > box.x0 && box.y1 > box.y0 ? std::optional<PixelBox>(box) : std::nullopt;
         ctx.ui.region_draft.reset();
         ctx.ui.drawing_region = false;
     }
-    for (int b = 0; b < 3; ++b)
-        if (!io.MouseDown[b]) in.drags[b].release();
     if (!io.MouseDown[0]) in.divider_drag = false;
     // Mouse: only when ImGui does not want it, so a click on a panel never moves the camera.
     if (io.WantCaptureMouse || !over_image) {
@@ -93,10 +115,10 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             if (ImGui::IsMouseClicked(b))
                 in.drags[b].press(io.MouseClickedPos[b].x * to_fb, io.MouseClickedPos[b].y * to_fb);
         const bool left_click = ImGui::IsMouseClicked(ImGuiMouseButton_Left);
+        const double px = io.MouseClickedPos[0].x * to_fb, py = io.MouseClickedPos[0].y * to_fb;  // the left press
         if (left_click) {
             // The orbit's pivot: the surface under the press, else the target.
             in.pivot = model.camera().target;
-            const double px = io.MouseClickedPos[0].x * to_fb, py = io.MouseClickedPos[0].y * to_fb;
             const double fx = (px - rect.x) / rect.width, fy = (py - rect.y) / rect.height;
             if (ctx.ui.nav.orbit_picked && model.prepared())
                 if (const auto p = surface_point(*model.prepared(), fx, fy)) in.pivot = *p;
@@ -111,16 +133,16 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
         if (left_click && io.KeyShift) {
             in.drags[0].release();  // Shift+click locks the inspector on a pixel, or frees it
-            const std::pair<int, int> pixel{int(std::floor((mx - rect.x) / image_scale)),
-                                            int(std::floor((my - rect.y) / image_scale))};
+            const std::pair<int, int> pixel{int(std::floor((px - rect.x) / image_scale)),
+                                            int(std::floor((py - rect.y) / image_scale))};
             if (tool.locked_probe == pixel) tool.locked_probe.reset();
             else tool.locked_probe = pixel;
-        } else if (left_click && tool.comparison.settings.mode == ViewMode::split && std::abs(mx - divider_x) <= 6 * to_fb) {
+        } else if (left_click && tool.comparison.settings.mode == ViewMode::split && std::abs(px - divider_x) <= 6 * to_fb) {
             in.drags[0].release();  // the split view's divider, never an orbit
             in.divider_drag = true;
         } else if (left_click && (io.KeyCtrl || ctx.ui.pick_focus)) {
             in.drags[0].release();  // a focus click, never an orbit
-            const Vec2 film = raster_to_camera((mx - rect.x) / rect.width * w, (my - rect.y) / rect.height * h, w, h);
+            const Vec2 film = raster_to_camera((px - rect.x) / rect.width * w, (py - rect.y) / rect.height * h, w, h);
             if (!model.focus_at(film.x, film.y)) ctx.messages.show_error("click-to-focus: nothing there to focus on");
             ctx.ui.pick_focus = false;
         }
@@ -147,7 +169,11 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     double dx = 0, dy = 0;
     const int active = model.scene().camera;
     auto drag = [&](DragGesture& g) {
-        if (!g.move(mx, my, model.camera(), dx, dy)) return false;
+        const int b = int(&g - in.drags);
+        const auto [x, y] = pointer_of(b);
+        // On the frame of its release a drag moves only to where the button went up, if it moved.
+        if (!io.MouseDown[b] && (!in.released_here[b] || (x == g.last_x && y == g.last_y))) return false;
+        if (!g.move(x, y, model.camera(), dx, dy)) return false;
         dx /= image_scale;
         dy /= image_scale;
         return true;
@@ -185,7 +211,8 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         // The image follows the pointer from where the button went down: this frame's part of
         // the drag, in screen pixels, once past the click threshold.
         if (drag(in.drags[2])) {
-            const double tx = mx - in.drags[2].press_x, ty = my - in.drags[2].press_y;
+            const auto [x, y] = pointer_of(2);
+            const double tx = x - in.drags[2].press_x, ty = y - in.drags[2].press_y;
             tool.view.pan(area, w, h, tx - in.pan_last_x, ty - in.pan_last_y);
             in.pan_last_x = tx;
             in.pan_last_y = ty;
@@ -199,6 +226,9 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             if (nav.stop_at_surfaces) keep_outside(s, before, cam);
         }, "dolly", "dolly");
     }
+    // A button that went up ends its drag, after the drag's last move above.
+    for (int b = 0; b < 3; ++b)
+        if (!io.MouseDown[b]) in.drags[b].release();
 }
 
 // The zoom and compare keys; true when one acted.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "viewer/navigation.h"
@@ -30,9 +31,23 @@ struct InputState {
     // Keys pressed with Ctrl, Alt or Super and not yet released: a chord's key (the S of
     // Ctrl+S, the D of Ctrl+D) is no camera key even when the modifier goes up first.
     std::vector<int> chord_keys;
-
+    // Where each button went down and up, by the events: the pointer's last motion before
+    // each. ImGui 1.86 reads the pointer at the frame that sees a press or release, which on a
+    // busy machine can be after the pointer moved on (a drag, a click's selection or a region
+    // would start late, or lose its last move); apply_button_positions gives the frame the
+    // events' positions instead.
+    using Point = std::pair<double, double>;  // window points
+    std::optional<Point> cursor;              // none before the first motion
+    std::optional<Point> press_at[3], release_at[3];
+    std::optional<Point> released_here[3];    // where the button this frame sees released went up
 
     void note_key(int key, int action, int mods = 0);
+    void note_cursor(double x, double y) { cursor = {x, y}; }
+    void note_button(int button, int action);
+    // After ImGui::NewFrame: each button ImGui sees clicked this frame gets the position of
+    // its press event as io.MouseClickedPos, and each it sees released its release's as
+    // released_here.
+    void apply_button_positions();
     // `key` was pressed since the last frame with Ctrl held (by its event, not the frame's state).
     bool pressed_with_ctrl(int key) const;
     // `key` went down as part of a chord and is still held.
