@@ -457,6 +457,14 @@ TEST_F(ViewerWindow, WheelZoomsTheImageShiftWheelDollies) {
     auto r = drive(dir, "wheel_zooms", 3);
     ASSERT_EQ(r.count("error"), 0u) << r["error"];
     EXPECT_EQ(r["generation_zoomed"], r["generation_before"]);
+    // The quick turn zoomed about (200, 300), where the wheel turned: the image point under it
+    // stayed under it (within a pixel of the zoom's rounding), not the point under (420, 120).
+    double fx = 0, fy = 0, fs = 0, zx = 0, zy = 0, zs = 0;
+    ASSERT_EQ(std::sscanf(r["fitted"].c_str(), "%lf,%lf,fit%lf", &fx, &fy, &fs), 3) << r["fitted"];
+    ASSERT_EQ(std::sscanf(r["quick_zoomed"].c_str(), "%lf,%lf,%lf", &zx, &zy, &zs), 3) << r["quick_zoomed"];
+    EXPECT_GT(zs, fs);
+    EXPECT_NEAR((200 - fx) / fs, (200 - zx) / zs, 1.0);
+    EXPECT_NEAR((300 - fy) / fs, (300 - zy) / zs, 1.0);
     EXPECT_NE(r["generation_after"], r["generation_before"]);
 }
 

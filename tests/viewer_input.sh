@@ -181,6 +181,16 @@ wheel_zooms)
     echo "generation_zoomed=$(field generation)"
     xdotool key 0
     wait_for 'image=[-0-9.]+,[-0-9.]+,fit' || exit 1
+    # A turn of the wheel and a quick move away, sent at once: the zoom is about where the
+    # wheel turned, wherever the pointer is when a frame sees the turn.
+    xdotool mousemove --window "$wid" 200 300
+    wait_for 'pointer=200,300' || exit 1
+    echo "fitted=$(field image)"
+    xdotool click 4 mousemove --window "$wid" 420 120
+    wait_for 'image=[-0-9.]+,[-0-9.]+,[0-9.]+ ' || exit 1
+    echo "quick_zoomed=$(field image)"
+    xdotool key 0
+    wait_for 'image=[-0-9.]+,[-0-9.]+,fit' || exit 1
     xdotool keydown shift
     xdotool click 4
     xdotool keyup shift

@@ -33,7 +33,7 @@ ViewerApp* app_of(GLFWwindow* w) { return static_cast<ViewerApp*>(glfwGetWindowU
 void install_input_callbacks(GLFWwindow* w) {
     glfwSetCursorPosCallback(w, [](GLFWwindow* win, double x, double y) { app_of(win)->note_cursor(x, y); });
     glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int button, int action, int) { app_of(win)->note_button(button, action); });
-    glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_input(); });
+    glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_wheel(); });
     glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
     glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });

@@ -35,6 +35,7 @@ public:
     void note_key(int key, int action, int mods);
     void note_cursor(double x, double y) { input_seen_ = true; input_.note_cursor(x, y); }
     void note_button(int button, int action) { input_seen_ = true; input_.note_button(button, action); }
+    void note_wheel() { input_seen_ = true; input_.note_wheel(); }
     void on_close_request();
 
 private:

@@ -40,6 +40,7 @@ void InputState::apply_button_positions() {
         released_here[b].reset();
         if (io.MouseReleased[b]) released_here[b] = std::exchange(release_at[b], std::nullopt);
     }
+    wheel_here = std::exchange(wheel_at, std::nullopt);
 }
 
 bool InputState::held_in_chord(int key) const {
@@ -80,6 +81,8 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     const double mx = io.MousePos.x * to_fb, my = io.MousePos.y * to_fb;
     const PixelRect area = ctx.view_area();
     auto inside = [&](const PixelRect& r) { return mx >= r.x && my >= r.y && mx < r.x + r.width && my < r.y + r.height; };
+    // The wheel zooms about where the pointer was when it turned.
+    const double wx = in.wheel_here ? in.wheel_here->first * to_fb : mx, wy = in.wheel_here ? in.wheel_here->second * to_fb : my;
     const bool over_image = inside(area) && inside(rect);
     // A left press and release that never became a drag is a click: it selects the sphere
     // under it, or clears the selection.
@@ -106,7 +109,7 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
         if (!io.WantCaptureMouse && inside(area) && !io.KeyShift && io.MouseWheel != 0)
-            tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, wx, wy);
     } else if (ctx.ui.drawing_region && (ImGui::IsMouseClicked(ImGuiMouseButton_Left) || ctx.ui.region_draft)) {
         // B, then a left drag: the box from the press to the pointer, in image pixels.
         ctx.ui.region_draft = region_box(io.MouseClickedPos[0].x * to_fb, io.MouseClickedPos[0].y * to_fb, mx, my, rect, w, h);
@@ -153,7 +156,7 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         }
         if (io.MouseWheel != 0) {
             // The wheel zooms the image about the pointer (samples kept); Shift+wheel dollies.
-            if (!io.KeyShift) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, mx, my);
+            if (!io.KeyShift) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, wx, wy);
             else
                 ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
                     Camera& cam = s.cameras[size_t(s.camera)];

@@ -40,13 +40,15 @@ struct InputState {
     std::optional<Point> cursor;              // none before the first motion
     std::optional<Point> press_at[3], release_at[3];
     std::optional<Point> released_here[3];    // where the button this frame sees released went up
+    std::optional<Point> wheel_at, wheel_here;  // the pointer at the last wheel event (zoom's centre)
 
     void note_key(int key, int action, int mods = 0);
     void note_cursor(double x, double y) { cursor = {x, y}; }
     void note_button(int button, int action);
+    void note_wheel() { wheel_at = cursor; }
     // After ImGui::NewFrame: each button ImGui sees clicked this frame gets the position of
     // its press event as io.MouseClickedPos, and each it sees released its release's as
-    // released_here.
+    // released_here; the wheel's turns since the last frame, the last one's as wheel_here.
     void apply_button_positions();
     // `key` was pressed since the last frame with Ctrl held (by its event, not the frame's state).
     bool pressed_with_ctrl(int key) const;
