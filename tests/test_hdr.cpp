@@ -591,3 +591,18 @@ TEST_F(HdrCli, BadInputsGiveOneLineNamingTheFileAndExitOne) {
         expect_one_line_naming(r.err, file);
     }
 }
+
+// A name of an image format keithray does not write (out.jpg, out.TIFF, out.hdr) is refused
+// before the render, one line naming it; nothing is written. Any other name gets a PPM.
+TEST_F(HdrCli, OutputNamedForAnotherImageFormatIsRefused) {
+    write_scene("s.json");
+    for (const std::string name : {"out.jpg", "out.JPEG", "out.TIFF", "out.hdr", "out.webp"}) {
+        const test::CommandResult r = run("render s.json -q -o " + name);
+        EXPECT_EQ(r.status, 1) << name << "\n" << r.out << r.err;
+        expect_one_line_naming(r.err, name);
+        EXPECT_NE(r.err.find("nothing rendered"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / name)) << name;
+    }
+    ASSERT_EQ(run("render s.json -q -o out.image").status, 0);
+    EXPECT_EQ(read_bytes(dir / "out.image").substr(0, 3), "P6\n");
+}

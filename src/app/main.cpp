@@ -304,6 +304,7 @@ private:
         // Every file written later (the images after the render, the checkpoint during it)
         // checked now, as the writer would: not after hours of rendering.
         if (leader_ && !overwrites_input) try {
+                check_output_extension(output_);
                 std::vector<fs::path> targets = outputs;
                 if (opt_.checkpoint) targets.push_back(*opt_.checkpoint);
                 check_output_targets(targets);

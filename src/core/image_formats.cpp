@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/file_write.h"
 #include "core/image_io.h"
 #include "core/text.h"
 
@@ -28,6 +29,23 @@ const ImageFormatInfo* format_by_extension(const std::filesystem::path& path) {
 const ImageFormatInfo& output_format(const std::filesystem::path& path) {
     const ImageFormatInfo* f = format_by_extension(path);
     return f ? *f : format_info(ImageFormat::ppm);
+}
+
+void check_output_extension(const std::filesystem::path& path) {
+    struct Other {
+        const char* extension;
+        const char* name;
+    };
+    static constexpr Other kOthers[] = {{".jpg", "JPEG"}, {".jpeg", "JPEG"}, {".tif", "TIFF"}, {".tiff", "TIFF"},
+                                        {".bmp", "BMP"},  {".gif", "GIF"},   {".webp", "WebP"}, {".hdr", "Radiance HDR"},
+                                        {".tga", "TGA"},  {".pgm", "PGM"},   {".pnm", "PNM"},   {".jxl", "JPEG XL"}};
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const Other& o : kOthers)
+        if (ext == o.extension)
+            throw std::runtime_error(quoted_path(path) + ": a " + o.name +
+                                     " name; keithray writes .ppm, .png, .exr or .pfm images (a name without one of "
+                                     "these extensions gets a PPM)");
 }
 
 std::vector<std::filesystem::path> output_file_paths(const std::filesystem::path& path) {

@@ -51,6 +51,9 @@ const ImageFormatInfo& format_info(ImageFormat format);
 const ImageFormatInfo* format_by_extension(const std::filesystem::path& path);
 // What an image written to `path` is: its extension's format, binary PPM for any other name.
 const ImageFormatInfo& output_format(const std::filesystem::path& path);
+// Throws std::runtime_error when `path` names an image format keithray does not write
+// (.jpg, .tiff, .hdr, ...): a PPM under that name would not be what the name says.
+void check_output_extension(const std::filesystem::path& path);
 // Every file one output named `path` writes: `path`, then its depth file where the format
 // puts the depth beside it (depth_path_for).
 std::vector<std::filesystem::path> output_file_paths(const std::filesystem::path& path);
