@@ -99,6 +99,20 @@ TEST_F(RobustRuns, ViewerOutputsNeverReplaceItsInputs) {
     EXPECT_EQ(test::read_file(dir / "ref-depth.ppm"), "reference depth");
 }
 
+// A viewer image named for a format it does not write is refused before the window opens:
+// a .jpg anywhere, and an HDR name for the 8-bit shots (a PPM's bytes under out.exr before).
+TEST_F(RobustRuns, ViewerImageNamesMatchWhatIsWritten) {
+    scene_file();
+    for (const std::string flags : {"--frames 1 --screenshot shot.jpg", "--frames 1 --screenshot shot.exr",
+                                    "--frames 1 --window-shot shot.PFM"}) {
+        const test::CommandResult r = here(exe() + " view scene.json " + flags);
+        EXPECT_EQ(r.status, 1) << flags;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+        EXPECT_NE(r.err.find(flags.substr(flags.rfind(' ') + 1)), std::string::npos) << r.err;
+    }
+    for (const char* name : {"shot.jpg", "shot.exr", "shot.PFM"}) EXPECT_FALSE(fs::exists(dir / name)) << name;
+}
+
 // Help to a full device fails like any other output to it.
 TEST_F(RobustRuns, HelpToAFullDeviceFails) {
     for (const char* command : {"--help", "render --help", "view --help"}) {
