@@ -1,4 +1,4 @@
-// The processes of one `keithray render`: the ranks of an MPI job when a launcher (mpirun,
+// The processes of one `keithray render` or `keithray view` (app/view_ranks.h): the ranks of an MPI job when a launcher (mpirun,
 // srun) started this process, else this process alone. Only cluster_mpi.cpp includes mpi.h;
 // a build without MPI has cluster_single.cpp, a cluster of one.
 //
