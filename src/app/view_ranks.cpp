@@ -152,11 +152,11 @@ int serve_view_passes(const Cluster& cluster) {
                 state.reset(w, h, std::move(held));
                 if (halves) state.track_halves();
                 driver.emplace(*scene, settings, state, StopRule{}, &hooks);
-            } catch (const SceneError& e) {
-                std::fprintf(stderr, "error: rank %d: %s\n", cluster.rank(), e.what());
-                failure = kUnreadable;
             } catch (const std::bad_alloc&) {
                 failure = kNoMemory;
+            } catch (const std::exception& e) {  // SceneError; a camera prepare_scene refuses
+                std::fprintf(stderr, "error: rank %d: %s\n", cluster.rank(), e.what());
+                failure = kUnreadable;
             }
         } else if (command[0] == kPass) {
             const StopRule rule = fields.take<StopRule>();
