@@ -14,7 +14,12 @@
 #            interleaved with these (its summary names no bytes: 36 B x P x (N-1)/N a pass).
 #   memory:  each rank's peak resident memory (/usr/bin/time) in a 4096x4096 render (scene 1,
 #            10 spp: adaptive allocation plans passes 9 and 10) at np 1, 2 and 4.
-# Usage: scripts/bench_mpi.sh ratio|balance|exchange|plan|memory [REPEATS] [extra render flags]
+#   view:    `keithray view` (under xvfb-run) in one process and under mpirun -np 1, 2 and 4
+#            (1 thread a rank), scene 6 at 512x512, interleaved, REPEATS rounds: the edit to
+#            first preview latency (--measure-latency 10: orbit nudges made while full passes
+#            run) and full passes per second of the render thread (32 passes, --denoise off:
+#            spp over the stats' elapsed seconds, previews and the gathers included); medians.
+# Usage: scripts/bench_mpi.sh ratio|balance|exchange|plan|memory|view [REPEATS] [extra flags]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 exe=build/keithray
@@ -105,5 +110,26 @@ memory)
       grep -E '^  [0-9]+$|ranks: busy'
   done
   ;;
-*) echo "usage: $0 ratio|balance|exchange|plan|memory [REPEATS] [render flags]" >&2; exit 2 ;;
+view)
+  scene=res/scenes/assignment_06.json
+  runs=(plain np1 np2 np4)
+  for r in "${runs[@]}"; do : >"$out/view-$r"; done
+  for ((i = 0; i < repeats; i++)); do
+    for r in "${runs[@]}"; do
+      launch=()
+      [ "$r" != plain ] && launch=("${mpi[@]}" -np "${r#np}")
+      xvfb-run -a -s '-screen 0 1280x1024x24 -noreset' "${launch[@]}" "$exe" view "$scene" --spp 32 --frames 32 \
+        --measure-latency 10 --denoise off --stats-json "$out/stats.json" --timeout 600 "$@" >"$out/log" 2>/dev/null
+      latency=$(sed -n 's/^latency .*edits: median \([0-9.]*\) ms.*/\1/p' "$out/log")
+      python3 -c 'import json, sys; s = json.load(open(sys.argv[1])); print(sys.argv[2], "%.2f" % (s["spp"] / s["elapsed_seconds"]))' \
+        "$out/stats.json" "$latency" >>"$out/view-$r"
+    done
+  done
+  echo "scene 6, 512x512, $repeats rounds interleaved $*; per run: first-preview latency ms, full passes/s"
+  for r in "${runs[@]}"; do
+    echo "  $r: $(tr '\n' ';' <"$out/view-$r") medians $(awk '{print $1}' "$out/view-$r" | median) ms," \
+      "$(awk '{print $2}' "$out/view-$r" | median) passes/s"
+  done
+  ;;
+*) echo "usage: $0 ratio|balance|exchange|plan|memory|view [REPEATS] [flags]" >&2; exit 2 ;;
 esac

@@ -13,7 +13,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <thread>
@@ -81,6 +83,33 @@ protected:
         return at == std::string::npos ? -1 : std::stoi(err.substr(at + 25));
     }
     std::string bytes(const std::string& name) { return test::read_file(dir / name); }
+
+    // The viewer's window runs under xvfb-run, as tests/test_viewer_window.cpp's do: -n starts
+    // the free-display search at a number of this process's and call's, -noreset keeps the
+    // exit status keithray's.
+    static bool have_xvfb() { return std::system("command -v xvfb-run >/dev/null 2>&1") == 0; }
+    static std::string xvfb_run() {
+        static int calls = 0;
+        const int start = 300 + int((unsigned(::getpid()) * 89u + unsigned(calls++) * 17u) % 20000u);
+        return "xvfb-run -a -n " + std::to_string(start) + " -s '-screen 0 1280x1024x24 -noreset' ";
+    }
+    // `keithray view` with `args` in one process, then under mpirun at each of `ranks`: the
+    // image saved (every EXR layer, developed by Save's final denoiser, which reads the two
+    // halves of the samples) and the screenshot of the display are the same bytes.
+    void expect_viewer_same_bytes(const std::string& args, std::initializer_list<int> ranks) {
+        const test::CommandResult single =
+            here(xvfb_run() + keithray() + "view " + args + " --save-image single.exr --screenshot single-shot.ppm");
+        ASSERT_EQ(single.status, 0) << single.err;
+        for (int n : ranks) {
+            SCOPED_TRACE(n);
+            const std::string name = std::to_string(n);
+            const test::CommandResult r = here(xvfb_run() + mpirun(n) + "view " + args + " --save-image " + name +
+                                               ".exr --screenshot " + name + "-shot.ppm");
+            ASSERT_EQ(r.status, 0) << r.err;
+            EXPECT_EQ(bytes(name + ".exr"), bytes("single.exr"));
+            EXPECT_EQ(bytes(name + "-shot.ppm"), bytes("single-shot.ppm"));
+        }
+    }
 };
 
 }  // namespace
@@ -197,15 +226,88 @@ TEST_F(Mpi, EachRankChecksTheMemoryOfTheRowsItHolds) {
 
 // Run plainly (no launcher in the environment), keithray never calls MPI_Init: Open MPI's
 // initialisation, even as a singleton, leaves its session folder (ompi.HOST.UID) in TMPDIR.
+// Neither render nor view.
 TEST_F(Mpi, PlainRunNeverStartsMpi) {
     scene(6, 16, "scene.json");
     fs::create_directories(dir / "tmp");
-    const test::CommandResult r =
-        here("env -u OMPI_COMM_WORLD_SIZE -u PMIX_RANK -u PMI_RANK TMPDIR='" + (dir / "tmp").string() + "' " +
-             keithray() + "render -q scene.json --spp 12 --noise 0.05 -o plain.ppm");
+    const std::string plain = "env -u OMPI_COMM_WORLD_SIZE -u PMIX_RANK -u PMI_RANK TMPDIR='" + (dir / "tmp").string() + "' ";
+    const test::CommandResult r = here(plain + keithray() + "render -q scene.json --spp 12 --noise 0.05 -o plain.ppm");
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_EQ(r.out.find("ranks: busy"), std::string::npos) << r.out;
+    if (have_xvfb()) {
+        // TMPDIR for keithray alone: xvfb-run keeps its own files there while it runs.
+        const test::CommandResult v =
+            here(xvfb_run() + plain + keithray() + "view scene.json --spp 4 --frames 4 --screenshot view.ppm --timeout 240");
+        ASSERT_EQ(v.status, 0) << v.err;
+        EXPECT_TRUE(fs::exists(dir / "view.ppm"));
+    }
     for (const auto& entry : fs::directory_iterator(dir / "tmp")) ADD_FAILURE() << "MPI started: " << entry.path();
+}
+
+// `mpirun -np N keithray view`: rank 0's window shows the single-process viewer's image at
+// N passes, bit for bit, at 1 to 4 ranks: adaptive passes (planned from pass 9 on, reading
+// the guard rows across ranks), 3 rows at 4 ranks (one rank owns none), and a render region.
+TEST_F(Mpi, ViewerImageIsOneProcesssAtOneToFourRanks) {
+    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (scripts/setup.sh installs it)";
+    scene(6, 24, "scene.json", "out.ppm", 19);
+    expect_viewer_same_bytes("scene.json --spp 12 --frames 12 --timeout 240", {1, 2, 3, 4});
+    scene(6, 7, "rows.json", "out.ppm", 3);
+    expect_viewer_same_bytes("rows.json --spp 10 --frames 10 --timeout 240", {4});
+    expect_viewer_same_bytes("scene.json --spp 12 --frames 12 --region 3,2 17,15 --estimator stratified --timeout 240",
+                             {3});
+}
+
+// Edits reach every rank: three orbit nudges, each made while full passes shared by the
+// ranks run (--measure-latency waits for a full-resolution frame before each), then the
+// passes of the edited view are the single-process viewer's after the same edits.
+TEST_F(Mpi, ViewerEditReachesEveryRank) {
+    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (scripts/setup.sh installs it)";
+    scene(6, 24, "scene.json", "out.ppm", 19);
+    expect_viewer_same_bytes("scene.json --spp 16 --frames 16 --measure-latency 3 --timeout 240", {2, 3});
+}
+
+// A rank killed while the ranks render: rank 0's window says the job is ending (and its
+// standard error), and the job ends non-zero at once instead of waiting on the dead rank.
+TEST_F(Mpi, ViewerRankKilledEndsTheSessionWithAMessage) {
+    if (!have_xvfb()) GTEST_SKIP() << "xvfb-run is not installed (scripts/setup.sh installs it)";
+    scene(6, 24, "scene.json", "out.ppm", 19);
+    const pid_t launcher = ::fork();
+    ASSERT_GE(launcher, 0);
+    if (launcher == 0) {
+        const std::string cmd = "cd '" + dir.string() + "' && exec " + xvfb_run() + mpirun(3) +
+                                "view scene.json --spp 1000000 --frames 1000000 --status-file status.txt "
+                                "--timeout 250 2>killed.err >killed.out";
+        ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        ::_exit(127);
+    }
+    // Until the ranks have shared a few passes.
+    auto spp = [&] {
+        const std::string line = fs::exists(dir / "status.txt") ? bytes("status.txt") : "";
+        const size_t at = line.find(" spp=");
+        return at == std::string::npos ? 0 : std::atoi(line.c_str() + at + 5);
+    };
+    for (int i = 0; i < 2400 && spp() < 3; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    ASSERT_GE(spp(), 3);
+    // Rank 1, found by its environment among the processes running this scratch folder's scene.
+    pid_t rank1 = 0;
+    for (const auto& entry : fs::directory_iterator("/proc")) {
+        const std::string name = entry.path().filename().string();
+        if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+        std::string environ = test::read_file(entry.path() / "environ");
+        std::replace(environ.begin(), environ.end(), '\0', '\n');
+        if (environ.find("\nOMPI_COMM_WORLD_RANK=1\n") != std::string::npos &&
+            environ.find(dir.string()) != std::string::npos)
+            rank1 = pid_t(std::stoi(name));
+    }
+    ASSERT_GT(rank1, 0);
+    ASSERT_EQ(::kill(rank1, SIGKILL), 0);
+    int status = 0;
+    ASSERT_EQ(::waitpid(launcher, &status, 0), launcher);  // the job's own --timeout would end a hang
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_NE(WEXITSTATUS(status), 0);
+    const std::string err = bytes("killed.err");
+    EXPECT_NE(err.find("error: the MPI job is ending (mpirun is ending it: a rank died"), std::string::npos) << err;
+    EXPECT_EQ(err.find("did not finish within"), std::string::npos) << err;
 }
 
 // A bad scene beside a good one: one error line, a non-zero exit from every rank (no hang),

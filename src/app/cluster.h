@@ -1,4 +1,4 @@
-// The processes of one `keithray render`: the ranks of an MPI job when a launcher (mpirun,
+// The processes of one `keithray render` or `keithray view` (app/view_ranks.h): the ranks of an MPI job when a launcher (mpirun,
 // srun) started this process, else this process alone. Only cluster_mpi.cpp includes mpi.h;
 // a build without MPI has cluster_single.cpp, a cluster of one.
 //
@@ -34,7 +34,9 @@ class Cluster {
 public:
     // Joins the MPI job where the environment names a launcher's rank, else a cluster of one
     // without touching MPI. Throws std::runtime_error (one line) where MPI cannot start.
-    Cluster(int& argc, char**& argv);
+    // `other_thread`: MPI is called from another thread than this one (the viewer's render
+    // thread), one thread at a time (MPI_THREAD_SERIALIZED).
+    Cluster(int& argc, char**& argv, bool other_thread = false);
     ~Cluster();  // leaves the MPI job
     Cluster(const Cluster&) = delete;
     Cluster& operator=(const Cluster&) = delete;
@@ -44,6 +46,9 @@ public:
     int rank() const { return rank_; }
     int size() const { return size_; }
 
+    // With `other_thread`, a failed MPI call (a rank that died) parks the calling thread of
+    // rank 0 for ever, and this says why from then on ("" before); another rank exits 1.
+    static std::string failure();
     // Ends every rank of the job with `status` (MPI_Abort), for a failure in one rank that
     // the others would wait on.
     [[noreturn]] void abort(int status) const;
@@ -51,6 +56,9 @@ public:
     void broadcast(std::string& bytes) const;
     // Rank 0's `value` in every rank.
     bool broadcast(bool value) const;
+    // As broadcast(bytes), for ranks that may wait long for it (the viewer's next command):
+    // they poll, sleeping a millisecond between polls, instead of spinning on a core.
+    void broadcast_waiting(std::string& bytes) const;
     // The bitwise or of every rank's `flags`, in every rank.
     int any_flags(int flags) const;
     // At rank 0, every rank's `cost` (rank order); elsewhere empty.
@@ -62,8 +70,8 @@ public:
     // (reset to its held_rows) gets its rows of it, with the passes; the rays and dropped
     // samples stay counted at rank 0.
     void scatter_state(RenderState& state) const;
-    // Makes rank 0's `state` whole (every pixel's sums and counts from the rank that drew
-    // them) and returns the job's rays and dropped samples there; the other ranks' states are
+    // Makes rank 0's `state` whole (every pixel's sums and counts, and the two halves of the
+    // samples where the states track them, from the rank that drew them) and returns the job's rays and dropped samples there; the other ranks' states are
     // unchanged.
     void gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const;
 

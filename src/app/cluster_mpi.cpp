@@ -2,6 +2,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -9,6 +10,7 @@
 #include <chrono>
 #include <cstdint>
 #include <stdexcept>
+#include <thread>
 
 #include "app/cluster.h"
 
@@ -260,14 +262,49 @@ private:
     int passes_ = 0;
 };
 
+std::atomic<bool> g_claimed{false}, g_failed{false};  // the first failure is being, has been recorded
+char g_failure[MPI_MAX_ERROR_STRING + 64] = "";
+
+void on_mpi_error(MPI_Comm*, int* code, ...) {
+    int rank = 0, length = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    char text[MPI_MAX_ERROR_STRING] = "";
+    MPI_Error_string(*code, text, &length);
+    if (rank != 0) {
+        std::fprintf(stderr, "error: rank %d: MPI: %s\n", rank, text);
+        std::fflush(stderr);
+        std::_Exit(1);
+    }
+    if (!g_claimed.exchange(true)) {
+        std::snprintf(g_failure, sizeof g_failure, "an MPI call failed (%s)", text);
+        g_failed.store(true);
+    }
+    for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
+}
+
 }  // namespace
 
-Cluster::Cluster(int& argc, char**& argv) {
+std::string Cluster::failure() { return g_failed.load() ? std::string(g_failure) : std::string(); }
+
+Cluster::Cluster(int& argc, char**& argv, bool other_thread) {
     if (!launched_by_mpi()) return;
-    // Only the main thread calls MPI; OpenMP's threads render between the calls.
+    // One thread calls MPI at a time; OpenMP's threads render between the calls.
+    const int level = other_thread ? MPI_THREAD_SERIALIZED : MPI_THREAD_FUNNELED;
     int provided = 0;
-    if (MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS)
+    if (MPI_Init_thread(&argc, &argv, level, &provided) != MPI_SUCCESS)
         throw std::runtime_error("MPI could not start (MPI_Init_thread failed)");
+    if (provided < level) {
+        MPI_Finalize();
+        throw std::runtime_error("this MPI library does not let another thread call it (no MPI_THREAD_SERIALIZED)");
+    }
+    if (other_thread) {
+        // A failed call (a peer that died) parks rank 0's calling thread and records why,
+        // for its window to say; another rank exits. MPI's default would end rank 0 at once.
+        MPI_Errhandler handler;
+        MPI_Comm_create_errhandler(on_mpi_error, &handler);
+        MPI_Comm_set_errhandler(MPI_COMM_WORLD, handler);
+        MPI_Errhandler_free(&handler);
+    }
     mpi_ = true;
     MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
@@ -290,6 +327,21 @@ void Cluster::broadcast(std::string& bytes) const {
     MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
     bytes.resize(size_t(size));
     // In pieces of at most 1 GiB: MPI counts are ints.
+    constexpr size_t kPiece = size_t(1) << 30;
+    for (size_t at = 0; at < bytes.size(); at += kPiece)
+        MPI_Bcast(bytes.data() + at, int(std::min(kPiece, bytes.size() - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
+}
+
+void Cluster::broadcast_waiting(std::string& bytes) const {
+    if (!mpi_) return;
+    unsigned long long size = bytes.size();
+    MPI_Request request;
+    MPI_Ibcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD, &request);
+    if (leader()) MPI_Wait(&request, MPI_STATUS_IGNORE);
+    else
+        for (int done = 0; MPI_Test(&request, &done, MPI_STATUS_IGNORE), !done;)
+            std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    bytes.resize(size_t(size));
     constexpr size_t kPiece = size_t(1) << 30;
     for (size_t at = 0; at < bytes.size(); at += kPiece)
         MPI_Bcast(bytes.data() + at, int(std::min(kPiece, bytes.size() - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
@@ -339,6 +391,10 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
     if (!px.active.empty()) deal.gather(state, px.active, mine, gathered);
     if (!px.sample_credit.empty()) deal.gather(state, px.sample_credit, mine, gathered);
+    if (state.tracks_halves()) {  // the viewer's (its Save's final denoiser reads them)
+        deal.gather(state, px.half_sum, mine, gathered);
+        deal.gather(state, px.half_count, mine, gathered);
+    }
     const unsigned long long counts[2] = {state.rays, state.nonfinite_samples};
     unsigned long long sum[2] = {0, 0};
     MPI_Reduce(counts, sum, 2, MPI_UNSIGNED_LONG_LONG, MPI_SUM, 0, MPI_COMM_WORLD);

@@ -20,6 +20,7 @@
 #include "app/cluster.h"
 #include "app/compare.h"
 #include "app/progress.h"
+#include "app/view_ranks.h"
 #include "core/args.h"
 #include "core/image.h"
 #include "core/limits.h"
@@ -536,6 +537,31 @@ bool stdout_written() {
     return false;
 }
 
+// `keithray view`; under mpirun, rank 0 opens the window and drives the other ranks, which
+// serve its passes with no window (app/view_ranks.h). Run plainly it never touches MPI.
+int run_view(int argc, char** argv) {
+    std::optional<Cluster> joined;
+    try {
+        joined.emplace(argc, argv, true);  // the viewer's render thread calls MPI
+    } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        return 1;
+    }
+    if (!joined->distributed()) {
+        const int status = viewer::run_viewer(argc, argv);
+        return stdout_written() ? status : 1;
+    }
+    if (!joined->leader()) return serve_view_passes(*joined);
+    int status = 1;
+    {
+        ViewRanks ranks(*joined);  // its end ends the other ranks' loops
+        // mpirun ends the job with SIGTERM when a rank dies: the window says so before it ends.
+        StopOnSignal stop_on_signal(true);
+        status = viewer::run_viewer(argc, argv, &ranks);
+    }
+    return stdout_written() ? status : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -566,10 +592,7 @@ int main(int argc, char** argv) {
             return 1;
         }
     }
-    if (command == "view") {
-        const int status = viewer::run_viewer(argc, argv);
-        return stdout_written() ? status : 1;
-    }
+    if (command == "view") return run_view(argc, argv);
     if (command != "render") {
         std::fprintf(stderr, "%s%s\n%s", command.empty() ? "error: no command given" : "error: unknown command ",
                      command.empty() ? "" : quote_user_text(command, 40).c_str(), usage().c_str());

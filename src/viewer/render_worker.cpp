@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 #include <sys/resource.h>
 #include <sys/syscall.h>
@@ -41,8 +43,8 @@ std::vector<int> preview_scales(int width, int height, double seconds_per_pixel,
     return scales;
 }
 
-RenderWorker::RenderWorker(std::function<void()> on_publish)
-    : on_publish_(std::move(on_publish)), thread_([this] { run(); }) {}
+RenderWorker::RenderWorker(std::function<void()> on_publish, SharedPasses* ranks)
+    : on_publish_(std::move(on_publish)), ranks_(ranks), thread_([this] { run(); }) {}
 
 RenderWorker::~RenderWorker() {
     {
@@ -79,12 +81,15 @@ void RegionHooks::before_pass(RenderState& state) {
     const int w = state.width, h = state.height;
     std::vector<uint8_t>& active = state.buffers().active;
     saved_.swap(active);  // empty: every pixel, else the noise rule's mask
-    active.assign(size_t(w) * size_t(h), 0);
-    for (int y = std::max(0, region->y0); y < std::min(h, region->y1); ++y)
+    active.assign(state.sample_count().size(), 0);
+    // A process of a shared render holds some rows only (RenderState::row_start).
+    for (int y = std::max(0, region->y0); y < std::min(h, region->y1); ++y) {
+        if (!state.holds_row(y)) continue;
         for (int x = std::max(0, region->x0); x < std::min(w, region->x1); ++x) {
-            const size_t i = size_t(y) * size_t(w) + size_t(x);
+            const size_t i = state.row_start(y) + size_t(x);
             active[i] = saved_.empty() ? 1 : saved_[i];
         }
+    }
     applied_ = true;
 }
 
@@ -180,6 +185,15 @@ void RenderWorker::run() {
     RenderJob job;
     RenderState state;  // the estimate of `job`, at full resolution
     RegionHooks region;  // before the driver, which holds it
+    std::optional<RegionOverShare> shared;  // with ranks: the region over this rank's rows
+    if (ranks_) shared.emplace(region, ranks_->hooks());
+    PassHooks* hooks = ranks_ ? static_cast<PassHooks*>(&*shared) : &region;
+    uint64_t job_rays = 0, job_nonfinite = 0;  // with ranks: every rank's, gathered after a pass
+    bool job_unsent = false;  // with ranks: `job` is not yet theirs
+    auto send_job = [&] {
+        if (job_unsent) ranks_->start_job(*job.source, job.settings, state.tracks_halves());
+        job_unsent = false;
+    };
     std::optional<ProgressiveDriver> driver;
     std::vector<int> previews;
     size_t next_preview = 0;
@@ -202,6 +216,7 @@ void RenderWorker::run() {
     };
 
     for (;;) {
+        send_job();
         StopRule rule;
         // Which rule ends the refinement, if any (called under the lock).
         auto stop_reason = [&]() -> std::optional<StopReason> {
@@ -248,7 +263,9 @@ void RenderWorker::run() {
                 albedo.clear();
                 normal.clear();
                 features.reset();
-                driver.emplace(*job.scene, job.settings, state, rule_, &region);
+                driver.emplace(*job.scene, job.settings, state, rule_, hooks);
+                job_unsent = ranks_ != nullptr;  // sent outside the lock: the ranks may be busy
+                job_rays = job_nonfinite = 0;
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
                 seconds = 0;
@@ -257,6 +274,7 @@ void RenderWorker::run() {
             rule = rule_;
             region.region = region_;
         }
+        send_job();
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
         if (republish) {
@@ -274,6 +292,7 @@ void RenderWorker::run() {
         }
         const auto start = Clock::now();
         auto frame = std::make_shared<Snapshot>();
+        bool shared_pass = false;  // inside a pass shared with the other ranks
         // An allocation that fails here (a preview, a pass's buffers, the frame's copies) is
         // the window's error, not an abort of the viewer; the job is dropped.
         try {
@@ -299,8 +318,20 @@ void RenderWorker::run() {
                 frame->hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
             }
         } else {
+            if (ranks_) {
+                // Every rank runs the pass to its end: they exchange rows after it.
+                if (std::string error = ranks_->begin_pass(rule, region.region); !error.empty()) {
+                    driver.reset();
+                    publish_error(job.generation, std::move(error));
+                    continue;
+                }
+                shared_pass = true;
+                driver->pass(rule);
+                ranks_->end_pass(state, job_rays, job_nonfinite);
+                shared_pass = false;
+            }
             // A pass stopped early is always an edit's: the next turn starts the new job.
-            if (!driver->pass(rule, &stop_)) continue;
+            else if (!driver->pass(rule, &stop_)) continue;
             const double dt = seconds_since(start);
             seconds += dt;
             // Only full passes: tiny previews are dominated by per-pass overheads.
@@ -315,9 +346,9 @@ void RenderWorker::run() {
         frame->spp = state.passes;
         frame->seconds = seconds;
         frame->full_seconds = driver->seconds();
-        frame->rays = state.rays;
+        frame->rays = ranks_ ? job_rays : state.rays;
         frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
-        frame->nonfinite_samples = state.nonfinite_samples;
+        frame->nonfinite_samples = ranks_ ? job_nonfinite : state.nonfinite_samples;
         if (frame->scale == 1) {
             record_pixel_statistics(state, *frame);
             if (features_.load()) {
@@ -326,6 +357,12 @@ void RenderWorker::run() {
             }
         }
         } catch (const std::bad_alloc&) {
+            if (shared_pass) {
+                // The other ranks wait for this one's rows: only the end of the job frees them.
+                std::fprintf(stderr, "error: not enough memory for rendering a %dx%d image on rank 0\n", w, h);
+                std::fflush(stderr);
+                std::_Exit(1);
+            }
             driver.reset();
             publish_error(job.generation, "not enough memory for rendering a " + std::to_string(w) + "x" +
                                               std::to_string(h) + " image");

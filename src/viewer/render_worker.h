@@ -27,6 +27,9 @@ struct RenderJob {
     std::shared_ptr<const RenderScene> scene;
     RenderSettings settings;
     StopRule stop;
+    // The scene `scene` was prepared from: what the other ranks prepare (SharedPasses; only
+    // needed with them).
+    std::shared_ptr<const Scene> source;
 };
 
 // A render region: the image pixels [x0, x1) x [y0, y1) that full passes refine.
@@ -49,6 +52,53 @@ public:
 private:
     std::vector<uint8_t> saved_;  // the noise rule's mask while the region's is in place
     bool applied_ = false;
+};
+
+// A region's hooks over a process's share of the rows (SharedPasses::hooks): a pass samples
+// the region's pixels of this process's rows; the share decides the stops and the row sums.
+class RegionOverShare final : public PassHooks {
+public:
+    RegionOverShare(RegionHooks& region, PassHooks& share) : region_(region), share_(share) {}
+    void before_pass(RenderState& state) override {
+        share_.before_pass(state);
+        region_.before_pass(state);
+    }
+    void after_pass(RenderState& state, bool statistics) override {
+        region_.after_pass(state, statistics);
+        share_.after_pass(state, statistics);
+    }
+    bool any(bool stop) override { return share_.any(stop); }
+    const RowShare* rows() const override { return share_.rows(); }
+
+private:
+    RegionHooks& region_;
+    PassHooks& share_;
+};
+
+// The other processes of an MPI job that share the full passes (`mpirun -np N keithray view`;
+// app/view_ranks.h implements it, so the viewer holds no MPI). Each pixel's samples are drawn
+// by one process in the single-process order (app/cluster.h), so the image at N passes is the
+// single-process viewer's, bit for bit. Only the render thread calls it, in this order: a job,
+// then for each full pass begin_pass, the driver's pass with hooks(), end_pass.
+class SharedPasses {
+public:
+    virtual ~SharedPasses() = default;
+    // Every other rank prepares `scene` (the viewer's, sent as saved) with `settings` and
+    // resets its state to its rows of the scene's image, tracking the two halves of
+    // the samples when `halves`. Returns without waiting for them.
+    virtual void start_job(const Scene& scene, const RenderSettings& settings, bool halves) = 0;
+    // Every other rank starts its share of the next full pass under `rule`, narrowed to
+    // `region`. Returns "" or, where a rank could not take the job (its memory), why; every
+    // rank has then dropped the job, and this one must drop it too (no pass).
+    virtual std::string begin_pass(const StopRule& rule, const std::optional<PixelBox>& region) = 0;
+    // This rank's share of each pass (the driver's hooks, under the region's).
+    virtual PassHooks& hooks() = 0;
+    // After the driver's pass: every rank's rows into `state` (which holds every row), and
+    // the job's rays and dropped samples so far.
+    virtual void end_pass(RenderState& state, uint64_t& rays, uint64_t& nonfinite) = 0;
+    // Any thread: "" while the job is whole, else why it is not (a rank died); the calling
+    // render thread then waits for ever, and the process is to end.
+    virtual std::string lost() const = 0;
 };
 
 // The first-surface albedo and normal of a frame's pixels (3 floats per pixel each): the
@@ -104,7 +154,9 @@ class RenderWorker {
 public:
     // `on_publish` runs on the render thread after each snapshot (the window passes
     // glfwPostEmptyEvent, thread-safe, to wake its event wait): it must not touch GL.
-    explicit RenderWorker(std::function<void()> on_publish = {});
+    // With `ranks`, full passes are shared with the other processes of an MPI job (previews stay
+    // here); a full pass under way then runs to its end before an edit's job starts.
+    explicit RenderWorker(std::function<void()> on_publish = {}, SharedPasses* ranks = nullptr);
     ~RenderWorker();  // stops the pass in flight and joins
     RenderWorker(const RenderWorker&) = delete;
     RenderWorker& operator=(const RenderWorker&) = delete;
@@ -141,6 +193,7 @@ private:
     void publish_error(uint64_t generation, std::string error);  // a frame with only the error
 
     std::function<void()> on_publish_;
+    SharedPasses* ranks_;
     mutable std::mutex mutex_;
     mutable std::condition_variable changed_;   // wakes the render thread
     mutable std::condition_variable published_; // wakes waiters on frames

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 
 #include <GLFW/glfw3.h>
@@ -24,6 +25,7 @@ namespace {
 constexpr double kFrameInterval = 1.0 / 60;  // UI frame cap where there is no vsync (Xvfb)
 constexpr double kMinFrameInterval = 1.0 / 120;  // ... and when a new snapshot cuts the wait short
 constexpr double kWatchInterval = 0.25;      // seconds between scene-file polls while idle
+constexpr double kSignalInterval = 0.05;     // ... under MPI, between looks at a stop signal
 constexpr int kSettleFrames = 3;             // frames drawn after input so ImGui's state settles
 constexpr int kMinWindowWidth = 640, kMinWindowHeight = 400;
 
@@ -47,7 +49,8 @@ double seconds(std::chrono::steady_clock::duration d) { return std::chrono::dura
 
 }  // namespace
 
-ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script_(options_) {
+ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
+    : options_(std::move(options)), ranks_(ranks), script_(options_) {
     model_.set_overrides(options_.render);
     model_.edit(Edit::run_control, [&](Scene&, ViewerSettings& s) {
         s.unlimited = options_.unlimited;
@@ -98,7 +101,7 @@ ViewerApp::ViewerApp(ViewOptions options) : options_(std::move(options)), script
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
-    worker_ = std::make_unique<RenderWorker>([] { glfwPostEmptyEvent(); });
+    worker_ = std::make_unique<RenderWorker>([] { glfwPostEmptyEvent(); }, ranks_);
 }
 
 ViewerApp::~ViewerApp() {
@@ -140,7 +143,9 @@ void ViewerApp::sync_worker() {
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
         sub.stop = rule;
-        worker_->submit({sub.generation, model_.prepared(), s.render, rule});
+        RenderJob job{sub.generation, model_.prepared(), s.render, rule, nullptr};
+        if (ranks_) job.source = std::make_shared<const Scene>(model_.scene());  // what the ranks prepare
+        worker_->submit(std::move(job));
     }
     // A new rule (target, unlimited, time, noise) keeps the samples taken (the reset rule: run control).
     if (rule != sub.stop) worker_->set_stop_rule(sub.stop = rule);
@@ -184,6 +189,18 @@ Rgb8Image ViewerApp::read_image_region(const PixelRect& rect) const {
             for (int k = 0; k < 3; ++k)
                 out.bytes[(size_t(row) * w + col) * 3 + k] = rgba[(size_t(h - 1 - row) * w + col) * 4 + k];
     return out;
+}
+
+void ViewerApp::end_with_the_job() {
+    const std::string lost = ranks_->lost();
+    const std::string message = "the MPI job is ending (" + (lost.empty() ? "a stop signal: a rank died, or mpirun was stopped" : lost) +
+                                "): the session ends; unsaved edits are lost";
+    messages_.show_error(message);
+    std::fprintf(stderr, "error: %s\n", message.c_str());
+    std::fflush(stderr);
+    std::fflush(stdout);
+    draw_frame();  // the message, in the window
+    std::_Exit(1);
 }
 
 void ViewerApp::note_key(int key, int action, int mods) {
@@ -390,6 +407,7 @@ int ViewerApp::run() {
     settle_frames_ = kSettleFrames;
     bool done = false;
     while (!done && !glfwWindowShouldClose(window_)) {
+        if (ranks_ && (stop_signal() || !ranks_->lost().empty())) end_with_the_job();
         poll_watch();
         sync_worker();
         if (options_.measure_idle > 0 && script_.idle_step(ctx_, [this] {
@@ -405,7 +423,8 @@ int ViewerApp::run() {
         // Redraw only on input, a new snapshot, or something moving; else sleep until one of
         // those (the render thread and GLFW wake the wait) or the next poll of the scene file.
         if (!(input_seen_ || new_snapshot || settle_frames_ > 0 || animating())) {
-            glfwWaitEventsTimeout(kWatchInterval);
+            // Under MPI, a stop signal is seen within a fraction of mpirun's second before SIGKILL.
+            glfwWaitEventsTimeout(ranks_ ? kSignalInterval : kWatchInterval);
             continue;
         }
         settle_frames_ = input_seen_ ? kSettleFrames : std::max(0, settle_frames_ - 1);

@@ -23,7 +23,9 @@ namespace kr::viewer {
 
 class ViewerApp {
 public:
-    explicit ViewerApp(ViewOptions options);
+    // With `ranks` (rank 0 of `mpirun -np N keithray view`), full passes are shared with the
+    // other ranks, and a stop signal (mpirun ends the job when a rank dies) ends the session.
+    explicit ViewerApp(ViewOptions options, SharedPasses* ranks = nullptr);
     ~ViewerApp();
     ViewerApp(const ViewerApp&) = delete;
     ViewerApp& operator=(const ViewerApp&) = delete;
@@ -51,8 +53,12 @@ private:
     void request_quit();
     void toggle_fullscreen();
     Rgb8Image read_image_region(const PixelRect& rect) const;
+    // The MPI job is ending (a stop signal): says so in the window and on standard error, then
+    // ends the process with status 1 at once (the render thread may be waiting on a dead rank).
+    [[noreturn]] void end_with_the_job();
 
     ViewOptions options_;
+    SharedPasses* ranks_;
     GLFWwindow* window_ = nullptr;
     GlFunctions gl_;
     std::unique_ptr<Display> display_;

@@ -9,7 +9,7 @@
 
 namespace kr::viewer {
 
-int run_viewer(int argc, char** argv) {
+int run_viewer(int argc, char** argv, SharedPasses* ranks) {
     ViewOptions options;
     try {
         options = parse_view_options(argc, argv);
@@ -26,7 +26,7 @@ int run_viewer(int argc, char** argv) {
         return 1;
     }
     try {
-        ViewerApp app(std::move(options));
+        ViewerApp app(std::move(options), ranks);
         return app.run();
     } catch (const std::exception& e) {
         std::fprintf(stderr, "error: %s\n", e.what());
