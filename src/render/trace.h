@@ -62,9 +62,9 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
 
 // What trace_samples runs for path tracing with these settings on this scene, as the
 // settings' kernels, the CPU and the scene decide.
-enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path };
-inline constexpr EnumNames<PacketKernels, 4> packet_kernels_names{
-    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path"}};
+enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_v4_float };
+inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
+    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
