@@ -7,12 +7,13 @@
 // functions as one path (path.h). So every path is the one trace_sample gives, up to
 // rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
 //
-// The kernels are in packet_lanes.inc, compiled three times: four double lanes for any
-// x86-64 CPU and for x86-64-v3 (AVX2, FMA), and eight single-precision lanes for x86-64-v3.
-// The v3 ones run where the CPU has those (the CPU is asked once, at the first call): the
-// single-precision lanes where float_lanes_fit says the scene's sizes and radiances keep
-// their rounding far below what an image shows (they then agree with one path to about 1e-6
-// per step; tests/test_packet.cpp), the double ones elsewhere. Without AVX2 paths are traced
+// The kernels are in packet_lanes.inc, compiled four times: four double lanes for any
+// x86-64 CPU and for x86-64-v3 (AVX2, FMA), eight single-precision lanes for x86-64-v3 and
+// sixteen for x86-64-v4 (AVX-512). The v3 ones run where the CPU has those (the CPU is asked
+// once, at the first call): the single-precision lanes where float_lanes_fit says the
+// scene's sizes and radiances keep their rounding far below what an image shows (they then
+// agree with one path to about 1e-6 per step; tests/test_packet.cpp), sixteen of them where
+// the CPU has AVX-512; the double ones elsewhere. Without AVX2 paths are traced
 // one at a time: GCC emulates what SSE2 lacks (64-bit compares, per-lane shifts, 32-bit
 // multiplies) lane by lane, so the kernels for any CPU are 2.5 times slower than one path at
 // a time (docs/performance.md); they run only when the settings' `kernels` ask for them, for
