@@ -246,7 +246,7 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     EXPECT_EQ(r.out.find("| x86-64 lanes |"), std::string::npos) << r.out;
     r = cli("bench --throughput --kernels avx9");
     EXPECT_EQ(r.status, 2);
-    EXPECT_NE(r.err.find("\"best\", \"double\", \"any\" or \"off\""), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("\"best\", \"double\", \"float8\", \"any\" or \"off\""), std::string::npos) << r.err;
     r = cli("bench --stress 20 --runs 1 --size 16");
     EXPECT_EQ(r.status, 0) << r.err;
     // One row per BVH: ours, and Embree's where the build has it.

@@ -42,7 +42,8 @@ bool close(double a, double b, double tolerance = 1e-9) { return std::abs(a - b)
 // 1e-4, 4 (one path of scene 3 under four light strategies) by more than 1e-3, the largest
 // by 0.7 %. A wrong factor or branch differs by far more, on many samples.
 double lane_tolerance(const RenderScene& scene, const RenderSettings& settings) {
-    return packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float ? 1e-2 : 1e-9;
+    const PacketKernels kernels = packet_kernels(scene, settings);
+    return kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float ? 1e-2 : 1e-9;
 }
 
 // `batches` batches of `count` camera samples of pixels spread over the image, traced together
@@ -120,7 +121,8 @@ protected:
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, PacketIsa::double_lanes, PacketIsa::best),
+INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, PacketIsa::double_lanes, PacketIsa::float8,
+                                                             PacketIsa::best),
                          [](const ::testing::TestParamInfo<PacketIsa>& info) {
                              return ::testing::PrintToString(info.param);
                          });
@@ -145,11 +147,21 @@ TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
     settings.kernels = PacketIsa::double_lanes;
     const PacketKernels v3 = packet_kernels(brief, settings);
     EXPECT_TRUE(v3 == PacketKernels::x86_64_v3 || v3 == PacketKernels::one_path);
+    settings.kernels = PacketIsa::float8;
+    const PacketKernels float8 = packet_kernels(brief, settings);
+    EXPECT_EQ(float8, v3 == PacketKernels::x86_64_v3 ? PacketKernels::x86_64_v3_float : PacketKernels::one_path);
     settings.kernels = PacketIsa::best;
     const PacketKernels best = packet_kernels(brief, settings);
-    EXPECT_EQ(best, v3 == PacketKernels::x86_64_v3 ? PacketKernels::x86_64_v3_float : PacketKernels::one_path);
+    // The sixteen float lanes where the CPU has AVX-512, else the eight.
+    EXPECT_TRUE(best == float8 || (float8 == PacketKernels::x86_64_v3_float && best == PacketKernels::x86_64_v4_float));
     std::printf("best on this CPU: %s\n", std::string(packet_kernels_names.name(best)).c_str());
-#if KEITHRAY_V3_KERNELS_EXPECTED
+#if KEITHRAY_V4_KERNELS_EXPECTED
+    // CMake built the kernels (GCC's pragmas, or the Clang sanitizer builds' whole-file
+    // -march=x86-64-v4) and saw AVX-512: so every build, sanitized ones too, runs the sixteen
+    // float lanes here, and the eight where asked.
+    EXPECT_EQ(best, PacketKernels::x86_64_v4_float);
+    EXPECT_EQ(float8, PacketKernels::x86_64_v3_float);
+#elif KEITHRAY_V3_KERNELS_EXPECTED
     // CMake built the v3 kernels (GCC's pragma, or the Clang sanitizer builds' whole-file
     // -march) and saw AVX2 and FMA: so every build, sanitized ones too, runs them here.
     EXPECT_EQ(best, PacketKernels::x86_64_v3_float);

@@ -29,7 +29,7 @@ namespace {
 
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
-                 [--kernels best|double|any|off] [--lens R]
+                 [--kernels best|double|float8|any|off] [--lens R]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
@@ -44,10 +44,12 @@ constexpr const char* kBenchUsage = R"(Usage:
               and prints that row with its speed as a fraction of the other's.
 --linear      test every sphere per ray instead of the BVH (the plain path, for comparison).
 --kernels     how paths are traced: best (default: in SIMD lanes with the AVX2/FMA
-              kernels where the CPU has them, eight in single precision where the
-              scene's sizes allow, else four in double; one at a time without AVX2),
-              double (always the four double lanes), any (in lanes with the kernels for
-              any x86-64 CPU, SSE2) or off (one at a time), to measure what each buys.
+              kernels where the CPU has them, in single precision where the scene's
+              sizes allow, sixteen at a time with AVX-512, else eight; else four in
+              double; one at a time without AVX2), double (always the four double
+              lanes), float8 (the eight float lanes even with AVX-512), any (in lanes
+              with the kernels for any x86-64 CPU, SSE2) or off (one at a time), to
+              measure what each buys.
               The table's last column says which ran for each scene.
 --stress      generated scenes of N random spheres (and a floor and a lamp, two spheres
               more) under a sphere light, path traced at W x W (default 256) with 4 spp:

@@ -66,10 +66,11 @@ constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map t
                         offscreen OSMesa framebuffer (no display, no GPU needed)
   --blur R              box blur of radius R pixels on the radiance, 0..4096 (default: 0)
   --threads N           worker threads, 1..4096 (default: all cores)
-  --kernels NAME        how paths are traced: best | double | any | off (default: best,
-                        in SIMD lanes where the CPU has AVX2: eight in single precision
-                        where the scene's sizes allow, else four in double; double keeps
-                        the four double lanes; docs/performance.md)
+  --kernels NAME        how paths are traced: best | double | float8 | any | off (default:
+                        best, in SIMD lanes where the CPU has AVX2: in single precision
+                        where the scene's sizes allow, sixteen at a time with AVX-512, else
+                        eight; else four in double; double keeps the four double lanes,
+                        float8 the eight float ones; docs/performance.md)
   -o OUT.ppm            write OUT.ppm and OUT-depth.ppm instead of the file's "output"
                         (only with a single scene); OUT.png writes PNGs instead;
                         OUT.exr one OpenEXR with the radiance and its layers; OUT.pfm

@@ -7,12 +7,13 @@
 // functions as one path (path.h). So every path is the one trace_sample gives, up to
 // rounding. docs/performance.md ("Paths in lanes" and after) has what it buys.
 //
-// The kernels are in packet_lanes.inc, compiled three times: four double lanes for any
-// x86-64 CPU and for x86-64-v3 (AVX2, FMA), and eight single-precision lanes for x86-64-v3.
-// The v3 ones run where the CPU has those (the CPU is asked once, at the first call): the
-// single-precision lanes where float_lanes_fit says the scene's sizes and radiances keep
-// their rounding far below what an image shows (they then agree with one path to about 1e-6
-// per step; tests/test_packet.cpp), the double ones elsewhere. Without AVX2 paths are traced
+// The kernels are in packet_lanes.inc, compiled four times: four double lanes for any
+// x86-64 CPU and for x86-64-v3 (AVX2, FMA), eight single-precision lanes for x86-64-v3 and
+// sixteen for x86-64-v4 (AVX-512). The v3 ones run where the CPU has those (the CPU is asked
+// once, at the first call): the single-precision lanes where float_lanes_fit says the
+// scene's sizes and radiances keep their rounding far below what an image shows (they then
+// agree with one path to about 1e-6 per step; tests/test_packet.cpp), sixteen of them where
+// the CPU has AVX-512; the double ones elsewhere. Without AVX2 paths are traced
 // one at a time: GCC emulates what SSE2 lacks (64-bit compares, per-lane shifts, 32-bit
 // multiplies) lane by lane, so the kernels for any CPU are 2.5 times slower than one path at
 // a time (docs/performance.md); they run only when the settings' `kernels` ask for them, for
@@ -34,6 +35,12 @@
 // KEITHRAY_CLANG_V3_KERNELS asks, instead of the target pragma below (CMakeLists.txt).
 #if defined(KR_PACKET_FILE_V3) && defined(__AVX2__) && defined(__FMA__) && !defined(KR_X86_64_V3)
 #define KR_X86_64_V3 1
+#endif
+// The sixteen float lanes (x86-64-v4: AVX-512 F, BW, DQ, VL) beside them: GCC by its target
+// pragma wherever it builds the v3 kernels, Clang where CMake compiles the file for x86-64-v4.
+#if defined(KR_X86_64_V3) && (!defined(KR_PACKET_FILE_V3) || (defined(__AVX512F__) && defined(__AVX512BW__) && \
+                                                             defined(__AVX512DQ__) && defined(__AVX512VL__)))
+#define KR_X86_64_V4 1
 #endif
 
 #ifdef KR_X86_64_V3
@@ -98,6 +105,25 @@ namespace packet_f8 {
 #endif
 #endif
 
+#ifdef KR_X86_64_V4
+#ifndef KR_PACKET_FILE_V3
+#pragma GCC push_options
+#pragma GCC target("arch=x86-64-v4")
+#endif
+// Sixteen single-precision lanes: the same source as packet_f8 (KR_PACKET_FLOAT8: single
+// precision), KR_PACKET_FLOAT16 picking the AVX-512 forms of its few intrinsics.
+#define KR_PACKET_FLOAT8
+#define KR_PACKET_FLOAT16
+namespace packet_f16 {
+#include "render/packet_lanes.inc"
+}  // namespace packet_f16
+#undef KR_PACKET_FLOAT16
+#undef KR_PACKET_FLOAT8
+#ifndef KR_PACKET_FILE_V3
+#pragma GCC pop_options
+#endif
+#endif
+
 namespace {
 
 bool cpu_has_v3() {
@@ -116,11 +142,34 @@ bool cpu_has_v3() {
 #endif
 }
 
+bool cpu_has_v4() {
+#ifdef KR_X86_64_V4
+    static const bool has = [] {
+        __builtin_cpu_init();
+#ifdef __clang__  // as above: the AVX-512 subsets x86-64-v4 names
+        return cpu_has_v3() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw") &&
+               __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512vl");
+#else
+        return __builtin_cpu_supports("x86-64-v4") != 0;
+#endif
+    }();
+    return has;
+#else
+    return false;
+#endif
+}
+
+// The single-precision lanes the CPU runs best: sixteen with AVX-512, else eight.
+PacketKernels float_kernels() {
+    return cpu_has_v4() ? PacketKernels::x86_64_v4_float : PacketKernels::x86_64_v3_float;
+}
+
 // The kernels the CPU and the settings pick, before a scene has a say (camera rays are the
 // double lanes' in both kinds of v3 lanes).
 PacketKernels isa_kernels(const RenderSettings& settings) {
     switch (settings.kernels) {
-    case PacketIsa::best: return cpu_has_v3() ? PacketKernels::x86_64_v3_float : PacketKernels::one_path;
+    case PacketIsa::best: return cpu_has_v3() ? float_kernels() : PacketKernels::one_path;
+    case PacketIsa::float8: return cpu_has_v3() ? PacketKernels::x86_64_v3_float : PacketKernels::one_path;
     case PacketIsa::double_lanes: return cpu_has_v3() ? PacketKernels::x86_64_v3 : PacketKernels::one_path;
     case PacketIsa::any: return PacketKernels::x86_64;
     case PacketIsa::one_path: return PacketKernels::one_path;
@@ -159,7 +208,9 @@ bool float_lanes_fit(const RenderScene& scene) {
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
     if (!packets_apply(scene, settings)) return PacketKernels::one_path;
     const PacketKernels kernels = isa_kernels(settings);
-    if (kernels == PacketKernels::x86_64_v3_float && !float_lanes_fit(scene)) return PacketKernels::x86_64_v3;
+    if ((kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float) &&
+        !float_lanes_fit(scene))
+        return PacketKernels::x86_64_v3;
     return kernels;
 }
 
@@ -167,6 +218,7 @@ void camera_rays(const RenderScene& scene, const RenderSettings& settings, int w
                  const int* ys, Sampler* const* samplers, int count, Ray* rays) {
     switch (isa_kernels(settings)) {
 #ifdef KR_X86_64_V3
+    case PacketKernels::x86_64_v4_float:
     case PacketKernels::x86_64_v3_float:
     case PacketKernels::x86_64_v3: return packet_v3::camera_rays(scene, width, height, xs, ys, samplers, count, rays);
 #endif
@@ -184,6 +236,10 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
             rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
     const PacketKernels kernels = packet_kernels(scene, settings);
     if (camera_rays && count > 1 && kernels != PacketKernels::one_path) {
+#ifdef KR_X86_64_V4
+        if (kernels == PacketKernels::x86_64_v4_float)
+            return packet_f16::trace_packet(scene, settings, rays, samplers, count, results);
+#endif
 #ifdef KR_X86_64_V3
         if (kernels == PacketKernels::x86_64_v3_float)
             return packet_f8::trace_packet(scene, settings, rays, samplers, count, results);
@@ -201,7 +257,12 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
 #ifdef KR_X86_64_V3
     bool sobol = count > 1;
     for (int k = 0; k < count && sobol; ++k) sobol = samplers[k]->sobol() && samplers[k]->dimension() == 0;
-    if (sobol && packet_kernels(scene, settings) == PacketKernels::x86_64_v3_float)
+    const PacketKernels kernels = sobol ? packet_kernels(scene, settings) : PacketKernels::one_path;
+#ifdef KR_X86_64_V4
+    if (kernels == PacketKernels::x86_64_v4_float)
+        return packet_f16::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
+#endif
+    if (kernels == PacketKernels::x86_64_v3_float)
         return packet_f8::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
 #endif
     Ray rays[kSampleBatch];

@@ -45,12 +45,13 @@ void camera_rays(const RenderScene& scene, const RenderSettings& settings, int w
                  Sampler* const* samplers, int count, Ray* rays);
 
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
-// camera rays in SIMD lanes (packet.cpp: eight paths in single precision, or four in double,
-// as packet_kernels() below says), a lane starting the next sample as its path ends, where
-// the scene is one leaf of our BVH; anything else goes one by one through trace_sample.
-// render_pass hands it up to kSampleBatch samples: the more, the less time lanes idle at the
-// batch's end.
-inline constexpr int kSampleBatch = 64;
+// camera rays in SIMD lanes (packet.cpp: sixteen or eight paths in single precision, or four
+// in double, as packet_kernels() below says), a lane starting the next sample as its path
+// ends, where the scene is one leaf of our BVH; anything else goes one by one through
+// trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less time
+// lanes idle at the batch's end (128 against 64: sixteen lanes 3 to 7 % less task-clock on
+// scenes 3 and 8; docs/performance.md).
+inline constexpr int kSampleBatch = 128;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);
 
@@ -62,9 +63,9 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
 
 // What trace_samples runs for path tracing with these settings on this scene, as the
 // settings' kernels, the CPU and the scene decide.
-enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path };
-inline constexpr EnumNames<PacketKernels, 4> packet_kernels_names{
-    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path"}};
+enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_v4_float };
+inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
+    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
