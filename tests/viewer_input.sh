@@ -18,7 +18,12 @@ wait_for() {
     local end=$((SECONDS + limit))
     while ((SECONDS < end)); do
         [[ -f $status ]] && grep -Eq "$1" "$status" && return 0
-        kill -0 $pid 2>/dev/null || { echo "error=viewer exited waiting for $1"; return 1; }
+        if ! kill -0 $pid 2>/dev/null; then
+            # What the viewer said on its way out, for the failure's message.
+            wait $pid
+            echo "error=viewer exited (status $?) waiting for $1; its stderr: $(tail -c 400 "$dir/view.err" | tr '\n' ' ')"
+            return 1
+        fi
         sleep 0.1
     done
     echo "error=timed out waiting for $1 (status: $(cat "$status" 2>/dev/null))"
