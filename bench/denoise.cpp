@@ -1,24 +1,35 @@
 // docs/denoising.md's figures: the denoiser's error against a converged reference, raw and
 // denoised, at several sample counts, and its cost.
-//   keithray_bench_denoise cost [ROUNDS]
+//   keithray_bench_denoise cost [ROUNDS [SCENE [FINAL_ROUNDS]]]
 //       each filter alone on scene 3's 4 spp estimates at 512x512 and 1920x1080 (medians of
-//       ROUNDS runs of the a-trous filter, of at most 3 of the final one; OMP_NUM_THREADS sets
-//       the threads)
+//       ROUNDS runs of the a-trous filter, of at most FINAL_ROUNDS (3) of the final one;
+//       OMP_NUM_THREADS sets the threads)
 //   keithray_bench_denoise error SIZE REFERENCE_SPP SPP,SPP,... SCENE.json...
 //       each scene at SIZE x SIZE: a reference at REFERENCE_SPP (seed 99, exact light
 //       sampling), then renders at each SPP (seed 1) raw and denoised by each filter (the
 //       interactive a-trous and the final one): relMSE (luminance, over ref^2 + 0.01) and PSNR
-//       of the sRGB-tone-mapped 8-bit images against the reference's
+//       of the sRGB-tone-mapped 8-bit images against the reference's. The relMSE is printed
+//       twice: as measured, and less the reference's own noise (per pixel the variance of its
+//       mean luminance over the same denominator, which the squared difference to an
+//       independent reference carries on top of the image's own error: an estimate of the
+//       error against the converged image, unbiased but for the denominator, which holds the
+//       noisy reference; the same term is subtracted for every image).
+//       With KR_BENCH_CACHE=DIR the renders are kept there as checkpoints and read back by a
+//       later run with the same scene, size, spp and seed (the filters are all that reruns).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <ctime>
+#include <filesystem>
 #include <string>
 #include <vector>
 
+#include "core/file_write.h"
 #include "core/image.h"
 #include "render/aov.h"
+#include "render/checkpoint.h"
 #include "render/outputs.h"
 #include "render/progressive.h"
 #include "scene/load.h"
@@ -45,13 +56,27 @@ Prepared prepare(const std::string& file, int width, int height, bool exact_ligh
     return p;
 }
 
-RenderState render(const Prepared& p, int spp, uint64_t seed) {
+RenderState render(const Prepared& p, int spp, uint64_t seed, const std::string& cache_name = "") {
     RenderSettings s = p.settings;
     s.seed = seed;
     RenderState state(p.scene.renderer.width, p.scene.renderer.height);
     state.track_halves();  // as render --denoise does
     StopRule rule;
     rule.max_passes = spp;
+    const char* dir = std::getenv("KR_BENCH_CACHE");
+    std::filesystem::path cached;
+    if (dir && *dir && !cache_name.empty()) {
+        cached = std::filesystem::path(dir) / (cache_name + "-" + std::to_string(p.scene.renderer.width) + "-" +
+                                               std::to_string(spp) + "-" + std::to_string(seed) + ".ckpt");
+        const CheckpointKey key = checkpoint_key(p.scene, p.rs, s, rule);
+        if (std::filesystem::exists(cached)) {
+            decode_checkpoint(read_checkpoint_file(cached, key), cached, key, state);
+            return state;
+        }
+        render_until(p.rs, s, state, rule);
+        write_file_atomic(cached, encode_checkpoint(key, state));
+        return state;
+    }
     render_until(p.rs, s, state, rule);
     return state;
 }
@@ -63,6 +88,18 @@ double rel_mse(const Image& a, const Image& ref) {
         sum += d * d / (r * r + 0.01);
     }
     return sum / double(ref.pixels.size());
+}
+
+// The reference's own share of rel_mse: per pixel the variance of its mean luminance over the
+// same denominator (pixels of fewer than two samples count none).
+double reference_noise(const RenderState& ref) {
+    const Image mean = ref.radiance();
+    double sum = 0;
+    for (size_t i = 0; i < mean.pixels.size(); ++i) {
+        const double se = ref.pixel_standard_error(i), r = luminance(mean.pixels[i]);
+        if (std::isfinite(se)) sum += se * se / (r * r + 0.01);
+    }
+    return sum / double(mean.pixels.size());
 }
 
 double psnr_srgb(const Image& a, const Image& ref) {
@@ -78,12 +115,13 @@ double cpu_seconds() {
 }
 
 double median(std::vector<double> v) {
+    if (v.empty()) return NAN;
     std::sort(v.begin(), v.end());
     return v[v.size() / 2];
 }
 
-int cost(int rounds, const std::string& scene_file) {
-    const int final_rounds = std::min(rounds, 3);
+int cost(int rounds, const std::string& scene_file, int final_rounds) {
+    final_rounds = std::min(rounds, final_rounds);
     for (const auto [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
         const Prepared p = prepare(scene_file, w, h, false);
         const RenderState state = render(p, 4, 1);
@@ -140,12 +178,16 @@ int cost(int rounds, const std::string& scene_file) {
 }
 
 int error(int size, int reference_spp, const std::vector<int>& spps, const std::vector<std::string>& scenes) {
-    std::printf("scene | spp | relMSE raw | relMSE a-trous | relMSE final | PSNR raw | PSNR a-trous | PSNR final\n");
+    std::printf("scene | spp | relMSE raw | relMSE a-trous | relMSE final | PSNR raw | PSNR a-trous | PSNR final | "
+                "less the reference's noise: relMSE raw | a-trous | final\n");
     for (const std::string& file : scenes) {
         const Prepared p = prepare(file, size, size, true);
-        const Image reference = render(p, reference_spp, 99).radiance();
+        const std::string name = std::filesystem::path(file).stem().string();
+        const RenderState reference_state = render(p, reference_spp, 99, name);
+        const Image reference = reference_state.radiance();
+        const double ref_noise = reference_noise(reference_state);
         for (const int spp : spps) {
-            const RenderState state = render(p, spp, 1);
+            const RenderState state = render(p, spp, 1, name);
             DevelopOptions options;
             options.denoise = Denoise::on;
             options.sampling = p.settings;
@@ -155,11 +197,11 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
             const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
             options.interactive = false;
             const Developed final = develop(p.rs, estimates, options, kLayerRadiance);
-            std::printf("%s | %d | %.5f | %.5f | %.5f | %.2f | %.2f | %.2f\n",
-                        file.substr(file.find_last_of('/') + 1).c_str(), spp, rel_mse(final.raw, reference),
-                        rel_mse(fast.radiance, reference), rel_mse(final.radiance, reference),
-                        psnr_srgb(final.raw, reference), psnr_srgb(fast.radiance, reference),
-                        psnr_srgb(final.radiance, reference));
+            const double raw = rel_mse(final.raw, reference), atrous = rel_mse(fast.radiance, reference),
+                         filtered = rel_mse(final.radiance, reference);
+            std::printf("%s | %d | %.5f | %.5f | %.5f | %.2f | %.2f | %.2f | %.5f | %.5f | %.5f\n", name.c_str(), spp, raw,
+                        atrous, filtered, psnr_srgb(final.raw, reference), psnr_srgb(fast.radiance, reference),
+                        psnr_srgb(final.radiance, reference), raw - ref_noise, atrous - ref_noise, filtered - ref_noise);
             std::fflush(stdout);
         }
     }
@@ -170,7 +212,9 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
 
 int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "";
-    if (mode == "cost") return cost(argc > 2 ? std::stoi(argv[2]) : 15, argc > 3 ? argv[3] : "res/scenes/assignment_03.json");
+    if (mode == "cost")
+        return cost(argc > 2 ? std::stoi(argv[2]) : 15, argc > 3 ? argv[3] : "res/scenes/assignment_03.json",
+                    argc > 4 ? std::stoi(argv[4]) : 3);
     if (mode == "error" && argc > 5) {
         std::vector<int> spps;
         for (size_t at = 0; at < std::string(argv[4]).size();) {
@@ -183,6 +227,6 @@ int main(int argc, char** argv) {
         return error(std::stoi(argv[2]), std::stoi(argv[3]), spps, std::vector<std::string>(argv + 5, argv + argc));
     }
     std::fprintf(stderr,
-                 "usage: keithray_bench_denoise cost [ROUNDS [SCENE]] | error SIZE REFERENCE_SPP SPP,SPP,... SCENE...\n");
+                 "usage: keithray_bench_denoise cost [ROUNDS [SCENE [FINAL_ROUNDS]]] | error SIZE REFERENCE_SPP SPP,SPP,... SCENE...\n");
     return 2;
 }
