@@ -177,17 +177,24 @@ public:
         }
     }
 
-    // Samples row y: each pixel once, or as often as the plan says.
+    // Samples row y: each pixel (of the noise rule's mask, if any) once, or as often as the
+    // plan says.
     void sample_row(int y) {
         const bool sobol = settings_.estimator == Estimator::sobol;
-        if (pass_samples_) sobol ? sample_row<true, true>(y) : sample_row<false, true>(y);
+        if (active_) sobol ? sample_row<true, true>(y) : sample_row<false, true>(y);
         else sobol ? sample_row<true, false>(y) : sample_row<false, false>(y);
     }
 
     uint64_t rays = 0, nonfinite = 0;
 
 private:
-    template <bool kSobol, bool kPlanned>
+    template <bool kSobol, bool kActive>
+    void sample_row(int y) {
+        if (pass_samples_) sample_row<kSobol, kActive, true>(y);
+        else sample_row<kSobol, kActive, false>(y);
+    }
+
+    template <bool kSobol, bool kActive, bool kPlanned>
     void sample_row(int y) {
         // The row's pointers and the batch's fill in locals, so they stay in registers
         // (stores to the buffers could alias members).
@@ -195,17 +202,17 @@ private:
         const int width = state_.width;
         uint32_t* const index_of = sample_index_ + row;
         const uint32_t* const key_of = kSobol ? sobol_keys_ + row : nullptr;
-        const uint8_t* const active = active_ ? active_ + row : nullptr;
+        const uint8_t* const active = kActive ? active_ + row : nullptr;
         const uint8_t* const planned = kPlanned ? pass_samples_ + row : nullptr;
         int* const xs = xs_;
         int* const ys = ys_;
         size_t* const pixels = pixels_;
-        int pending = 0;
+        size_t pending = 0;
         // In a pass of one sample per pixel every pixel draws the same index, so its bit
         // reversal is kept from the pixel before.
         uint32_t last_index = 0, last_reversed = 0;
         for (int x = 0; x < width; ++x) {
-            if (active && !active[x]) continue;
+            if (kActive && !active[x]) continue;
             const uint32_t n = kPlanned ? planned[x] : 1;
             const uint32_t first = index_of[x];
             index_of[x] = first + n;
@@ -220,7 +227,7 @@ private:
                 xs[pending] = x;
                 ys[pending] = y;
                 pixels[pending] = row + size_t(x);
-                if (++pending == kSampleBatch) {
+                if (++pending == size_t(kSampleBatch)) {
                     flush(pending);
                     pending = 0;
                 }
@@ -229,7 +236,8 @@ private:
         if (pending > 0) flush(pending);
     }
 
-    __attribute__((noinline)) void flush(int count) {
+    __attribute__((noinline)) void flush(size_t count_of) {
+        const int count = int(count_of);
         trace_camera_samples(scene_, settings_, state_.width, state_.height, xs_, ys_, samplers_, count, results_);
         accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
     }
