@@ -121,7 +121,10 @@ __attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums
         }
         store_xyz(sum, t);
         double* lost = &sums.compensation[i].x;
-        store_xyz(lost, _mm256_maskload_pd(lost, xyz) + two_sum_error(s, x, t));
+        // two_sum_error(s, x, t) written out: Clang passes no AVX vector to a function
+        // compiled without AVX.
+        const __m256d x_part = t - s;
+        store_xyz(lost, _mm256_maskload_pd(lost, xyz) + ((s - (t - x_part)) + (x - x_part)));
         sums.depth[i] += r.primary_distance;
         const double lum = luminance(r.radiance);
         sums.luminance_sq[i] += lum * lum;
