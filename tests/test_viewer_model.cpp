@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -224,6 +225,51 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
         EXPECT_NEAR(mean[k], radiance[k], 1e-12 * radiance[k]);
         EXPECT_GT(std::abs(plain[k] - radiance[k]), 1e-13 * radiance[k]);  // what the correction is for
     }
+}
+
+// render_pass's two ways of adding samples to their pixels (SSE2, and AVX2 where the CPU has
+// it) give the same sums bit for bit, over samples of every size, repeated pixels, samples
+// that are NaN or infinite, and one that would overflow its pixel's sum (all dropped).
+TEST(Accumulation, Avx2SumsAreSse2sBitForBit) {
+    if (!accumulation_isa_available(AccumulationIsa::avx2)) GTEST_SKIP() << "this CPU has no AVX2";
+    const size_t pixels = 7;
+    std::vector<size_t> where;
+    std::vector<SampleResult> results;
+    Rng rng(42, 7);
+    for (int k = 0; k < 4000; ++k) {
+        SampleResult r;
+        const double scale = std::pow(10.0, 12 * rng.next() - 6);
+        r.radiance = Color(scale * rng.next(), scale * rng.next(), scale * rng.next() * (rng.next() < 0.1 ? 0 : 1));
+        r.primary_distance = rng.next() < 0.2 ? kMissDepth : 10 * rng.next();
+        r.rays = 1 + uint64_t(rng.next() * 5);
+        if (k % 97 == 5) r.radiance.y = std::nan("");
+        if (k % 89 == 7) r.radiance.z = kInfinity;
+        if (k == 3000) r.radiance.x = 1e308;  // pixel 3000 % 7's sum, then this one, overflows
+        where.push_back(size_t(k) % pixels);
+        results.push_back(r);
+    }
+    where[3001] = where[3000];
+    results[3001].radiance.x = 1e308;
+    RenderState a(int(pixels), 1), b(int(pixels), 1);
+    uint64_t dropped_a = 0, dropped_b = 0;
+    for (size_t first = 0; first < results.size(); first += kSampleBatch) {
+        const int n = int(std::min<size_t>(kSampleBatch, results.size() - first));
+        accumulate_samples(a.buffers(), &where[first], &results[first], n, AccumulationIsa::sse2, dropped_a);
+        accumulate_samples(b.buffers(), &where[first], &results[first], n, AccumulationIsa::avx2, dropped_b);
+    }
+    EXPECT_EQ(dropped_a, dropped_b);
+    EXPECT_GT(dropped_a, 80u);  // the NaN, infinite and overflowing samples
+    const auto same_bits = [](const auto& x, const auto& y) {
+        return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+    };
+    const PixelBuffers &pa = a.buffers(), &pb = b.buffers();
+    EXPECT_TRUE(same_bits(pa.radiance_sum, pb.radiance_sum));
+    EXPECT_TRUE(same_bits(pa.radiance_compensation, pb.radiance_compensation));
+    EXPECT_TRUE(same_bits(pa.depth_sum, pb.depth_sum));
+    EXPECT_TRUE(same_bits(pa.luminance_sq_sum, pb.luminance_sq_sum));
+    EXPECT_TRUE(same_bits(pa.radiance_sq_sum, pb.radiance_sq_sum));
+    EXPECT_TRUE(same_bits(pa.sample_count, pb.sample_count));
+    for (const Color& lost : pa.radiance_compensation) EXPECT_TRUE(is_finite(lost));
 }
 
 TEST(RenderThread, PreviewScalesFitTheBudget) {

@@ -15,20 +15,37 @@ namespace {
 // image, so the neighbours guard against that. Separable, in two loops over rows: first
 // each row's 3-wide sums, then the guarded value from three rows of those sums.
 void sum_three_along_row(const double* values, double* sums, size_t width) {
-    for (size_t x = 0; x < width; ++x)
-        sums[x] = (x > 0 ? values[x - 1] : 0.0) + values[x] + (x + 1 < width ? values[x + 1] : 0.0);
+    if (width == 1) {
+        sums[0] = (0.0 + values[0]) + 0.0;
+        return;
+    }
+    // The ends apart, so the loop between has no test (the same sums, the same order).
+    sums[0] = (0.0 + values[0]) + values[1];
+    for (size_t x = 1; x + 1 < width; ++x) sums[x] = (values[x - 1] + values[x]) + values[x + 1];
+    sums[width - 1] = (values[width - 2] + values[width - 1]) + 0.0;
 }
 
-// At pixel x of row y, whose row starts at `start` in the buffers (and the rows above and
-// below at their own starts, where they are in the image).
-double guarded_3x3(const RenderState& state, const std::vector<double>& values, const std::vector<double>& row_sums,
-                   int y, size_t start, size_t x) {
-    const size_t i = start + x;
-    double sum = row_sums[i], cells = 1.0;
-    if (y > 0) sum += row_sums[state.row_start(y - 1) + x], cells += 1.0;
-    if (y + 1 < state.height) sum += row_sums[state.row_start(y + 1) + x], cells += 1.0;
-    cells *= 1.0 + (x > 0) + (x + 1 < size_t(state.width));
-    return std::max(values[i], sum / cells);
+// The guarded values of one row: `values` and `sums` (its 3-wide sums) at the row's start,
+// `above` and `below` the 3-wide sums of the rows around it (nullptr outside the image);
+// calls guarded(x, value) in order of x.
+template <class F>
+void guard_row(const double* values, const double* sums, const double* above, const double* below, size_t width,
+               F&& guarded) {
+    // The cells each mean is over: 3 rows (or 2 at an edge) times 3 columns (2 at an edge),
+    // exact small integers.
+    double rows = 1.0;
+    if (above) rows += 1.0;
+    if (below) rows += 1.0;
+    const double inner = rows * 3.0, edge = rows * (width > 1 ? 2.0 : 1.0);
+    const auto at = [&](size_t x, double cells) {
+        double sum = sums[x];
+        if (above) sum += above[x];
+        if (below) sum += below[x];
+        guarded(x, std::max(values[x], sum / cells));
+    };
+    at(0, edge);
+    for (size_t x = 1; x + 1 < width; ++x) at(x, inner);
+    if (width > 1) at(width - 1, edge);
 }
 
 }  // namespace
@@ -64,14 +81,16 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples, const R
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
         const size_t start = row_start(y);
+        const double* const above = y > 0 ? row_sums.data() + row_start(y - 1) : nullptr;
+        const double* const below = y + 1 < height ? row_sums.data() + row_start(y + 1) : nullptr;
+        const uint32_t* const samples = px_.sample_count.data() + start;
+        uint8_t* const active = px_.active.data() + start;
         size_t count = 0;
-        for (size_t x = 0; x < w; ++x) {
-            const size_t i = start + x;
-            const bool needs_more =
-                px_.sample_count[i] < min_samples || !(guarded_3x3(*this, error_sq, row_sums, y, start, x) <= allowed);
-            px_.active[i] = needs_more;
+        guard_row(error_sq.data() + start, row_sums.data() + start, above, below, w, [&](size_t x, double guarded) {
+            const bool needs_more = samples[x] < min_samples || !(guarded <= allowed);
+            active[x] = needs_more;
             count += needs_more;
-        }
+        });
         row_count[size_t(y)] = double(count);
     }
     if (share) share->combine(row_count, 1);
@@ -100,11 +119,20 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     variance.resize(n);
     row_sums.resize(n);
     weight.resize(n);
+    // The buffers' data as locals: the plan's byte stores may alias any member.
+    const uint32_t* const count = px_.sample_count.data();
+    const Color* const radiance = px_.radiance_sum.data();
+    const double* const luminance_sq = px_.luminance_sq_sum.data();
+    const uint8_t* const active = px_.active.empty() ? nullptr : px_.active.data();
+    double* const variance_of = variance.data();
+    double* const row_sums_of = row_sums.data();
+    double* const weight_of = weight.data();
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
         const size_t start = row_start(guarded[k]);
-        for (size_t i = start; i < start + w; ++i) variance[i] = sample_variance(i);
-        sum_three_along_row(&variance[start], &row_sums[start], w);
+        for (size_t i = start; i < start + w; ++i)
+            variance_of[i] = luminance_sample_variance(count[i], radiance[i], luminance_sq[i]);
+        sum_three_along_row(variance_of + start, row_sums_of + start, w);
     }
     // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
     // standard deviation; per row, the sum of the weights and the active pixels.
@@ -113,16 +141,19 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
         const size_t start = row_start(y);
+        const double* const above = y > 0 ? row_sums_of + row_start(y - 1) : nullptr;
+        const double* const below = y + 1 < height ? row_sums_of + row_start(y + 1) : nullptr;
         double row_weight = 0;
         size_t row_active = 0;
-        for (size_t x = 0; x < w; ++x) {
-            const size_t i = start + x;
-            const bool on = px_.active.empty() || px_.active[i];
-            const double guarded_variance = guarded_3x3(*this, variance, row_sums, y, start, x);
-            weight[i] = on && std::isfinite(guarded_variance) ? std::sqrt(guarded_variance) : 0.0;
-            row_weight += weight[i];
+        double* const row_weight_of = weight_of + start;
+        const uint8_t* const row_on = active ? active + start : nullptr;
+        guard_row(variance_of + start, row_sums_of + start, above, below, w, [&](size_t x, double guarded_variance) {
+            const bool on = !row_on || row_on[x];
+            const double weight_x = on && std::isfinite(guarded_variance) ? std::sqrt(guarded_variance) : 0.0;
+            row_weight_of[x] = weight_x;
+            row_weight += weight_x;
             row_active += on;
-        }
+        });
         row_weight_active[2 * size_t(y)] = row_weight;
         row_weight_active[2 * size_t(y) + 1] = double(row_active);
     }
@@ -141,21 +172,23 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     }
     px_.sample_credit.resize(n, 0.0f);
     px_.pass_samples.resize(n);
+    float* const credit_of = px_.sample_credit.data();
+    uint8_t* const take_of = px_.pass_samples.data();
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         const size_t start = row_start(own[k]);
         for (size_t i = start; i < start + w; ++i) {
-            if (!(px_.active.empty() || px_.active[i])) {
-                px_.pass_samples[i] = 0;
+            if (active && !active[i]) {
+                take_of[i] = 0;
                 continue;
             }
             // Quotas sum to the active pixel count: the pass costs what a uniform one does.
-            const double quota = (weight[i] + floor) * quota_scale;
-            const double credit = std::min<double>(px_.sample_credit[i] + quota, 4 * kMaxPassSamples);
+            const double quota = (weight_of[i] + floor) * quota_scale;
+            const double credit = std::min<double>(credit_of[i] + quota, 4 * kMaxPassSamples);
             const int take = std::min(int(credit), kMaxPassSamples);
-            px_.pass_samples[i] = static_cast<uint8_t>(take);
-            px_.sample_credit[i] = static_cast<float>(credit - take);
+            take_of[i] = static_cast<uint8_t>(take);
+            credit_of[i] = static_cast<float>(credit - take);
         }
     }
 }

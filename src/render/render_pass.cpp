@@ -1,8 +1,14 @@
 #include "render/render_pass.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <new>
 #include <type_traits>
+
+#if defined(__GNUC__) && defined(__x86_64__)
+#include <immintrin.h>
+#define KR_ACCUMULATE_AVX2 1
+#endif
 
 #include "render/sampler.h"
 #include "render/trace.h"
@@ -69,7 +75,206 @@ struct PixelSums {
     }
 };
 
+// A batch's samples added to their pixels in the order they were drawn (PixelSums::add each).
+void accumulate_sse2(const PixelSums& pixel_sums, const size_t* pixels, const SampleResult* results, int count,
+                     uint64_t& rays, uint64_t& nonfinite) {
+    const PixelSums sums = pixel_sums;  // in registers, not reloaded after each store
+    uint64_t batch_rays = 0, dropped = 0;
+    for (int k = 0; k < count; ++k) {
+        batch_rays += results[k].rays;
+        dropped += !sums.add(pixels[k], results[k]);
+    }
+    rays += batch_rays;
+    nonfinite += dropped;
+}
+
+#ifdef KR_ACCUMULATE_AVX2
+// The same with a colour's three channels in one AVX register: the same IEEE operations per
+// channel as PixelSums::add, so the same sums bit for bit, in about two thirds of its
+// instructions. (No FMA in this target, so no product is fused into a sum.)
+__attribute__((target("avx2"))) inline void store_xyz(double* p, __m256d v) {
+    _mm_storeu_pd(p, _mm256_castpd256_pd128(v));
+    _mm_store_sd(p + 2, _mm256_extractf128_pd(v, 1));
+}
+
+__attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums, const size_t* pixels,
+                                                     const SampleResult* results, int count, uint64_t& rays,
+                                                     uint64_t& nonfinite) {
+    static_assert(offsetof(SampleResult, primary_distance) == 3 * sizeof(double), "one load reads a result's colour");
+    const PixelSums sums = pixel_sums;
+    const __m256i xyz = _mm256_setr_epi64x(-1, -1, -1, 0);  // the lanes of a Color read from a pixel's sums
+    const __m256d zero = _mm256_setzero_pd();
+    uint64_t batch_rays = 0, dropped = 0;
+    for (int k = 0; k < count; ++k) {
+        const SampleResult& r = results[k];
+        const size_t i = pixels[k];
+        batch_rays += r.rays;
+        // The sample's colour, its fourth lane (the depth) cleared, and the new sums.
+        const __m256d x = _mm256_blend_pd(_mm256_loadu_pd(&r.radiance.x), zero, 0b1000);
+        double* sum = &sums.radiance[i].x;
+        const __m256d s = _mm256_maskload_pd(sum, xyz);
+        const __m256d t = s + x;
+        // Finite (the sample, and the sum not overflowed): t - t is 0 in every lane.
+        if (_mm256_movemask_pd(_mm256_cmp_pd(t - t, zero, _CMP_EQ_OQ)) != 0b1111) {
+            ++dropped;
+            continue;
+        }
+        store_xyz(sum, t);
+        double* lost = &sums.compensation[i].x;
+        // two_sum_error(s, x, t) written out: Clang passes no AVX vector to a function
+        // compiled without AVX.
+        const __m256d x_part = t - s;
+        store_xyz(lost, _mm256_maskload_pd(lost, xyz) + ((s - (t - x_part)) + (x - x_part)));
+        sums.depth[i] += r.primary_distance;
+        const double lum = luminance(r.radiance);
+        sums.luminance_sq[i] += lum * lum;
+        double* sq = &sums.radiance_sq[i].x;
+        store_xyz(sq, _mm256_maskload_pd(sq, xyz) + x * x);
+        sums.count[i] += 1;
+    }
+    rays += batch_rays;
+    nonfinite += dropped;
+}
+#endif
+
+bool avx2_accumulation() {
+#ifdef KR_ACCUMULATE_AVX2
+    static const bool has = __builtin_cpu_supports("avx2");
+    return has;
+#else
+    return false;
+#endif
+}
+
+void accumulate(const PixelSums& sums, const size_t* pixels, const SampleResult* results, int count,
+                bool avx2, uint64_t& rays, uint64_t& nonfinite) {
+#ifdef KR_ACCUMULATE_AVX2
+    if (avx2) return accumulate_avx2(sums, pixels, results, count, rays, nonfinite);
+#endif
+    (void)avx2;
+    accumulate_sse2(sums, pixels, results, count, rays, nonfinite);
+}
+
+PixelSums pixel_sums_of(PixelBuffers& px) {
+    return {px.radiance_sum.data(), px.radiance_compensation.data(), px.depth_sum.data(),
+            px.luminance_sq_sum.data(),  px.radiance_sq_sum.data(),       px.sample_count.data()};
+}
+
+// One thread's share of a pass: it fills batches of samples row by row, traces each batch
+// (trace_camera_samples: SIMD lanes where they can be) and adds the results to their pixels
+// in the order they were drawn, so every pixel's sums are those of tracing them one by one.
+class PassThread {
+public:
+    PassThread(const RenderScene& scene, const RenderSettings& settings, RenderState& state, bool avx2)
+        : scene_(scene), settings_(settings), state_(state), sums_(pixel_sums_of(state.buffers())), avx2_(avx2) {
+        PixelBuffers& px = state.buffers();
+        sample_index_ = px.sample_index.data();
+        sobol_keys_ = px.sobol_keys.data();
+        active_ = px.active.empty() ? nullptr : px.active.data();
+        pass_samples_ = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
+        for (int k = 0; k < kSampleBatch; ++k) {
+            // A Sobol pass restarts these samplers in place (restart_sobol); the other
+            // estimators make each one anew.
+            new (&slots_[k].sampler) Sampler(0, 0, 0);
+            samplers_[k] = &slots_[k].sampler;
+        }
+    }
+
+    // Samples row y: each pixel (of the noise rule's mask, if any) once, or as often as the
+    // plan says.
+    void sample_row(int y) {
+        const bool sobol = settings_.estimator == Estimator::sobol;
+        if (active_) sobol ? sample_row<true, true>(y) : sample_row<false, true>(y);
+        else sobol ? sample_row<true, false>(y) : sample_row<false, false>(y);
+    }
+
+    uint64_t rays = 0, nonfinite = 0;
+
+private:
+    template <bool kSobol, bool kActive>
+    void sample_row(int y) {
+        if (pass_samples_) sample_row<kSobol, kActive, true>(y);
+        else sample_row<kSobol, kActive, false>(y);
+    }
+
+    template <bool kSobol, bool kActive, bool kPlanned>
+    void sample_row(int y) {
+        // The row's pointers and the batch's fill in locals, so they stay in registers
+        // (stores to the buffers could alias members).
+        const size_t row = state_.row_start(y), image_row = size_t(y) * size_t(state_.width);
+        const int width = state_.width;
+        uint32_t* const index_of = sample_index_ + row;
+        const uint32_t* const key_of = kSobol ? sobol_keys_ + row : nullptr;
+        const uint8_t* const active = kActive ? active_ + row : nullptr;
+        const uint8_t* const planned = kPlanned ? pass_samples_ + row : nullptr;
+        int* const xs = xs_;
+        int* const ys = ys_;
+        size_t* const pixels = pixels_;
+        size_t pending = 0;
+        // In a pass of one sample per pixel every pixel draws the same index, so its bit
+        // reversal is kept from the pixel before.
+        uint32_t last_index = 0, last_reversed = 0;
+        for (int x = 0; x < width; ++x) {
+            if (kActive && !active[x]) continue;
+            const uint32_t n = kPlanned ? planned[x] : 1;
+            const uint32_t first = index_of[x];
+            index_of[x] = first + n;
+            for (uint32_t index = first; index != first + n; ++index) {
+                if constexpr (kSobol) {
+                    if (index != last_index) last_index = index, last_reversed = reverse_bits(index);
+                    slots_[pending].sampler.restart_sobol(key_of[x], index, last_reversed);
+                } else {
+                    new (&slots_[pending].sampler)
+                        Sampler(settings_.estimator, settings_.seed, image_row + x, index, settings_.target_spp);
+                }
+                xs[pending] = x;
+                ys[pending] = y;
+                pixels[pending] = row + size_t(x);
+                if (++pending == size_t(kSampleBatch)) {
+                    flush(pending);
+                    pending = 0;
+                }
+            }
+        }
+        if (pending > 0) flush(pending);
+    }
+
+    __attribute__((noinline)) void flush(size_t count_of) {
+        const int count = int(count_of);
+        trace_camera_samples(scene_, settings_, state_.width, state_.height, xs_, ys_, samplers_, count, results_);
+        accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
+    }
+
+    const RenderScene& scene_;
+    const RenderSettings& settings_;
+    const RenderState& state_;
+    const PixelSums sums_;
+    const bool avx2_;
+    uint32_t* sample_index_;
+    const uint32_t* sobol_keys_;
+    const uint8_t* active_;
+    const uint8_t* pass_samples_;
+    static_assert(std::is_trivially_destructible_v<Sampler>, "slots are reused without destruction");
+    union SamplerSlot {  // a Sampler made in place
+        Sampler sampler;
+        SamplerSlot() {}
+    } slots_[kSampleBatch];
+    Sampler* samplers_[kSampleBatch];
+    int xs_[kSampleBatch], ys_[kSampleBatch];
+    size_t pixels_[kSampleBatch];
+    SampleResult results_[kSampleBatch];
+};
+
 }  // namespace
+
+void accumulate_samples(PixelBuffers& buffers, const size_t* pixels, const SampleResult* results, int count,
+                        AccumulationIsa isa, uint64_t& nonfinite) {
+    uint64_t rays = 0;
+    accumulate(pixel_sums_of(buffers), pixels, results, count, isa == AccumulationIsa::avx2 && avx2_accumulation(),
+               rays, nonfinite);
+}
+
+bool accumulation_isa_available(AccumulationIsa isa) { return isa == AccumulationIsa::sse2 || avx2_accumulation(); }
 
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop) {
@@ -91,81 +296,23 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 px.sobol_keys[start + x] = Sampler::pixel_key(settings.seed, uint64_t(first + x));
         }
     }
-    const PixelSums pixel_sums{px.radiance_sum.data(), px.radiance_compensation.data(), px.depth_sum.data(),
-                               px.luminance_sq_sum.data(), px.radiance_sq_sum.data(), px.sample_count.data()};
-    const uint8_t* const pixel_active = px.active.empty() ? nullptr : px.active.data();
     const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
-    const uint8_t* const pixel_pass_samples = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
+    const bool avx2 = avx2_accumulation();
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
-        // The pass's constants as each thread's own copies, so that they stay in registers.
-        const PixelSums sums = pixel_sums;
-        const uint8_t* const active = pixel_active;
-        const uint8_t* const pass_samples = pixel_pass_samples;
-        uint32_t* const sample_index = px.sample_index.data();
-        const uint32_t* const sobol_keys = px.sobol_keys.data();
-        const int w = width, h = height;
-        // Samples go to trace_samples kSampleBatch at a time (path tracing traces their paths
-        // in SIMD lanes) and are accumulated in the order they were drawn, so every pixel's
-        // sums are those of tracing them one by one. The batch's arrays are each thread's,
-        // for all its rows.
-        static_assert(std::is_trivially_destructible_v<Sampler>, "slots are reused without destruction");
-        union SamplerSlot {  // a Sampler made in place for each sample
-            Sampler sampler;
-            SamplerSlot() {}
-        } slots[kSampleBatch];
-        Sampler* batch_samplers[kSampleBatch];
-        for (int k = 0; k < kSampleBatch; ++k) batch_samplers[k] = &slots[k].sampler;
-        int batch_x[kSampleBatch], batch_y[kSampleBatch];
-        size_t batch_pixels[kSampleBatch];
-        SampleResult results[kSampleBatch];
+        PassThread thread(scene, settings, state, avx2);
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
-        for (int y = 0; y < h; ++y) {
+        for (int y = 0; y < height; ++y) {
             if ((rows_active && !rows_active[y]) || !state.holds_row(y)) continue;
             if (stop && stop->load(std::memory_order_relaxed)) {
                 stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
                 continue;
             }
-            int pending = 0;
-            auto flush = [&] {
-                trace_camera_samples(scene, settings, w, h, batch_x, batch_y, batch_samplers, pending, results);
-                for (int k = 0; k < pending; ++k) {
-                    rays += results[k].rays;
-                    nonfinite += !sums.add(batch_pixels[k], results[k]);
-                }
-                pending = 0;
-            };
-            // One sample into the batch. In a pass of one sample per pixel every pixel has the
-            // same sample index, so its bit reversal is kept from the pixel before.
-            uint32_t last_index = 0, last_reversed = 0;
-            // `pixel`: the pixel's place in the buffers; `image_pixel`: in the image.
-            const auto draw = [&](int x, size_t pixel, size_t image_pixel) {
-                const uint32_t index = sample_index[pixel]++;
-                if (sobol) {
-                    if (index != last_index) last_index = index, last_reversed = reverse_bits(index);
-                    new (&slots[pending].sampler) Sampler(sobol_keys[pixel], index, last_reversed);
-                } else {
-                    new (&slots[pending].sampler)
-                        Sampler(settings.estimator, settings.seed, image_pixel, index, settings.target_spp);
-                }
-                batch_x[pending] = x;
-                batch_y[pending] = y;
-                batch_pixels[pending] = pixel;
-                if (++pending == kSampleBatch) flush();
-            };
-            const size_t row = state.row_start(y), image_row = static_cast<size_t>(y) * w;
-            for (int x = 0; x < w; ++x) {
-                const size_t pixel = row + x;
-                if (active && !active[pixel]) continue;
-                if (!pass_samples) {
-                    draw(x, pixel, image_row + x);
-                    continue;
-                }
-                for (int k = 0; k < pass_samples[pixel]; ++k) draw(x, pixel, image_row + x);
-            }
-            if (pending > 0) flush();
+            thread.sample_row(y);
         }
+        rays += thread.rays;
+        nonfinite += thread.nonfinite;
     }
     state.rays += rays;
     state.nonfinite_samples += nonfinite;

@@ -7,6 +7,7 @@
 #include "render/render_scene.h"
 #include "render/render_state.h"
 #include "render/settings.h"
+#include "render/trace.h"
 
 namespace kr {
 
@@ -19,5 +20,15 @@ namespace kr {
 // ProgressiveDriver's users drop (the viewer stops a pass only for an edit).
 bool render_pass(const RenderScene& scene, const RenderSettings& settings, RenderState& state,
                  const std::atomic<bool>* stop = nullptr);
+
+// How render_pass adds a sample to its pixel's sums: SSE2 (any x86-64 CPU) or, where the CPU
+// has AVX2, a colour's three channels in one register. Both give the same sums bit for bit.
+enum class AccumulationIsa { sse2, avx2 };
+bool accumulation_isa_available(AccumulationIsa isa);
+// Adds `count` samples to the pixels `pixels` of `buffers` in order, as render_pass does (a
+// sample that is not finite, or would overflow its pixel's sums, is dropped and counted in
+// `nonfinite`). For tests.
+void accumulate_samples(PixelBuffers& buffers, const size_t* pixels, const SampleResult* results, int count,
+                        AccumulationIsa isa, uint64_t& nonfinite);
 
 }  // namespace kr

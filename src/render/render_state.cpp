@@ -110,15 +110,6 @@ std::vector<Color> RenderState::variance_of_mean() const {
     return v;
 }
 
-double RenderState::sample_variance(size_t i) const {
-    const double n = px_.sample_count[i];
-    // Below two samples there is no variance; a sum of squares that overflowed (radiance
-    // above ~1e154) would give inf - inf: the variance is unknown, not zero.
-    if (n < 2 || !std::isfinite(px_.luminance_sq_sum[i])) return kInfinity;
-    const double mean = luminance(px_.radiance_sum[i]) / n;
-    return std::max(0.0, (px_.luminance_sq_sum[i] - n * mean * mean) / (n - 1));  // unbiased
-}
-
 double RenderState::pixel_standard_error(size_t i) const {
     return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
 }

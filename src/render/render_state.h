@@ -4,8 +4,11 @@
 // from them (allocation.cpp), and the memory a render holds.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/image.h"
@@ -119,7 +122,18 @@ public:
 
     // Unbiased variance of one sample's luminance in the buffers' pixel `i` (infinite below
     // two samples).
-    double sample_variance(size_t i) const;
+    double sample_variance(size_t i) const {
+        return luminance_sample_variance(px_.sample_count[i], px_.radiance_sum[i], px_.luminance_sq_sum[i]);
+    }
+    // The same from a pixel's count, radiance sum and sum of squared luminances.
+    static double luminance_sample_variance(uint32_t count, const Color& sum, double luminance_sq_sum) {
+        const double n = count;
+        // Below two samples there is no variance; a sum of squares that overflowed (radiance
+        // above ~1e154) would give inf - inf: the variance is unknown, not zero.
+        if (n < 2 || !std::isfinite(luminance_sq_sum)) return std::numeric_limits<double>::infinity();
+        const double mean = luminance(sum) / n;
+        return std::max(0.0, (luminance_sq_sum - n * mean * mean) / (n - 1));  // unbiased
+    }
     // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
     // two samples).
     double pixel_standard_error(size_t i) const;

@@ -136,6 +136,14 @@ public:
     // The same with reverse_bits(index) given (render_pass reuses it across pixels).
     Sampler(uint32_t sobol_key, uint32_t index, uint32_t index_reversed)
         : estimator_(Estimator::sobol), sobol_key_(sobol_key), index_(index), index_reversed_(index_reversed) {}
+    // Makes this Sobol sampler the one Sampler(sobol_key, index, index_reversed) gives, in
+    // place (render_pass reuses its batch's samplers: only these fields differ between them).
+    void restart_sobol(uint32_t sobol_key, uint32_t index, uint32_t index_reversed) {
+        sobol_key_ = sobol_key;
+        index_ = index;
+        index_reversed_ = index_reversed;
+        dimension_ = 0;
+    }
     // The Sobol numbers' key of a pixel for a seed: two SplitMix64 hashes.
     static uint32_t pixel_key(uint64_t seed, uint64_t pixel) {
         return uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)));
