@@ -94,7 +94,8 @@ int balance(const std::string& file, int size, int passes, const std::string& co
         const int count = std::atoi(item.c_str());
         if (count < 1) continue;
         std::vector<double> rank(size_t(count), 0.0);
-        for (int y = 0; y < size; ++y) rank[size_t(y % count)] += seconds[size_t(y)];
+        const std::vector<int> owner = row_owners(count, size);
+        for (int y = 0; y < size; ++y) rank[size_t(owner[size_t(y)])] += seconds[size_t(y)];
         std::printf("  %d ranks (%.2f rows each): %.3f\n", count, double(size) / count,
                     *std::max_element(rank.begin(), rank.end()) / (total / count));
     }
@@ -135,10 +136,12 @@ int main(int argc, char** argv) {
             }
             const size_t own = rows_owned(rows, size).size();
             const double own_pixels = double(own) * size;
-            // Received a pass: the two neighbours' rows (36 bytes a pixel; one neighbour at
-            // N = 2, none alone) and the other rows' two plan sums (8 bytes each).
-            const double neighbours = count == 1 ? 0 : count == 2 ? 1 : 2;
-            const double guard = neighbours * double(size / count + (size % count != 0)) * size * 36;
+            // Received a pass, by the rank receiving most: the rows next to its blocks (36
+            // bytes a pixel) and the other rows' two plan sums (8 bytes each).
+            size_t guard_rows = 0;
+            for (int r = 0; r < count; ++r)
+                guard_rows = std::max(guard_rows, rows_guarded(r, count, size).size() - rows_owned(r, count, size).size());
+            const double guard = double(guard_rows) * size * 36;
             const double sums = double(size - int(own)) * 2 * 8;
             std::printf("%d | %dx%d | %zu | %.3f | %.3f | %.1f | %.1f kB | %.1f kB\n", count, size, size, own,
                         1e3 * median(plan), 1e3 * median(check), 1e9 * median(plan) / own_pixels, guard * 1e-3,

@@ -63,7 +63,7 @@ public:
         : RowShare(index, count), sync_(sync), table_(table) {}
     void combine(std::vector<double>& values, int fields) const override {
         const int height = int(values.size()) / fields;
-        for (int y = index(); y < height; y += count())
+        for (int y : rows_owned(this, height))
             std::copy_n(values.begin() + y * fields, fields, table_.begin() + y * fields);
         sync_.arrive_and_wait();
         std::copy_n(table_.begin(), values.size(), values.begin());
@@ -291,13 +291,10 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     for (size_t i = 0; i < image.pixels.size(); ++i) EXPECT_EQ(f->radiance.pixels[i].x, image.pixels[i].x) << i;
 }
 
-// Each process plans its own rows (RowShare): holding only its rows and their neighbours'
-// (RenderState::reset's held rows), or every row with the others poisoned with NaN and wrong
-// counts, and with the per-row sums combined, its rows get the estimated error, the noise
-// mask, the active count and the plan of one process, bit for bit; N from 2 to more processes
-// than rows (some own none), odd sizes.
-TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
-    const int w = 13, h = 11;
+namespace {
+
+void each_process_plans_its_rows_as_one_process_does(int w, int h) {
+    SCOPED_TRACE(h);
     Scene authored = brief_scene(6, w);
     authored.renderer.height = h;
     const RenderScene scene = prepare_scene(authored);
@@ -361,7 +358,7 @@ TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
             const RenderState& s = states[size_t(r)];
             EXPECT_EQ(errors[size_t(r)], error);
             EXPECT_EQ(actives[size_t(r)], active);
-            for (int y = r; y < h; y += count)
+            for (int y : rows_owned(r, count, h))
                 for (size_t x = 0; x < size_t(w); ++x) {
                     const size_t i = s.row_start(y) + x, at = size_t(y) * w + x;
                     EXPECT_EQ(s.active()[i], whole.active()[at]) << at;
@@ -370,4 +367,50 @@ TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
                 }
         }
     }
+}
+
+}  // namespace
+
+// Each process plans its own rows (RowShare): holding only its rows and their neighbours'
+// (RenderState::reset's held rows), or every row with the others poisoned with NaN and wrong
+// counts, and with the per-row sums combined, its rows get the estimated error, the noise
+// mask, the active count and the plan of one process, bit for bit; N from 2 to more processes
+// than rows (some own none), odd sizes, row blocks of one row and of several.
+TEST(Allocation, EachProcessPlansItsRowsAsOneProcessDoes) {
+    for (const int h : {11, 41})  // blocks of one row or none; of up to three rows
+        each_process_plans_its_rows_as_one_process_does(13, h);
+}
+
+// Dealt rows: every process owns height/count rows or one more, and holds (its rows and their
+// neighbours) at most ceil(height/count) + 2 kRowBlocks: a part of the image that shrinks as
+// 1/count plus a fixed part. And its rows are spread over the image: kRowBlocks blocks, the
+// first no lower than the first 1/kRowBlocks of the image ends.
+TEST(Allocation, ProcessesHoldTheirShareOfTheRowsPlusAFixedPart) {
+    for (const int count : {1, 2, 3, 4, 7, 16, 64})
+        for (const int height : {1, 3, 5, 17, 100, 1000, 4096, 4099}) {
+            SCOPED_TRACE(std::to_string(count) + " processes, " + std::to_string(height) + " rows");
+            const std::vector<int> owner = row_owners(count, height);
+            ASSERT_EQ(owner.size(), size_t(height));
+            size_t owned_total = 0;
+            for (int r = 0; r < count; ++r) {
+                const std::vector<int> own = rows_owned(r, count, height), held = rows_guarded(r, count, height);
+                owned_total += own.size();
+                EXPECT_EQ(own.size(), size_t(height / count + (r < height % count)));
+                EXPECT_LE(held.size(), size_t((height + count - 1) / count + 2 * kRowBlocks));
+                for (int y : own) {
+                    EXPECT_EQ(owner[size_t(y)], r);
+                    for (int n : {y - 1, y, y + 1})
+                        if (n >= 0 && n < height) EXPECT_TRUE(std::binary_search(held.begin(), held.end(), n)) << n;
+                }
+                // Blocks: runs of consecutive own rows.
+                int blocks = 0;
+                for (size_t k = 0; k < own.size(); ++k) blocks += k == 0 || own[k] != own[k - 1] + 1;
+                EXPECT_LE(blocks, kRowBlocks);
+                if (height >= count * kRowBlocks) {
+                    EXPECT_EQ(blocks, count == 1 ? 1 : kRowBlocks);
+                    EXPECT_LT(own.front(), height / kRowBlocks + 1);
+                }
+            }
+            EXPECT_EQ(owned_total, size_t(height));
+        }
 }

@@ -187,10 +187,12 @@ TEST_F(Mpi, CheckpointIsOneProcesssAtAnyRankCount) {
     }
 }
 
-// Between passes a rank receives its rows' neighbouring rows (36 bytes a pixel, from two
-// ranks) and the per-row sums, not the whole image's statistics: at 4 ranks, 64x64, 24 spp
-// (16 passes planned), at most 2 x 16 rows x 64 pixels x 36 bytes and 64 rows x 2 sums x 8
-// bytes a pass, under the 36 x 4096 x 3/4 bytes of the whole image's.
+// Between passes a rank receives the rows next to its blocks (36 bytes a pixel, from the
+// ranks owning the neighbouring blocks) and the per-row sums, not the whole image's
+// statistics: at 4 ranks, 64x64, 24 spp (16 passes planned), the most a rank receives a pass
+// is its guard rows (rows_guarded less its own: 16 at most, 2 per block) x 64 pixels x 36
+// bytes, plus at most 64 rows x 2 sums x 8 bytes, under the 36 x 4096 x 3/4 bytes of the
+// whole image's.
 TEST_F(Mpi, RanksReceiveOnlyTheirNeighbourRowsAndRowSums) {
     scene(6, 64, "scene.json");
     const test::CommandResult r = here(mpirun(4) + "render -q scene.json --spp 24 -o out.ppm");
@@ -200,14 +202,19 @@ TEST_F(Mpi, RanksReceiveOnlyTheirNeighbourRowsAndRowSums) {
     const double megabytes = std::stod(r.out.substr(r.out.rfind(' ', at - 1) + 1));
     const int passes = std::stoi(r.out.substr(at + 19));
     EXPECT_EQ(passes, 24 - 8 + 1) << r.out;  // after passes 8 to 24 (the last for its summary)
+    size_t guard = 0;
+    for (int rank = 0; rank < 4; ++rank)
+        guard = std::max(guard, rows_guarded(rank, 4, 64).size() - rows_owned(rank, 4, 64).size());
+    EXPECT_EQ(guard, 2u * kRowBlocks);
     const double per_pass = megabytes * 1e6 / passes;
-    EXPECT_GT(per_pass, 16 * 64 * 36) << r.out;
-    EXPECT_LE(per_pass, 2 * 16 * 64 * 36 + 64 * 2 * 8) << r.out;
+    EXPECT_GT(per_pass, double(guard) * 64 * 36) << r.out;
+    EXPECT_LE(per_pass, double(guard) * 64 * 36 + 64 * 2 * 8) << r.out;
 }
 
 // Rank 0 holds the whole state (it gathers it and writes the outputs); every other rank only
 // its rows and their neighbours': the memory check of each says so, here refused under a
-// 16 GiB address-space limit for a 32768x32768 image (each rank of 4 holds 3 rows in 4).
+// 16 GiB address-space limit for a 32768x32768 image (each rank of 4 holds a quarter of the
+// rows and at most 16 more).
 TEST_F(Mpi, EachRankChecksTheMemoryOfTheRowsItHolds) {
     scene(6, 32768, "huge.json");
     const test::CommandResult r = here("ulimit -v 16777216; " + mpirun(4) + "render -q huge.json -o huge.ppm");
@@ -215,12 +222,15 @@ TEST_F(Mpi, EachRankChecksTheMemoryOfTheRowsItHolds) {
     const std::string rank0 = "needs about " + format_bytes(render_memory_bytes(32768, 32768, false)) + ", above the "
                               "address-space limit (ulimit -v) (16.0 GiB) on rank 0";
     EXPECT_NE(r.err.find(rank0), std::string::npos) << r.err;
-    const std::string others = "needs about " + format_bytes(render_state_bytes(32768, 3 * 32768 / 4));
-    for (int rank : {1, 2, 3})
+    for (int rank : {1, 2, 3}) {
+        const size_t held = rows_guarded(rank, 4, 32768).size();
+        EXPECT_LE(held, 32768 / 4 + 2 * kRowBlocks);
+        const std::string others = "needs about " + format_bytes(render_state_bytes(32768, held));
         EXPECT_NE(r.err.find(others + ", above the address-space limit (ulimit -v) (16.0 GiB) on rank " +
                              std::to_string(rank)),
                   std::string::npos)
             << r.err;
+    }
     EXPECT_FALSE(fs::exists(dir / "huge.ppm"));
 }
 

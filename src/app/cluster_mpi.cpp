@@ -62,10 +62,19 @@ private:
     MPI_Datatype type_ = MPI_BYTE;
 };
 
-// Rows dealt round-robin: rank r holds rows r, r+N, r+2N, ...; packed in that order.
+// The rows as row_owners deals them: each rank's packed in order, ranks in order.
 struct RowDeal {
     int rank, size, width, height;
-    int rows_of(int r) const { return r < height ? (height - r + size - 1) / size : 0; }
+    std::vector<int> owner;  // per row, its rank
+    std::vector<int> place;  // per row, its place among its rank's rows
+    std::vector<int> rows;   // per rank, its rows
+
+    RowDeal(int rank_, int size_, int width_, int height_)
+        : rank(rank_), size(size_), width(width_), height(height_), owner(row_owners(size_, height_)),
+          place(owner.size()), rows(size_t(size_), 0) {
+        for (size_t y = 0; y < owner.size(); ++y) place[y] = rows[size_t(owner[y])]++;
+    }
+    int rows_of(int r) const { return rows[size_t(r)]; }
     std::vector<int> counts() const {  // pixels per rank
         std::vector<int> c(static_cast<size_t>(size));
         for (int r = 0; r < size; ++r) c[size_t(r)] = rows_of(r) * width;
@@ -80,20 +89,20 @@ struct RowDeal {
     template <class T>
     void pack(const RenderState& state, const std::vector<T>& field, std::vector<char>& out) const {
         const size_t row = size_t(width) * sizeof(T);
-        const int rows = rows_of(rank);
-        out.resize(size_t(rows) * row);
+        out.resize(size_t(rows_of(rank)) * row);
 #pragma omp parallel for schedule(static)
-        for (int k = 0; k < rows; ++k)
-            std::memcpy(out.data() + size_t(k) * row, field.data() + state.row_start(rank + k * size), row);
+        for (int y = 0; y < height; ++y)
+            if (owner[size_t(y)] == rank)
+                std::memcpy(out.data() + size_t(place[size_t(y)]) * row, field.data() + state.row_start(y), row);
     }
     template <class T>
     void unpack(const std::vector<char>& all, const std::vector<int>& offsets, std::vector<T>& field) const {
         const size_t row = size_t(width) * sizeof(T);
-        // Row y is rank (y mod N)'s row y div N.
 #pragma omp parallel for schedule(static)
         for (int y = 0; y < height; ++y)
             std::memcpy(field.data() + size_t(y) * size_t(width),
-                        all.data() + size_t(offsets[size_t(y % size)]) * sizeof(T) + size_t(y / size) * row, row);
+                        all.data() + size_t(offsets[size_t(owner[size_t(y)])]) * sizeof(T) + size_t(place[size_t(y)]) * row,
+                        row);
     }
     // Every rank's rows of `field` in rank 0, whose state holds every row. `mine` and
     // `gathered` are buffers kept between calls: fresh pages cost more than the copy.
@@ -184,10 +193,9 @@ public:
         std::vector<double> all(values.size());
         MPI_Allgatherv(mine.data(), int(mine.size()), MPI_DOUBLE, all.data(), counts.data(), offsets.data(),
                        MPI_DOUBLE, MPI_COMM_WORLD);
-        // Row y is rank (y mod N)'s row y div N.
         for (int y = 0; y < height; ++y)
-            std::copy_n(all.begin() + offsets[size_t(y % count())] + ptrdiff_t(y / count()) * fields, fields,
-                        values.begin() + ptrdiff_t(y) * fields);
+            std::copy_n(all.begin() + offsets[size_t(deal.owner[size_t(y)])] + ptrdiff_t(deal.place[size_t(y)]) * fields,
+                        fields, values.begin() + ptrdiff_t(y) * fields);
         cost_.received_bytes += double((values.size() - mine.size()) * sizeof(double));
         cost_.combine_seconds += wall_seconds() - start;
     }
@@ -195,9 +203,10 @@ public:
     mutable RankCost cost_;
 
 private:
-    // The rows the 3x3 guard reads besides this rank's own: rows y - 1 and y + 1 of each own
-    // row y, which ranks r - 1 and r + 1 (mod N) own. Each rank sends its rows' three sums to
-    // both and receives theirs (from the one other rank when N = 2).
+    // The rows the 3x3 guard reads besides this rank's own: the rows next to its blocks,
+    // which the ranks owning the neighbouring blocks own. Each rank sends every such
+    // neighbour its rows next to that neighbour's (their three sums) and receives theirs; both
+    // sides list them in row order from row_owners.
     void receive_guard_rows(RenderState& state) {
         if (count() == 1) return;
         const double start = wall_seconds();
@@ -206,44 +215,59 @@ private:
         PixelBuffers& px = state.buffers();
         const size_t w = size_t(width);
         const size_t row_bytes = w * kGuardRowBytesPerPixel;
-        const std::vector<int> own = rows_owned(this, height);
-        send_.resize(own.size() * row_bytes);
-#pragma omp parallel for schedule(static)
-        for (size_t k = 0; k < own.size(); ++k) {
-            char* at = send_.data() + k * row_bytes;
-            const size_t first = state.row_start(own[k]);
-            at = std::copy_n(reinterpret_cast<const char*>(&px.radiance_sum[first]), w * sizeof(Color), at);
-            at = std::copy_n(reinterpret_cast<const char*>(&px.luminance_sq_sum[first]), w * sizeof(double), at);
-            std::copy_n(reinterpret_cast<const char*>(&px.sample_count[first]), w * sizeof(uint32_t), at);
+        // The rows rank `from` owns next to a row rank `to` owns, per rank `to`.
+        const auto next_to = [&](int from, int to) {
+            std::vector<int> rows;
+            for (int y = 0; y < height; ++y)
+                if (deal.owner[size_t(y)] == from && ((y > 0 && deal.owner[size_t(y - 1)] == to) ||
+                                                      (y + 1 < height && deal.owner[size_t(y + 1)] == to)))
+                    rows.push_back(y);
+            return rows;
+        };
+        std::vector<int> neighbours;
+        std::vector<std::vector<int>> sent_rows, received_rows;
+        for (int r = 0; r < count(); ++r) {
+            if (r == index()) continue;
+            std::vector<int> out = next_to(index(), r);
+            if (out.empty()) continue;  // then neither side is next to the other
+            neighbours.push_back(r);
+            sent_rows.push_back(std::move(out));
+            received_rows.push_back(next_to(r, index()));
         }
+        send_.resize(neighbours.size());
+        received_.resize(neighbours.size());
         MPI_Datatype row;
         MPI_Type_contiguous(int(row_bytes), MPI_BYTE, &row);
         MPI_Type_commit(&row);
-        const int before = (index() + count() - 1) % count(), after = (index() + 1) % count();
-        std::vector<int> neighbours = {before};
-        if (after != before) neighbours.push_back(after);
-        received_.resize(neighbours.size());
         std::vector<MPI_Request> requests;
         for (size_t n = 0; n < neighbours.size(); ++n) {
-            received_[n].resize(size_t(deal.rows_of(neighbours[n])) * row_bytes);
+            received_[n].resize(received_rows[n].size() * row_bytes);
             requests.emplace_back();
-            MPI_Irecv(received_[n].data(), deal.rows_of(neighbours[n]), row, neighbours[n], 0, MPI_COMM_WORLD,
+            MPI_Irecv(received_[n].data(), int(received_rows[n].size()), row, neighbours[n], 0, MPI_COMM_WORLD,
                       &requests.back());
         }
-        for (int to : neighbours) {
+        for (size_t n = 0; n < neighbours.size(); ++n) {
+            const std::vector<int>& rows = sent_rows[n];
+            send_[n].resize(rows.size() * row_bytes);
+#pragma omp parallel for schedule(static)
+            for (size_t k = 0; k < rows.size(); ++k) {
+                char* at = send_[n].data() + k * row_bytes;
+                const size_t first = state.row_start(rows[k]);
+                at = std::copy_n(reinterpret_cast<const char*>(&px.radiance_sum[first]), w * sizeof(Color), at);
+                at = std::copy_n(reinterpret_cast<const char*>(&px.luminance_sq_sum[first]), w * sizeof(double), at);
+                std::copy_n(reinterpret_cast<const char*>(&px.sample_count[first]), w * sizeof(uint32_t), at);
+            }
             requests.emplace_back();
-            MPI_Isend(send_.data(), int(own.size()), row, to, 0, MPI_COMM_WORLD, &requests.back());
+            MPI_Isend(send_[n].data(), int(rows.size()), row, neighbours[n], 0, MPI_COMM_WORLD, &requests.back());
         }
         MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE);
         MPI_Type_free(&row);
         for (size_t n = 0; n < neighbours.size(); ++n) {
-            const int rows = deal.rows_of(neighbours[n]);
+            const std::vector<int>& rows = received_rows[n];
 #pragma omp parallel for schedule(static)
-            for (int k = 0; k < rows; ++k) {
-                const int y = neighbours[n] + k * count();
-                if (!state.holds_row(y)) continue;  // the last row, where the neighbour owns it
-                const char* at = received_[n].data() + size_t(k) * row_bytes;
-                const size_t first = state.row_start(y);
+            for (size_t k = 0; k < rows.size(); ++k) {
+                const char* at = received_[n].data() + k * row_bytes;
+                const size_t first = state.row_start(rows[k]);
                 std::copy_n(at, w * sizeof(Color), reinterpret_cast<char*>(&px.radiance_sum[first]));
                 at += w * sizeof(Color);
                 std::copy_n(at, w * sizeof(double), reinterpret_cast<char*>(&px.luminance_sq_sum[first]));
@@ -256,8 +280,8 @@ private:
     }
 
     std::vector<uint8_t> owned_rows_;  // 1 for this rank's rows
-    std::vector<char> send_;      // the guard rows' buffers, kept between passes
-    std::vector<std::vector<char>> received_;
+    // The guard rows' buffers, per neighbour, kept between passes.
+    std::vector<std::vector<char>> send_, received_;
     double cpu_start_ = 0, pass_end_ = 0, combine_mark_ = 0;
     int passes_ = 0;
 };

@@ -52,19 +52,29 @@ struct PixelBuffers {
     std::vector<uint32_t> half_count;
 };
 
-// The rows of an image shared between processes (app/cluster.h deals them through the
-// driver's PassHooks). This process owns the rows y with y mod count == index: it samples and
-// plans them, and holds the statistics of their neighbours too (the 3x3 guard reads them).
-// The image-wide sums (of the plan, the noise rule, the estimated error) are taken per row,
-// made known to every process by combine() and added in row order by each: the same plan and
-// verdicts, bit for bit, as one process that owns every row (no RowShare).
+// The rows of an image shared between `count` processes, dealt in interleaved blocks: each
+// process owns height/count rows (one more for the first height mod count processes), split
+// into kRowBlocks contiguous blocks of near-equal size (some empty on short images), laid out
+// block 0 of process 0, of 1, ..., of count - 1, then each one's block 1, and so on. A process
+// holds its own rows and their neighbours (the 3x3 guard reads them): at most 2 kRowBlocks
+// rows more than its share whatever the count, and the interleaving spreads every process's
+// rows over the image, for balance. Everything that maps a row to its process or its place
+// there (RowShare, app/cluster's gather, scatter and exchanges) reads row_owners.
+constexpr int kRowBlocks = 8;
+// The process owning each row of an image `height` rows high shared by `count` processes.
+std::vector<int> row_owners(int count, int height);
+
+// This process's share of the rows (row_owners): it samples and plans its rows, and holds the
+// statistics of their neighbours too. The image-wide sums (of the plan, the noise rule, the
+// estimated error) are taken per row, made known to every process by combine() and added in
+// row order by each: the same plan and verdicts, bit for bit, as one process that owns every
+// row (no RowShare).
 class RowShare {
 public:
     RowShare(int index, int count) : index_(index), count_(count) {}
     virtual ~RowShare() = default;
     int index() const { return index_; }
     int count() const { return count_; }
-    bool owns(int y) const { return y % count_ == index_; }
     // `values` holds `fields` numbers per row, rows in order, this process's own rows filled
     // in: replaces every other row's with the numbers of the process that owns it.
     virtual void combine(std::vector<double>& values, int fields) const = 0;
@@ -78,6 +88,7 @@ private:
 std::vector<int> rows_owned(const RowShare* share, int height);
 std::vector<int> rows_guarded(const RowShare* share, int height);
 // Those of process `index` of `count`.
+std::vector<int> rows_owned(int index, int count, int height);
 std::vector<int> rows_guarded(int index, int count, int height);
 
 class RenderState {
@@ -214,9 +225,10 @@ inline constexpr uint64_t kGuardRowBytesPerPixel = sizeof(Color) + sizeof(double
 
 // The memory of a process of a shared render that holds `rows` rows of `width` pixels and
 // writes nothing (RenderState::reset's held rows): their state, and the buffers in which it
-// sends its own rows' guard sums and receives its neighbours'.
+// sends its rows next to other processes' blocks (each at most twice: 4 kRowBlocks rows) and
+// receives the rows next to its own blocks (2 kRowBlocks).
 inline uint64_t render_state_bytes(int width, size_t rows) {
-    return uint64_t(width) * uint64_t(rows) * (kRenderStateBytesPerPixel + kGuardRowBytesPerPixel);
+    return uint64_t(width) * (uint64_t(rows) * kRenderStateBytesPerPixel + 6 * kRowBlocks * kGuardRowBytesPerPixel);
 }
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
