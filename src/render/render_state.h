@@ -60,7 +60,7 @@ struct PixelBuffers {
 // rows more than its share whatever the count, and the interleaving spreads every process's
 // rows over the image, for balance. Everything that maps a row to its process or its place
 // there (RowShare, app/cluster's gather, scatter and exchanges) reads row_owners.
-constexpr int kRowBlocks = 8;
+constexpr int kRowBlocks = 32;
 // The process owning each row of an image `height` rows high shared by `count` processes.
 std::vector<int> row_owners(int count, int height);
 
