@@ -215,24 +215,27 @@ private:
         PixelBuffers& px = state.buffers();
         const size_t w = size_t(width);
         const size_t row_bytes = w * kGuardRowBytesPerPixel;
-        // The rows rank `from` owns next to a row rank `to` owns, per rank `to`.
-        const auto next_to = [&](int from, int to) {
-            std::vector<int> rows;
-            for (int y = 0; y < height; ++y)
-                if (deal.owner[size_t(y)] == from && ((y > 0 && deal.owner[size_t(y - 1)] == to) ||
-                                                      (y + 1 < height && deal.owner[size_t(y + 1)] == to)))
-                    rows.push_back(y);
-            return rows;
-        };
+        // Per other rank, in row order: this rank's rows next to one of its rows (sent), and
+        // its rows next to one of this rank's (received). One pass over the rows, where the
+        // block boundaries are.
+        std::vector<std::vector<int>> out(static_cast<size_t>(count())), in(static_cast<size_t>(count()));
+        for (int y = 0; y < height; ++y) {
+            const int owner = deal.owner[size_t(y)];
+            for (const int next : {y - 1, y + 1}) {
+                if (next < 0 || next >= height) continue;
+                const int other = deal.owner[size_t(next)];
+                if (other == owner) continue;
+                std::vector<int>* rows = owner == index() ? &out[size_t(other)] : other == index() ? &in[size_t(owner)] : nullptr;
+                if (rows && (rows->empty() || rows->back() != y)) rows->push_back(y);
+            }
+        }
         std::vector<int> neighbours;
         std::vector<std::vector<int>> sent_rows, received_rows;
         for (int r = 0; r < count(); ++r) {
-            if (r == index()) continue;
-            std::vector<int> out = next_to(index(), r);
-            if (out.empty()) continue;  // then neither side is next to the other
+            if (out[size_t(r)].empty()) continue;  // then neither side is next to the other
             neighbours.push_back(r);
-            sent_rows.push_back(std::move(out));
-            received_rows.push_back(next_to(r, index()));
+            sent_rows.push_back(std::move(out[size_t(r)]));
+            received_rows.push_back(std::move(in[size_t(r)]));
         }
         send_.resize(neighbours.size());
         received_.resize(neighbours.size());
@@ -345,15 +348,24 @@ void Cluster::abort(int status) const {
     std::_Exit(status);
 }
 
-void Cluster::broadcast(std::string& bytes) const {
-    if (!mpi_) return;
-    unsigned long long size = bytes.size();
-    MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+namespace {
+
+// Rank 0's `bytes`, whose size every rank already has, into every rank's.
+void broadcast_bytes(std::string& bytes, unsigned long long size) {
     bytes.resize(size_t(size));
     // In pieces of at most 1 GiB: MPI counts are ints.
     constexpr size_t kPiece = size_t(1) << 30;
     for (size_t at = 0; at < bytes.size(); at += kPiece)
         MPI_Bcast(bytes.data() + at, int(std::min(kPiece, bytes.size() - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
+}
+
+}  // namespace
+
+void Cluster::broadcast(std::string& bytes) const {
+    if (!mpi_) return;
+    unsigned long long size = bytes.size();
+    MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
+    broadcast_bytes(bytes, size);
 }
 
 void Cluster::broadcast_waiting(std::string& bytes) const {
@@ -365,10 +377,7 @@ void Cluster::broadcast_waiting(std::string& bytes) const {
     else
         for (int done = 0; MPI_Test(&request, &done, MPI_STATUS_IGNORE), !done;)
             std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    bytes.resize(size_t(size));
-    constexpr size_t kPiece = size_t(1) << 30;
-    for (size_t at = 0; at < bytes.size(); at += kPiece)
-        MPI_Bcast(bytes.data() + at, int(std::min(kPiece, bytes.size() - at)), MPI_BYTE, 0, MPI_COMM_WORLD);
+    broadcast_bytes(bytes, size);
 }
 
 bool Cluster::broadcast(bool value) const {

@@ -140,8 +140,7 @@ int serve_view_passes(const Cluster& cluster) {
                 std::vector<int> held = cluster.held_rows(h);
                 const size_t rows = held.empty() ? size_t(h) : held.size();
                 // Its rows' state and guard buffers, and their halves (render_state.h).
-                const uint64_t bytes =
-                    render_state_bytes(w, rows) + (halves ? uint64_t(w) * rows * (sizeof(Color) + sizeof(uint32_t)) : 0);
+                const uint64_t bytes = render_state_bytes(w, rows, halves);
                 if (std::string shortfall = memory_shortfall(bytes, "the render of a " + std::to_string(w) + "x" +
                                                                         std::to_string(h) + " image");
                     !shortfall.empty()) {

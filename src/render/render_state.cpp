@@ -74,7 +74,7 @@ RenderState::Halves RenderState::halves() const {
 uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised) {
     const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
     uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
-    if (denoised) output += sizeof(Color) + sizeof(uint32_t) + kDenoiseBytesPerPixel;
+    if (denoised) output += kHalvesBytesPerPixel + kDenoiseBytesPerPixel;
     return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
 }
 

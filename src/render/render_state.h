@@ -211,6 +211,8 @@ private:
 inline constexpr uint64_t kRenderStateBytesPerPixel =
     3 * sizeof(Color) + 2 * sizeof(double) + 2 * sizeof(uint32_t) + 2 * sizeof(uint8_t) + sizeof(float) +
     3 * sizeof(double) + sizeof(uint32_t);
+// The bytes per pixel of the two halves of the samples (track_halves: half_sum, half_count).
+inline constexpr uint64_t kHalvesBytesPerPixel = sizeof(Color) + sizeof(uint32_t);
 
 // An upper estimate of the memory a render of width x height pixels holds at its peak: the
 // RenderState, then at the end the mean radiance (and, when blurred, two more radiance images),
@@ -226,9 +228,10 @@ inline constexpr uint64_t kGuardRowBytesPerPixel = sizeof(Color) + sizeof(double
 // The memory of a process of a shared render that holds `rows` rows of `width` pixels and
 // writes nothing (RenderState::reset's held rows): their state, and the buffers in which it
 // sends its rows next to other processes' blocks (each at most twice: 4 kRowBlocks rows) and
-// receives the rows next to its own blocks (2 kRowBlocks).
-inline uint64_t render_state_bytes(int width, size_t rows) {
-    return uint64_t(width) * (uint64_t(rows) * kRenderStateBytesPerPixel + 6 * kRowBlocks * kGuardRowBytesPerPixel);
+// receives the rows next to its own blocks (2 kRowBlocks); with `halves`, their halves too.
+inline uint64_t render_state_bytes(int width, size_t rows, bool halves = false) {
+    const uint64_t per_pixel = kRenderStateBytesPerPixel + (halves ? kHalvesBytesPerPixel : 0);
+    return uint64_t(width) * (uint64_t(rows) * per_pixel + 6 * kRowBlocks * kGuardRowBytesPerPixel);
 }
 
 inline constexpr int kAllocationWarmup = 8;        // passes of one sample each before adapting
