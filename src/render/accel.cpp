@@ -404,6 +404,10 @@ LaneTree build_lane_tree(const std::vector<SphereGeom>& spheres) {
         tree.nodes.push_back(ln);
     }
     tree.depth = builder.depth;
+    if (tree.spheres_f.size() <= kLaneScanMaxSpheres) {
+        tree.scan_f.resize(tree.spheres_f.size());
+        for (const LaneSphere<float>& s : tree.spheres_f) tree.scan_f[size_t(s.id)] = s;
+    }
     return tree;
 }
 

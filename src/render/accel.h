@@ -65,10 +65,16 @@ struct LaneSphere {
     Real centre_l1;  // |centre|_1, for the single-precision lanes' shadow segments
     int32_t id;      // the sphere's index in the scene
 };
+// Up to this many spheres the sixteen float lanes scan them all rather than walk the lane
+// tree (docs/performance.md, "Sixteen single-precision lanes").
+inline constexpr size_t kLaneScanMaxSpheres = 128;
 struct LaneTree {
     std::vector<LaneNode> nodes;  // empty: no tree (a one-leaf scene, or Embree's only)
     std::vector<LaneSphere<float>> spheres_f;
     std::vector<LaneSphere<double>> spheres_d;
+    // spheres_f in the scene's order, for a tree of up to kLaneScanMaxSpheres (else empty):
+    // what the sixteen lanes scan.
+    std::vector<LaneSphere<float>> scan_f;
     int depth = 0;
 };
 
