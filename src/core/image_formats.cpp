@@ -18,9 +18,19 @@ const ImageFormatInfo& format_info(ImageFormat format) {
     return kImageFormats[0];
 }
 
-const ImageFormatInfo* format_by_extension(const std::filesystem::path& path) {
+namespace {
+
+// `path`'s extension in lower case, with its dot.
+std::string lower_extension(const std::filesystem::path& path) {
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+}  // namespace
+
+const ImageFormatInfo* format_by_extension(const std::filesystem::path& path) {
+    const std::string ext = lower_extension(path);
     for (const ImageFormatInfo& f : kImageFormats)
         if (ext == f.extension) return &f;
     return nullptr;
@@ -39,8 +49,7 @@ void check_output_extension(const std::filesystem::path& path) {
     static constexpr Other kOthers[] = {{".jpg", "JPEG"}, {".jpeg", "JPEG"}, {".tif", "TIFF"}, {".tiff", "TIFF"},
                                         {".bmp", "BMP"},  {".gif", "GIF"},   {".webp", "WebP"}, {".hdr", "Radiance HDR"},
                                         {".tga", "TGA"},  {".pgm", "PGM"},   {".pnm", "PNM"},   {".jxl", "JPEG XL"}};
-    std::string ext = path.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    const std::string ext = lower_extension(path);
     for (const Other& o : kOthers)
         if (ext == o.extension)
             throw std::runtime_error(quoted_path(path) + ": a " + o.name +

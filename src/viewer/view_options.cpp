@@ -143,18 +143,19 @@ std::string view_files_problem(const ViewOptions& o) {
                    (fs::is_directory(status) ? "a folder" : fs::is_fifo(status) ? "a FIFO" : "not a regular file") +
                    "; the viewer reads a regular file";
     }
-    // An image named for a format the viewer does not write (a .jpg), as render refuses it.
-    // (--save-image's name is checked with the options.)
-    for (const auto& [flag, image] : {std::pair{"--screenshot", o.screenshot}, std::pair{"--window-shot", o.window_shot}})
-        if (image) try {
-                check_output_extension(*image);
-            } catch (const std::runtime_error& e) {
-                return std::string(flag) + " " + e.what();
-            }
-    // The shots are the 8-bit pictures on screen: PNG or PPM, not an HDR format's name.
-    for (const auto& [flag, shot] : {std::pair{"--screenshot", o.screenshot}, std::pair{"--window-shot", o.window_shot}})
-        if (shot && output_format(*shot).hdr)
+    // The shots are the 8-bit pictures on screen: PNG or PPM, not the name of a format the
+    // viewer does not write (a .jpg, as render refuses it) nor an HDR one. (--save-image's
+    // name is checked with the options.)
+    for (const auto& [flag, shot] : {std::pair{"--screenshot", o.screenshot}, std::pair{"--window-shot", o.window_shot}}) {
+        if (!shot) continue;
+        try {
+            check_output_extension(*shot);
+        } catch (const std::runtime_error& e) {
+            return std::string(flag) + " " + e.what();
+        }
+        if (output_format(*shot).hdr)
             return std::string(flag) + " " + quoted_path(*shot) + ": the shot is an 8-bit picture; give it a name ending in .png or .ppm";
+    }
     std::vector<std::pair<const char*, fs::path>> outputs;
     if (o.screenshot) outputs.push_back({"--screenshot", *o.screenshot});
     if (o.window_shot) outputs.push_back({"--window-shot", *o.window_shot});
