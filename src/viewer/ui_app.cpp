@@ -288,7 +288,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
                   "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
-                  "feature=%s draft=%s\n",
+                  "feature=%s draft=%s question=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
@@ -296,7 +296,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
-                  feature.c_str(), draft);
+                  feature.c_str(), draft, open_question());
     if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
@@ -310,12 +310,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
 }
 
 void ViewerApp::draw_panels() {
-    if (quit_popup(quit_asked_)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
-    discard_popup(ctx_);
-    if (!ui_.panel_visible) {
-        overwrite_popup(ctx_);
-        return;
-    }
+    if (!ui_.panel_visible) return;
     const ImGuiIO& io = ImGui::GetIO();
     const float bar_h = float(ctx_.status_bar_height() / std::max(1.0f, io.DisplayFramebufferScale.y));
     // The panel keeps the right edge above the status bar. The width the user chose stays
@@ -330,7 +325,6 @@ void ViewerApp::draw_panels() {
     ImGui::PushItemWidth(-kPanelLabelWidth);
     draw_panel_list(ctx_);
     ImGui::PopItemWidth();
-    overwrite_popup(ctx_);
     ImGui::End();
     // The panel's left edge: a grip kPanelGripWidth wide that drags the width.
     ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width - kPanelGripWidth / 2, 0));
@@ -346,6 +340,15 @@ void ViewerApp::draw_panels() {
         ui_.panel_width = shown_panel_width(io.DisplaySize.x - io.MousePos.x, io.DisplaySize.x);
     ImGui::End();
     ImGui::PopStyleVar(2);
+}
+
+// The questions (modal popups) are begun after every other window of the frame. ImGui 1.86
+// asserts when a window appears after a modal in the modal's first frame (Esc then F1
+// reaching one frame on a busy machine opened the quit question, then the help: an abort).
+void ViewerApp::draw_questions(bool cancel) {
+    if (quit_popup(quit_asked_, cancel)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+    discard_popup(ctx_, cancel);
+    overwrite_popup(ctx_, cancel);
 }
 
 bool ViewerApp::draw_frame() {
@@ -394,6 +397,7 @@ bool ViewerApp::draw_frame() {
     // the panels are drawn over anything.
     const auto read = [this](const PixelRect& r) { return read_image_region(r); };
     const bool done = options_.scripted() && script_.step(ctx_, rect, read, [this] { sync_worker(); });
+    draw_questions(requests.cancel_question);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (done) script_.window_shot(read, fb_w, fb_h);

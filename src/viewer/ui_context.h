@@ -101,10 +101,16 @@ struct SceneFiles {
     bool ask_discard = false;                           // open that question this frame
 };
 
+// The questions' popup names (ImGui IDs, begun at the top level by ViewerApp::draw_questions).
+inline constexpr const char* kQuitQuestion = "Quit?";
+inline constexpr const char* kDiscardQuestion = "Unsaved edits";
+inline constexpr const char* kOverwriteQuestion = "Overwrite?";
+
 // The Save panel's paths (edited by the user) and the save awaiting the overwrite question.
 struct SaveTool {
     SavePaths paths;
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
+    bool ask_overwrite = false;  // open that question this frame
 };
 
 // The panel's width in window points: the default (labels uncut at the default font), the
@@ -175,7 +181,7 @@ void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file);
 void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path& path);
 // Save: the scene over its own file, without asking (Ctrl+S).
 void save_scene_in_place(PanelContext& ctx);
-// The overwrite question, drawn every frame where request_save may have opened it.
-void overwrite_popup(PanelContext& ctx);
+// The overwrite question (request_save asks for it), drawn every frame after the other windows.
+void overwrite_popup(PanelContext& ctx, bool cancel);
 
 }  // namespace kr::viewer

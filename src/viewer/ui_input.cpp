@@ -283,12 +283,13 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
         else if (typing) continue;
         else if (key == GLFW_KEY_ESCAPE) {
-            // Esc closes what is open first: the help, a drop-down or a question; then quits.
+            // Esc closes what is open first: the help, the selection, a drop-down or a question
+            // (its safe answer); then quits.
             if (ui.help_visible) ui.help_visible = false;
             else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && ui.selected) ui.selected.reset();
             else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
             else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
-            // (a question closes itself on Esc: its Cancel)
+            else requests.cancel_question = true;
         } else if (key == GLFW_KEY_TAB) {
             ui.panel_visible = !ui.panel_visible;
         }

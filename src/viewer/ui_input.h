@@ -64,6 +64,7 @@ struct InputState {
 struct WindowRequests {
     bool toggle_fullscreen = false;  // F11 (pressed an odd number of times)
     bool quit = false;               // Esc
+    bool cancel_question = false;    // Esc while a question is open: its safe answer
 };
 
 WindowRequests handle_input(PanelContext& ctx, InputState& input);

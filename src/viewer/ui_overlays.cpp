@@ -186,12 +186,12 @@ void draw_help(UiState& ui) {
     ImGui::End();
 }
 
-bool quit_popup(bool& asked) {
+bool quit_popup(bool& asked, bool cancel) {
     if (asked) {
-        ImGui::OpenPopup("Quit?");
+        ImGui::OpenPopup(kQuitQuestion);
         asked = false;
     }
-    if (!ImGui::BeginPopupModal("Quit?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return false;
+    if (!ImGui::BeginPopupModal(kQuitQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return false;
     ImGui::Text("The scene has unsaved edits. Quit and lose them?");
     bool quit = false;
     if (ImGui::Button("Quit without saving")) {
@@ -199,18 +199,25 @@ bool quit_popup(bool& asked) {
         ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
-    if (ImGui::Button("Cancel") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) ImGui::CloseCurrentPopup();
+    if (ImGui::Button("Cancel") || cancel) ImGui::CloseCurrentPopup();
     ImGui::EndPopup();
     return quit;
 }
 
-void discard_popup(PanelContext& ctx) {
+const char* open_question() {
+    if (ImGui::IsPopupOpen(kQuitQuestion)) return "quit";
+    if (ImGui::IsPopupOpen(kDiscardQuestion)) return "discard";
+    if (ImGui::IsPopupOpen(kOverwriteQuestion)) return "overwrite";
+    return "none";
+}
+
+void discard_popup(PanelContext& ctx, bool cancel) {
     SceneFiles& files = ctx.ui.files;
     if (files.ask_discard) {
-        ImGui::OpenPopup("Unsaved edits");
+        ImGui::OpenPopup(kDiscardQuestion);
         files.ask_discard = false;
     }
-    if (!ImGui::BeginPopupModal("Unsaved edits", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    if (!ImGui::BeginPopupModal(kDiscardQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
     const bool same = files.pending_open && *files.pending_open == files.watch.file();
     if (same) ImGui::Text("%s changed on disk, and the scene here has unsaved edits.", files.watch.file().filename().string().c_str());
     else ImGui::Text("The scene has unsaved edits. Open %s and lose them?",
@@ -227,7 +234,7 @@ void discard_popup(PanelContext& ctx) {
         ImGui::CloseCurrentPopup();
     }
     if (same) ImGui::SameLine();
-    if (ImGui::Button("Keep my edits") || ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false)) {
+    if (ImGui::Button("Keep my edits") || cancel) {
         if (same) ctx.messages.show_status("kept your edits; the file on disk differs (Save scene JSON to keep them)");
         files.pending_open.reset();
         ImGui::CloseCurrentPopup();

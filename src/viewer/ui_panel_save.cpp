@@ -70,15 +70,19 @@ void request_save(PanelContext& ctx, SaveKind kind, const fs::path& path) {
         std::error_code ec;
         if (!fs::exists(target, ec)) continue;
         ctx.ui.save.pending = std::make_pair(kind, path);
-        ImGui::OpenPopup("Overwrite?");
+        ctx.ui.save.ask_overwrite = true;
         return;
     }
     save_now(ctx, kind, path);
 }
 
-void overwrite_popup(PanelContext& ctx) {
+void overwrite_popup(PanelContext& ctx, bool cancel) {
     auto& pending = ctx.ui.save.pending;
-    if (!ImGui::BeginPopupModal("Overwrite?", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+    if (ctx.ui.save.ask_overwrite) {
+        ImGui::OpenPopup(kOverwriteQuestion);
+        ctx.ui.save.ask_overwrite = false;
+    }
+    if (!ImGui::BeginPopupModal(kOverwriteQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
     ImGui::Text("%s already exists. Overwrite it?", pending ? pending->second.string().c_str() : "");
     if (ImGui::Button("Overwrite")) {
         if (pending) save_now(ctx, pending->first, pending->second);
@@ -86,7 +90,7 @@ void overwrite_popup(PanelContext& ctx) {
         ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
-    if (ImGui::Button("Cancel")) {
+    if (ImGui::Button("Cancel") || cancel) {
         pending.reset();
         ctx.messages.show_status("not saved");
         ImGui::CloseCurrentPopup();
