@@ -379,7 +379,7 @@ TEST_F(CheckpointCli, DenoisedRenderResumesToTheWholeRendersBytes) {
     stop_at_second_checkpoint(plain + "-o raw.pfm", "raw.ckpt");
     const test::CommandResult refused = cli_here(denoised + "-o other.pfm --resume raw.ckpt");
     EXPECT_EQ(refused.status, 1);
-    EXPECT_EQ(refused.err, "error: --resume raw.ckpt: checkpoint of a render without --denoise (or under MPI): "
+    EXPECT_EQ(refused.err, "error: --resume raw.ckpt: checkpoint of a render without --denoise: "
                            "it lacks the two halves of the samples that --denoise reads; nothing rendered\n");
     EXPECT_FALSE(fs::exists(dir / "other.pfm"));
     // Without --denoise it goes on as before.

@@ -138,6 +138,29 @@ TEST_F(Mpi, SameBytesAtOneToFourRanks) {
     }
 }
 
+// `render --denoise`: each rank keeps its rows' two halves of the samples and the gather
+// brings them to rank 0, so the final filter (which cross-filters the halves) develops one
+// process's image at 1 to 4 ranks: the PNG-like PPM, and the EXR's denoised, raw and feature
+// layers, with adaptive passes and a rank owning no row (3 rows at 4 ranks). A checkpoint of
+// the denoised render keeps the halves: resumed at 2 and 3 ranks (each rank receives its
+// rows' halves) it develops the same image.
+TEST_F(Mpi, DenoisedRenderIsOneProcesssAtAnyRankCount) {
+    const std::string pt = scene(6, 24, "pt.json", "out.ppm", 19), rows = scene(6, 7, "rows.json", "out.ppm", 3);
+    expect_same_bytes(pt + " --spp 12 --denoise", "d.ppm");
+    expect_same_bytes(pt + " --spp 9 --estimator stratified --denoise", "d.exr");
+    expect_same_bytes(rows + " --spp 10 --denoise", "r.ppm");
+    const std::string args = "render -q " + pt + " --spp 8 --denoise --every 0 ";
+    const test::CommandResult single = here(keithray() + args + "--threads 2 -o single.ppm --checkpoint d.ckpt");
+    ASSERT_EQ(single.status, 0) << single.err;
+    for (int ranks : {2, 3}) {
+        SCOPED_TRACE(ranks);
+        const test::CommandResult r = here(mpirun(ranks) + args + "-o resumed.ppm --resume d.ckpt");
+        ASSERT_EQ(r.status, 0) << r.err;
+        EXPECT_EQ(r.err.find("note:"), std::string::npos) << r.err;
+        EXPECT_EQ(bytes("resumed.ppm"), bytes("single.ppm"));
+    }
+}
+
 // Row partitions where a rank owns one row or none (3 rows at 4 ranks), unequal shares and
 // odd sizes (5 rows of 7 pixels), with the adaptive plan and the noise rule reading the 3x3
 // guard across the ranks' rows.

@@ -424,7 +424,7 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
     if (!px.active.empty()) deal.gather(state, px.active, mine, gathered);
     if (!px.sample_credit.empty()) deal.gather(state, px.sample_credit, mine, gathered);
-    if (state.tracks_halves()) {  // the viewer's (its Save's final denoiser reads them)
+    if (state.tracks_halves()) {  // with --denoise and in the viewer: the final denoiser reads them
         deal.gather(state, px.half_sum, mine, gathered);
         deal.gather(state, px.half_count, mine, gathered);
     }
@@ -440,15 +440,16 @@ void Cluster::scatter_state(RenderState& state) const {
     const RowDeal deal{rank_, size_, state.width, state.height};
     PixelBuffers& px = state.buffers();
     // The counters and which optional buffers are in use, then each buffer.
-    long long counters[4] = {state.passes, (long long)state.nonfinite_samples, !px.active.empty(),
-                             !px.sample_credit.empty()};
-    MPI_Bcast(counters, 4, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    long long counters[5] = {state.passes, (long long)state.nonfinite_samples, !px.active.empty(),
+                             !px.sample_credit.empty(), state.tracks_halves()};
+    MPI_Bcast(counters, 5, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
     if (!leader()) {
         state.passes = int(counters[0]);
         state.nonfinite_samples = 0;  // counted once, at rank 0
         state.rays = 0;
         if (counters[2]) px.active.resize(px.sample_count.size());
         if (counters[3]) px.sample_credit.resize(px.sample_count.size());
+        if (counters[4] && !state.tracks_halves()) state.track_halves();
     }
     deal.scatter(px.radiance_sum);
     deal.scatter(px.radiance_compensation);
@@ -459,6 +460,10 @@ void Cluster::scatter_state(RenderState& state) const {
     deal.scatter(px.sample_index);
     if (counters[2]) deal.scatter(px.active);
     if (counters[3]) deal.scatter(px.sample_credit);
+    if (counters[4]) {  // a checkpoint of a render with --denoise: the final denoiser's halves
+        deal.scatter(px.half_sum);
+        deal.scatter(px.half_count);
+    }
 }
 
 std::vector<int> Cluster::held_rows(int height) const {

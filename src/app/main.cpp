@@ -325,8 +325,10 @@ private:
         // Rank 0 holds the whole state and writes the outputs; another rank holds its rows and
         // their neighbours only. Each checks its own machine.
         std::vector<int> held = cluster_.held_rows(height);
-        const uint64_t bytes = held.empty() ? render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off)
-                                            : render_state_bytes(width, held.size());
+        const uint64_t bytes =
+            held.empty() ? render_memory_bytes(width, height, opt_.blur > 0, denoise() != Denoise::off)
+                         : render_state_bytes(width, held.size()) +
+                               (denoise() != Denoise::off ? kHalvesBytesPerPixel * uint64_t(width) * held.size() : 0);
         const std::string shortfall = memory_shortfall(bytes, "the render of a " + image_);
         if (!shortfall.empty())
             std::fprintf(stderr, "error: %s: %s%s\n", file_.c_str(), shortfall.c_str(),
@@ -357,13 +359,10 @@ private:
                     decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
                     // The final denoiser reads the halves of every sample: without them in the
                     // checkpoint it would not make the uninterrupted render's image.
-                    if (denoise() != Denoise::off && !cluster_.distributed() && !state_.tracks_halves() &&
-                        state_.passes > 0)
+                    if (denoise() != Denoise::off && !state_.tracks_halves() && state_.passes > 0)
                         error = show_user_text(opt_.resume->string()) +
-                                ": checkpoint of a render without --denoise (or under MPI): it lacks the two halves "
+                                ": checkpoint of a render without --denoise: it lacks the two halves "
                                 "of the samples that --denoise reads";
-                    // Under MPI the halves are not kept (render()): stale ones would be written on.
-                    if (cluster_.distributed()) state_.untrack_halves();
                 } catch (const std::runtime_error& e) {
                     error = e.what();
                 }
@@ -386,14 +385,8 @@ private:
         double last_draw = -1;
         StopOnSignal stop_on_signal(opt_.checkpoint.has_value());
         // The final denoiser's two halves of the samples, from here on or from the checkpoint
-        // resumed; under MPI they are not gathered, and it filters without them.
-        if (denoise() != Denoise::off) {
-            if (!cluster_.distributed()) {
-                if (!state_.tracks_halves()) state_.track_halves();
-            } else if (leader_)
-                std::fprintf(stderr, "note: %s: under MPI --denoise filters without the two halves of the samples "
-                                     "(docs/denoising.md)\n", file_.c_str());
-        }
+        // resumed (under MPI each rank keeps its rows', and the gather brings them to rank 0).
+        if (denoise() != Denoise::off && !state_.tracks_halves()) state_.track_halves();
         hooks_ = cluster_.deal_rows();
         const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
         // The progress line's estimated error is added up from every rank's rows: every rank
