@@ -216,6 +216,48 @@ TEST(Accel, SmallScenesAreOneLeaf) {
     EXPECT_EQ(room.bvh.node_count(), 1u);
 }
 
+// The float lanes' scan of up to kLaneScanMaxSpheres (LaneTree::clusters): every sphere once,
+// the wall (a box spanning the scene) first and alone, the others in clusters of up to eight
+// whose padded boxes hold them; none above kLaneScanMaxSpheres, where the lanes walk the tree.
+TEST(Accel, LaneClustersHoldEverySphereOnce) {
+    const RenderScene scene = with_backend(random_spheres(60, 1.0, 7, true), AccelBackend::own);
+    const LaneTree& tree = scene.bvh.lane_tree();
+    ASSERT_FALSE(tree.clusters.empty());
+    ASSERT_EQ(tree.scan_f.size(), scene.spheres.size());
+    std::vector<int> seen(scene.spheres.size(), 0);
+    for (const LaneSphere<float>& s : tree.scan_f) ++seen[size_t(s.id)];
+    for (size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], 1) << "sphere " << i;
+    const LaneCluster& first = tree.clusters.front();
+    EXPECT_EQ(first.count, 1);
+    EXPECT_FALSE(first.boxed);
+    EXPECT_EQ(tree.scan_f[first.first].id, 60);  // the wall
+    uint32_t next = 0;
+    size_t boxed = 0;
+    for (const LaneCluster& c : tree.clusters) {
+        EXPECT_EQ(c.first, next);  // in order, without gaps
+        next += c.count;
+        EXPECT_GE(c.count, 1);
+        EXPECT_LE(c.count, 8);
+        EXPECT_EQ(c.boxed, c.count > 1);
+        if (!c.boxed) continue;
+        ++boxed;
+        for (uint32_t k = c.first; k < c.first + c.count; ++k) {
+            const SphereGeom& s = scene.spheres[size_t(tree.scan_f[k].id)];
+            const double centre[3] = {s.centre.x, s.centre.y, s.centre.z};
+            for (int a = 0; a < 3; ++a) {
+                EXPECT_LT(double(c.lo[a]), centre[a] - s.radius);
+                EXPECT_GT(double(c.hi[a]), centre[a] + s.radius);
+            }
+        }
+    }
+    EXPECT_EQ(next, scene.spheres.size());
+    EXPECT_GE(boxed, 60u / 8);
+    const RenderScene many = with_backend(random_spheres(200, 1.0, 7, true), AccelBackend::own);
+    EXPECT_FALSE(many.bvh.lane_tree().nodes.empty());
+    EXPECT_TRUE(many.bvh.lane_tree().clusters.empty());
+    EXPECT_TRUE(many.bvh.lane_tree().scan_f.empty());
+}
+
 TEST(Accel, CoincidentCentresStillSplit) {
     test::SceneBuilder b;
     const int m = b.material(MaterialType::diffuse);

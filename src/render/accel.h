@@ -65,16 +65,25 @@ struct LaneSphere {
     Real centre_l1;  // |centre|_1, for the single-precision lanes' shadow segments
     int32_t id;      // the sphere's index in the scene
 };
-// Up to this many spheres the sixteen float lanes scan them all rather than walk the lane
-// tree (docs/performance.md, "Sixteen single-precision lanes").
+// Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
+// walk the lane tree (docs/performance.md, "Sixteen single-precision lanes").
 inline constexpr size_t kLaneScanMaxSpheres = 128;
+// Spheres near each other that the scan tests after their box (boxed), or a sphere it tests
+// alone: scan_f[first, first + count).
+struct LaneCluster {
+    float lo[3], hi[3];  // padded and rounded outward as LaneNode's
+    uint32_t first = 0;
+    uint16_t count = 0;
+    bool boxed = false;
+};
 struct LaneTree {
     std::vector<LaneNode> nodes;  // empty: no tree (a one-leaf scene, or Embree's only)
     std::vector<LaneSphere<float>> spheres_f;
     std::vector<LaneSphere<double>> spheres_d;
-    // spheres_f in the scene's order, for a tree of up to kLaneScanMaxSpheres (else empty):
-    // what the sixteen lanes scan.
+    // For a tree of up to kLaneScanMaxSpheres (else empty): what the float lanes scan, the
+    // spheres by cluster (spheres whose boxes span a large part of the scene's first, alone).
     std::vector<LaneSphere<float>> scan_f;
+    std::vector<LaneCluster> clusters;
     int depth = 0;
 };
 
