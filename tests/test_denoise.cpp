@@ -2,6 +2,8 @@
 // buffers and halves, and on path-traced scenes against a high-spp reference.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <cmath>
 #include <random>
 
@@ -226,6 +228,55 @@ TEST(Denoise, DepthEdgeIsKept) {
         expect_edge_kept(
             [](Synthetic& s, int x, int y, bool left) { s.set(x, y, left ? 0.2 : 0.8, 0.5, {0, 0, -1}, left ? 5 : 50); },
             0.2, 0.8, 0.03, final);
+}
+
+// The interactive filter splits its rows between threads and each row into spans by which
+// taps fall outside the image: the image is the same bits at 1, 2 and 3 threads, on an image
+// narrower than its widest step (every span kind) and on one with edges in every feature and
+// pixels of unknown variance; and with a workspace reused from a larger image.
+TEST(Denoise, AtrousDoesNotDependOnTheThreadCount) {
+    const int threads = omp_get_max_threads();
+    for (const auto [w, h] : {std::pair{61, 45}, std::pair{20, 7}, std::pair{1, 3}}) {
+        Synthetic s(w, h);
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<double> u(0, 1);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool left = x < w / 2, top = y < h / 3;
+                s.set(x, y, left ? 0.2 : 0.8, top ? 0.3 : 0.6, left ? Vec3{-0.7071, 0, -0.7071} : Vec3{0, 0, -1},
+                      top ? 5 + 0.1 * x : 50);
+            }
+        s.add_noise(0.2);
+        for (size_t i = 0; i < s.truth.pixels.size(); i += 13)
+            for (int k = 0; k < 3; ++k) s.variance[3 * i + size_t(k)] = INFINITY;  // one sample there
+        DenoiseWorkspace reused;
+        {
+            Synthetic big(70, 50);
+            big.add_noise(0.1);
+            (void)denoise_atrous(big.input(), {}, &reused);
+        }
+        std::vector<Image> out;
+        for (const int n : {1, 2, 3}) {
+            omp_set_num_threads(n);
+            out.push_back(denoise_atrous(s.input()));
+            out.push_back(denoise_atrous(s.input(), {}, &reused));
+        }
+        omp_set_num_threads(threads);
+        for (const Image& img : out)
+            for (size_t i = 0; i < img.pixels.size(); ++i)
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(img.pixels[i][k])) << w << "x" << h << " pixel " << i;
+                    ASSERT_EQ(img.pixels[i][k], out[0].pixels[i][k]) << w << "x" << h << " pixel " << i;
+                }
+        if (w * h < 100) continue;
+        // The filter did something: the noise dropped.
+        double raw = 0, filtered = 0;
+        for (size_t i = 0; i < s.truth.pixels.size(); ++i) {
+            raw += std::pow(s.noisy.pixels[i].y - s.truth.pixels[i].y, 2);
+            filtered += std::pow(out[0].pixels[i].y - s.truth.pixels[i].y, 2);
+        }
+        EXPECT_LT(filtered, raw) << w << "x" << h;
+    }
 }
 
 // With every weight at one (distances scaled away, flat features, no fade) the final filter

@@ -27,11 +27,33 @@ inline float fast_exp_neg(float x) {
 
 using Planes = DenoiseWorkspace;
 
+// Compiled for AVX-512 and AVX2 too where GCC can dispatch on the CPU: the a-trous filter's
+// loops, which the compiler vectorises.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define KR_DENOISE_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+#else
+#define KR_DENOISE_CLONES
+#endif
+// A loop whose iterations are independent (its planes do not overlap): vectorised without
+// run-time alias checks, which the many planes of a loop would exceed.
+#if defined(__clang__)
+#define KR_INDEPENDENT_ITERATIONS _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define KR_INDEPENDENT_ITERATIONS _Pragma("GCC ivdep")
+#else
+#define KR_INDEPENDENT_ITERATIONS
+#endif
+
 // Where a pixel's variance is unknown (one sample): the luminance's variance over its 3x3
 // neighbourhood, the variance of one sample where the neighbours are alike.
 void fill_unknown_variance(int w, int h, const std::vector<float>& lum, std::vector<float>& var) {
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < h; ++y)
+    for (int y = 0; y < h; ++y) {
+        // Most rows have none: a count the compiler vectorises first.
+        const float* row = var.data() + size_t(y) * size_t(w);
+        int unknown = 0;
+        for (int x = 0; x < w; ++x) unknown += !std::isfinite(row[x]);
+        if (unknown == 0) continue;
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             if (std::isfinite(var[i])) continue;
@@ -48,27 +70,136 @@ void fill_unknown_variance(int w, int h, const std::vector<float>& lum, std::vec
                 }
             var[i] = float(std::max(0.0, (s2 - s * s / n) / std::max(n - 1, 1)));
         }
+    }
 }
 
 // 3x3 binomial blur of a plane (borders renormalised): SVGF's prefilter of the variance
-// before it scales the luminance stop.
+// before it scales the luminance stop. Row y; inside the border the weights sum to 1 exactly
+// and the taps are added in the same order, so both loops give the same sums.
+KR_DENOISE_CLONES
+void blur3_row(const float* v, float* out, int w, int h, int y) {
+    constexpr float k[3] = {0.25f, 0.5f, 0.25f};
+    const auto border = [&](int x) {
+        float s = 0, ws = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const int xx = x + dx, yy = y + dy;
+                if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                const float wk = k[dx + 1] * k[dy + 1];
+                s += wk * v[size_t(yy) * size_t(w) + size_t(xx)];
+                ws += wk;
+            }
+        out[size_t(y) * size_t(w) + size_t(x)] = s / ws;
+    };
+    if (y == 0 || y == h - 1 || w < 3) {
+        for (int x = 0; x < w; ++x) border(x);
+        return;
+    }
+    const size_t row = size_t(y) * size_t(w);
+    const float *__restrict up = v + row - w, *__restrict mid = v + row, *__restrict down = v + row + w;
+    float* __restrict o = out + row;
+    border(0);
+    for (int x = 1; x < w - 1; ++x) {
+        float s = 0;
+        s += k[0] * k[0] * up[x - 1];
+        s += k[1] * k[0] * up[x];
+        s += k[2] * k[0] * up[x + 1];
+        s += k[0] * k[1] * mid[x - 1];
+        s += k[1] * k[1] * mid[x];
+        s += k[2] * k[1] * mid[x + 1];
+        s += k[0] * k[2] * down[x - 1];
+        s += k[1] * k[2] * down[x];
+        s += k[2] * k[2] * down[x + 1];
+        o[x] = s;
+    }
+    border(w - 1);
+}
+
 void blur3(int w, int h, const std::vector<float>& v, std::vector<float>& out) {
     out.resize(v.size());
-    constexpr float k[3] = {0.25f, 0.5f, 0.25f};
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            float s = 0, ws = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                    const float wk = k[dx + 1] * k[dy + 1];
-                    s += wk * v[size_t(yy) * size_t(w) + size_t(xx)];
-                    ws += wk;
-                }
-            out[size_t(y) * size_t(w) + size_t(x)] = s / ws;
+    for (int y = 0; y < h; ++y) blur3_row(v.data(), out.data(), w, h, y);
+}
+
+// prepare's per-pixel step, pixels [i0, i1): the demodulated radiance, the variances and
+// luminances (demodulated and raw), the unit feature vector and the depth.
+KR_DENOISE_CLONES
+void prepare_pixels(const DenoiseInput& in, Planes& p, size_t i0, size_t i1) {
+    const Color* __restrict rad = in.radiance->pixels.data();
+    const float *__restrict variance = in.variance.data(), *__restrict albedo = in.albedo.data(),
+                *__restrict normal = in.normal.data();
+    const double* __restrict depth = in.depth.data();
+    float *__restrict d0 = p.demod[0].data(), *__restrict d1 = p.demod[1].data(), *__restrict d2 = p.demod[2].data();
+    float *__restrict c0 = p.c[0].data(), *__restrict c1 = p.c[1].data(), *__restrict c2 = p.c[2].data();
+    float *__restrict f0 = p.f[0].data(), *__restrict f1 = p.f[1].data(), *__restrict f2 = p.f[2].data(),
+          *__restrict f3 = p.f[3].data();
+    float *__restrict var_out = p.var.data(), *__restrict raw_var_out = p.raw_var.data(), *__restrict lum = p.lum.data(),
+          *__restrict raw_lum = p.lum_raw.data(), *__restrict z = p.z.data();
+KR_INDEPENDENT_ITERATIONS
+    for (size_t i = i0; i < i1; ++i) {
+        const float r[3] = {float(rad[i].x), float(rad[i].y), float(rad[i].z)};
+        float d[3], c[3];
+        float var = 0, raw_var = 0, l = 0, raw_l = 0;
+        for (int k = 0; k < 3; ++k) {
+            // Demodulation: the illumination is the radiance over the albedo.
+            d[k] = std::max(0.f, albedo[3 * i + size_t(k)]) + kAlbedoFloor;
+            c[k] = r[k] / d[k];
+            const float v = variance[3 * i + size_t(k)];
+            var += kLum[k] * kLum[k] * v / (d[k] * d[k]);
+            raw_var += kLum[k] * kLum[k] * v;
+            l += kLum[k] * c[k];  // as the a-trous passes take it from p.c
+            raw_l += kLum[k] * r[k];
         }
+        d0[i] = d[0];
+        d1[i] = d[1];
+        d2[i] = d[2];
+        c0[i] = c[0];
+        c1[i] = c[1];
+        c2[i] = c[2];
+        var_out[i] = std::isfinite(var) ? var : INFINITY;
+        raw_var_out[i] = std::isfinite(raw_var) ? raw_var : INFINITY;
+        lum[i] = l;
+        raw_lum[i] = raw_l;
+        // The feature vector: the averaged normal and how much of the pixel saw nothing.
+        const float nx = normal[3 * i], ny = normal[3 * i + 1], nz = normal[3 * i + 2];
+        const float len = std::sqrt(nx * nx + ny * ny + nz * nz);
+        const float miss = std::max(0.f, 1.f - len);
+        const float norm = std::sqrt(len * len + miss * miss);
+        const float inv = norm > 0 ? 1 / norm : 0;
+        f0[i] = nx * inv;
+        f1[i] = ny * inv;
+        f2[i] = nz * inv;
+        f3[i] = norm > 0 ? miss * inv : 1;
+        z[i] = float(depth[i]);
+    }
+}
+
+// The depth gradient of row y: per axis the smaller one-sided difference (the smooth side at
+// a silhouette; a side outside the image does not count), summed over the axes so that any
+// 3x3 tap's change on a plane stays below it.
+KR_DENOISE_CLONES
+void depth_gradient_row(const float* z_plane, float* zgrad, int w, int h, int y) {
+    const size_t row = size_t(y) * size_t(w);
+    const float* __restrict z = z_plane + row;
+    // A missing row above or below: read the row itself, its side taken as infinite.
+    const bool has_up = y > 0, has_down = y + 1 < h;
+    const float *__restrict up = has_up ? z - w : z, *__restrict down = has_down ? z + w : z;
+    float* __restrict out = zgrad + row;
+    const auto pixel = [&](int x, float left, float right) __attribute__((always_inline)) {
+        const float zc = z[x];
+        const float su = has_up ? std::fabs(up[x] - zc) : INFINITY, sd = has_down ? std::fabs(down[x] - zc) : INFINITY;
+        float gx = std::min(left, right), gy = std::min(su, sd);
+        if (!std::isfinite(gx)) gx = 0;
+        if (!std::isfinite(gy)) gy = 0;
+        out[x] = gx + gy;
+    };
+    if (w == 1) {
+        pixel(0, INFINITY, INFINITY);
+        return;
+    }
+    pixel(0, INFINITY, std::fabs(z[1] - z[0]));
+    for (int x = 1; x < w - 1; ++x) pixel(x, std::fabs(z[x - 1] - z[x]), std::fabs(z[x + 1] - z[x]));
+    pixel(w - 1, std::fabs(z[w - 2] - z[w - 1]), INFINITY);
 }
 
 void prepare(const DenoiseInput& in, Planes& p) {
@@ -87,61 +218,15 @@ void prepare(const DenoiseInput& in, Planes& p) {
     p.raw_var.resize(n);
     p.z.resize(n);
     p.zgrad.resize(n);
-    std::vector<float>&lum = p.lum, &raw_lum = p.lum_raw;
-    lum.resize(n);
-    raw_lum.resize(n);
-    const long count = long(n);
-#pragma omp parallel for schedule(static)
-    for (long li = 0; li < count; ++li) {
-        const size_t i = size_t(li);
-        float var = 0, raw_var = 0, l = 0, raw_l = 0;
-        for (int k = 0; k < 3; ++k) {
-            // Demodulation: the illumination is the radiance over the albedo.
-            const float d = std::max(0.f, in.albedo[3 * i + size_t(k)]) + kAlbedoFloor;
-            const float r = float(rad.pixels[i][k]);
-            const float v = in.variance[3 * i + size_t(k)];
-            p.demod[k][i] = d;
-            p.c[k][i] = r / d;
-            var += kLum[k] * kLum[k] * v / (d * d);
-            raw_var += kLum[k] * kLum[k] * v;
-            l += kLum[k] * r / d;
-            raw_l += kLum[k] * r;
-        }
-        p.var[i] = std::isfinite(var) ? var : INFINITY;
-        p.raw_var[i] = std::isfinite(raw_var) ? raw_var : INFINITY;
-        lum[i] = l;
-        raw_lum[i] = raw_l;
-        // The feature vector: the averaged normal and how much of the pixel saw nothing.
-        const float nx = in.normal[3 * i], ny = in.normal[3 * i + 1], nz = in.normal[3 * i + 2];
-        const float len = std::sqrt(nx * nx + ny * ny + nz * nz);
-        const float miss = std::max(0.f, 1.f - len);
-        const float norm = std::sqrt(len * len + miss * miss);
-        const float inv = norm > 0 ? 1 / norm : 0;
-        p.f[0][i] = nx * inv;
-        p.f[1][i] = ny * inv;
-        p.f[2][i] = nz * inv;
-        p.f[3][i] = norm > 0 ? miss * inv : 1;
-        p.z[i] = float(in.depth[i]);
-    }
-    fill_unknown_variance(p.w, p.h, lum, p.var);
-    fill_unknown_variance(p.w, p.h, raw_lum, p.raw_var);
-    // The depth gradient: per axis the smaller one-sided difference (the smooth side at a
-    // silhouette), summed over the axes so that any 3x3 tap's change on a plane stays below it.
+    p.lum.resize(n);
+    p.lum_raw.resize(n);
     const int w = p.w, h = p.h;
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const size_t i = size_t(y) * size_t(w) + size_t(x);
-            auto side = [&](int dx, int dy) {
-                const int xx = x + dx, yy = y + dy;
-                if (xx < 0 || yy < 0 || xx >= w || yy >= h) return INFINITY;
-                return std::fabs(p.z[size_t(yy) * size_t(w) + size_t(xx)] - p.z[i]);
-            };
-            float gx = std::min(side(-1, 0), side(1, 0)), gy = std::min(side(0, -1), side(0, 1));
-            if (!std::isfinite(gx)) gx = 0;
-            if (!std::isfinite(gy)) gy = 0;
-            p.zgrad[i] = gx + gy;
-        }
+    for (int y = 0; y < h; ++y) prepare_pixels(in, p, size_t(y) * size_t(w), size_t(y + 1) * size_t(w));
+    fill_unknown_variance(w, h, p.lum, p.var);
+    fill_unknown_variance(w, h, p.lum_raw, p.raw_var);
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < h; ++y) depth_gradient_row(p.z.data(), p.zgrad.data(), w, h, y);
 }
 
 // Both filters' start: the caller's workspace (or `local`), prepared for `input`.
@@ -151,34 +236,105 @@ Planes& prepared_planes(const DenoiseInput& input, DenoiseWorkspace* workspace, 
     return p;
 }
 
-// One tap of an a-trous pass along a row: pixels [x0, x1) of the row at p, their taps at
-// p + off. Compiled for AVX2 too where GCC can dispatch on the CPU (twice the lanes).
-struct TapRow {
-    const float *lum, *z, *inv_l, *inv_z, *f[4], *c[3], *var;
-    float *sw, *sc[3], *sv;
+// One a-trous pass: what a row of it reads (the taps: the pass's input planes; the centre:
+// the stops' scales) and writes (the next pass's planes), all w x h and row-major.
+struct AtrousPass {
+    const float *lum, *z, *f[4], *c[3], *var;  // the taps' luminance, depth, feature, radiance, variance
+    const float *var_centre, *zgrad;           // the luminance stop's variance, the depth gradient
+    float *out_c[3], *out_var, *out_lum;
+    int w, h, step;
+    float sigma_luminance, gate, zscale, sigma_normal;
 };
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float sigma_normal) {
-    const float *l = r.lum, *ql = r.lum + off, *z = r.z, *qz = r.z + off, *il = r.inv_l, *iz = r.inv_z;
-    const float *f0 = r.f[0], *f1 = r.f[1], *f2 = r.f[2], *f3 = r.f[3];
-    const float *q0 = f0 + off, *q1 = f1 + off, *q2 = f2 + off, *q3 = f3 + off;
-    const float *qr = r.c[0] + off, *qg = r.c[1] + off, *qb = r.c[2] + off, *qv = r.var + off;
-    float *aw = r.sw, *ar = r.sc[0], *ag = r.sc[1], *ab = r.sc[2], *av = r.sv;
-#pragma omp simd
+
+// The pixels [x0, x1) of row `row` (its first pixel's index): all nine taps fused in one
+// loop, the sums in registers. The template arguments say which taps lie inside the image
+// (the rows above and below, the columns left and right), so the loop has no test per tap
+// and reads no tap outside the image.
+template <bool Up, bool Down, bool Left, bool Right>
+[[gnu::always_inline]] inline void atrous_span(const AtrousPass& a, size_t row, int x0, int x1) {
+    const ptrdiff_t dy = ptrdiff_t(a.step) * a.w, dx = a.step;
+    const float* __restrict lum = a.lum + row;
+    const float* __restrict z = a.z + row;
+    const float *__restrict f0 = a.f[0] + row, *__restrict f1 = a.f[1] + row, *__restrict f2 = a.f[2] + row,
+                *__restrict f3 = a.f[3] + row;
+    const float *__restrict c0 = a.c[0] + row, *__restrict c1 = a.c[1] + row, *__restrict c2 = a.c[2] + row;
+    const float* __restrict var = a.var + row;
+    const float *__restrict vc = a.var_centre + row, *__restrict zg = a.zgrad + row;
+    float *__restrict o0 = a.out_c[0] + row, *__restrict o1 = a.out_c[1] + row, *__restrict o2 = a.out_c[2] + row,
+          *__restrict ov = a.out_var + row, *__restrict ol = a.out_lum + row;
+    const float sigma_l = a.sigma_luminance, gate = a.gate, zscale = a.zscale, sigma_n = a.sigma_normal;
+KR_INDEPENDENT_ITERATIONS
     for (int x = x0; x < x1; ++x) {
-        // The edge stops, summed in one exponent.
-        const float el = std::fabs(l[x] - ql[x]) * il[x];
-        const float ez = std::fabs(z[x] - qz[x]) * iz[x];
-        const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
-        const float en = sigma_normal * std::max(0.f, 1.f - fd);
-        const float wt = tap * fast_exp_neg(el + ez + en);
-        aw[x] += wt;
-        ar[x] += wt * qr[x];
-        ag[x] += wt * qg[x];
-        ab[x] += wt * qb[x];
-        av[x] += wt * wt * qv[x];
+        // The stops' scales at the centre: the luminance's by the standard deviation, the
+        // depth's by the gradient over the step.
+        const float l = lum[x], zc = z[x], g0 = f0[x], g1 = f1[x], g2 = f2[x], g3 = f3[x];
+        const float il = gate / (sigma_l * std::sqrt(std::max(0.f, vc[x])) + 1e-12f);
+        const float iz = 1 / (zscale * zg[x] + 1e-3f * zc + 1e-9f);
+        float sw = 0, sr = 0, sg = 0, sb = 0, sv = 0;
+        // The tap at offset `off` of weight `k`: the edge stops, summed in one exponent.
+        const auto tap = [&](ptrdiff_t off, float k) __attribute__((always_inline)) {
+            const ptrdiff_t j = x + off;
+            const float el = std::fabs(l - lum[j]) * il;
+            const float ez = std::fabs(zc - z[j]) * iz;
+            const float fd = g0 * f0[j] + g1 * f1[j] + g2 * f2[j] + g3 * f3[j];
+            const float en = sigma_n * std::max(0.f, 1.f - fd);
+            const float wt = k * fast_exp_neg(el + ez + en);
+            sw += wt;
+            sr += wt * c0[j];
+            sg += wt * c1[j];
+            sb += wt * c2[j];
+            sv += wt * wt * var[j];
+        };
+        // The taps in the order of rows, then columns, with the B-spline's weights.
+        if constexpr (Up) {
+            if constexpr (Left) tap(-dy - dx, 1 / 16.f);
+            tap(-dy, 1 / 8.f);
+            if constexpr (Right) tap(-dy + dx, 1 / 16.f);
+        }
+        if constexpr (Left) tap(-dx, 1 / 8.f);
+        tap(0, 1 / 4.f);
+        if constexpr (Right) tap(dx, 1 / 8.f);
+        if constexpr (Down) {
+            if constexpr (Left) tap(dy - dx, 1 / 16.f);
+            tap(dy, 1 / 8.f);
+            if constexpr (Right) tap(dy + dx, 1 / 16.f);
+        }
+        // The centre tap always counts, so the weights' sum is at least 1/4.
+        const float inv = 1 / sw;
+        const float r = sr * inv, g = sg * inv, b = sb * inv;
+        o0[x] = r;
+        o1[x] = g;
+        o2[x] = b;
+        ov[x] = sv * inv * inv;
+        ol[x] = kLum[0] * r + kLum[1] * g + kLum[2] * b;
+    }
+}
+
+template <bool Up, bool Down>
+[[gnu::always_inline]] inline void atrous_span_rows(const AtrousPass& a, size_t row, int x0, int x1, bool left,
+                                                     bool right) {
+    if (left && right) atrous_span<Up, Down, true, true>(a, row, x0, x1);
+    else if (left) atrous_span<Up, Down, true, false>(a, row, x0, x1);
+    else if (right) atrous_span<Up, Down, false, true>(a, row, x0, x1);
+    else atrous_span<Up, Down, false, false>(a, row, x0, x1);
+}
+
+// Row y of a pass, in up to three spans: where the left taps are outside (x < step), where
+// all are inside, where the right ones are outside (x >= w - step).
+KR_DENOISE_CLONES
+void atrous_row(const AtrousPass& a, int y) {
+    const size_t row = size_t(y) * size_t(a.w);
+    const bool up = y - a.step >= 0, down = y + a.step < a.h;
+    const int b0 = std::clamp(std::min(a.step, a.w - a.step), 0, a.w), b1 = std::clamp(std::max(a.step, a.w - a.step), 0, a.w);
+    const int bounds[4] = {0, b0, b1, a.w};
+    for (int s = 0; s < 3; ++s) {
+        const int x0 = bounds[s], x1 = bounds[s + 1];
+        if (x0 >= x1) continue;
+        const bool left = x0 >= a.step, right = x0 < a.w - a.step;
+        if (up && down) atrous_span_rows<true, true>(a, row, x0, x1, left, right);
+        else if (up) atrous_span_rows<true, false>(a, row, x0, x1, left, right);
+        else if (down) atrous_span_rows<false, true>(a, row, x0, x1, left, right);
+        else atrous_span_rows<false, false>(a, row, x0, x1, left, right);
     }
 }
 
@@ -186,29 +342,36 @@ void add_tap(const TapRow& r, ptrdiff_t off, int x0, int x1, float tap, float si
 // then faded towards the raw radiance as its relative standard error drops (the
 // 3x3-prefiltered raw variance against the filtered luminance), so a converged pixel keeps
 // its raw value. A pixel whose p.c is NaN keeps its raw value exactly.
+KR_DENOISE_CLONES
+void remodulate_and_fade_pixels(const Image& raw, const Planes& p, const float* raw_var, float t2, Image& out,
+                                size_t i0, size_t i1) {
+    const float *__restrict c0 = p.c[0].data(), *__restrict c1 = p.c[1].data(), *__restrict c2 = p.c[2].data();
+    const float *__restrict d0 = p.demod[0].data(), *__restrict d1 = p.demod[1].data(), *__restrict d2 = p.demod[2].data();
+    const Color* __restrict in = raw.pixels.data();
+    Color* __restrict o = out.pixels.data();
+    // Selects rather than branches, so that the loop vectorises.
+KR_INDEPENDENT_ITERATIONS
+    for (size_t i = i0; i < i1; ++i) {
+        const Color filtered{double(c0[i] * d0[i]), double(c1[i] * d1[i]), double(c2[i] * d2[i])};
+        const double l = std::max(luminance(filtered), 0.0), v = raw_var[i];
+        const double r2 = l > 0 ? v / (l * l) : (v > 0 ? INFINITY : 0.0);
+        const double blend = t2 > 0 && std::isfinite(r2) ? r2 / (r2 + t2) : 1.0;
+        const bool keep = std::isnan(c0[i]);
+        const Color r = in[i];
+        o[i] = Color(keep ? r.x : r.x + blend * (filtered.x - r.x), keep ? r.y : r.y + blend * (filtered.y - r.y),
+                     keep ? r.z : r.z + blend * (filtered.z - r.z));
+    }
+}
+
 void remodulate_and_fade(const DenoiseInput& input, float fade_error, Planes& p, Image& out) {
     std::vector<float>& raw_var = p.var_blur;
     blur3(p.w, p.h, p.raw_var, raw_var);
     const float t2 = fade_error * fade_error;
     const Image& raw = *input.radiance;
-    const long count = long(raw.pixels.size());
+    const size_t w = size_t(p.w);
 #pragma omp parallel for schedule(static)
-    for (long li = 0; li < count; ++li) {
-        const size_t i = size_t(li);
-        if (std::isnan(p.c[0][i])) {
-            out.pixels[i] = raw.pixels[i];
-            continue;
-        }
-        const Color filtered{double(p.c[0][i] * p.demod[0][i]), double(p.c[1][i] * p.demod[1][i]),
-                             double(p.c[2][i] * p.demod[2][i])};
-        const double l = std::max(luminance(filtered), 0.0);
-        double blend = 1;
-        if (t2 > 0) {
-            const double r2 = l > 0 ? raw_var[i] / (l * l) : (raw_var[i] > 0 ? INFINITY : 0.0);
-            blend = std::isfinite(r2) ? r2 / (r2 + t2) : 1.0;
-        }
-        out.pixels[i] = raw.pixels[i] + blend * (filtered - raw.pixels[i]);
-    }
+    for (int y = 0; y < p.h; ++y)
+        remodulate_and_fade_pixels(raw, p, raw_var.data(), t2, out, size_t(y) * w, size_t(y + 1) * w);
 }
 
 }  // namespace
@@ -220,78 +383,38 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, Deno
     const size_t n = size_t(w) * size_t(h);
     Image out(w, h);
     if (n == 0) return out;
-    std::vector<float>(&c2)[3] = p.c2;
-    std::vector<float>&var2 = p.var2, &inv_l = p.inv_l, &inv_z = p.inv_z, &lum = p.lum, &var_blur = p.var_blur;
-    for (auto* plane : {&c2[0], &c2[1], &c2[2], &var2, &inv_l, &inv_z, &lum}) plane->resize(n);
-    constexpr float kTap[3] = {0.25f, 0.5f, 0.25f};
-    blur3(w, h, p.var, var_blur);
+    for (auto* plane : {&p.c2[0], &p.c2[1], &p.c2[2], &p.var2, &p.lum2}) plane->resize(n);
+    // The first pass's luminance stop takes the variance 3x3-prefiltered; later passes' is
+    // filtered already.
+    blur3(w, h, p.var, p.var_blur);
     // One team of threads for every pass (each loop ends at a barrier).
 #pragma omp parallel
-    {
-        const size_t row_len = size_t(w);
-        std::vector<float> sw(row_len), sr(row_len), sg(row_len), sb(row_len), sv(row_len);
-        for (int it = 0; it < params.iterations; ++it) {
-            const int step = 1 << it;
-            // Per pixel, the stops' scales for this pass: the luminance's by the standard
-            // deviation (the first pass's variance 3x3-prefiltered; later passes' is filtered
-            // already), the depth's by the gradient over the step.
-            const float* var = it == 0 ? var_blur.data() : p.var.data();
-            const float gate = params.sigma_luminance > 0 ? 1.f : 0.f, zscale = params.sigma_depth * float(step);
-            const float *c0 = p.c[0].data(), *c1 = p.c[1].data(), *cb = p.c[2].data(), *zg = p.zgrad.data(),
-                        *zz = p.z.data();
-            float *lo = lum.data(), *ilo = inv_l.data(), *izo = inv_z.data();
-#pragma omp for simd schedule(static)
-            for (long i = 0; i < long(n); ++i) {
-                lo[i] = kLum[0] * c0[i] + kLum[1] * c1[i] + kLum[2] * cb[i];
-                const float sd = std::sqrt(std::max(0.f, var[i]));
-                ilo[i] = gate / (params.sigma_luminance * sd + 1e-12f);
-                izo[i] = 1 / (zscale * zg[i] + 1e-3f * zz[i] + 1e-9f);
-            }
+    for (int it = 0; it < params.iterations; ++it) {
+        const int step = 1 << it;
+        const AtrousPass a{p.lum.data(),
+                           p.z.data(),
+                           {p.f[0].data(), p.f[1].data(), p.f[2].data(), p.f[3].data()},
+                           {p.c[0].data(), p.c[1].data(), p.c[2].data()},
+                           p.var.data(),
+                           it == 0 ? p.var_blur.data() : p.var.data(),
+                           p.zgrad.data(),
+                           {p.c2[0].data(), p.c2[1].data(), p.c2[2].data()},
+                           p.var2.data(),
+                           p.lum2.data(),
+                           w,
+                           h,
+                           step,
+                           params.sigma_luminance,
+                           params.sigma_luminance > 0 ? 1.f : 0.f,
+                           params.sigma_depth * float(step),
+                           params.sigma_normal};
 #pragma omp for schedule(static)
-            for (int y = 0; y < h; ++y) {
-                std::fill(sw.begin(), sw.end(), 0.f);
-                std::fill(sr.begin(), sr.end(), 0.f);
-                std::fill(sg.begin(), sg.end(), 0.f);
-                std::fill(sb.begin(), sb.end(), 0.f);
-                std::fill(sv.begin(), sv.end(), 0.f);
-                const size_t row = size_t(y) * size_t(w);
-                const TapRow r{lum.data() + row,
-                               p.z.data() + row,
-                               inv_l.data() + row,
-                               inv_z.data() + row,
-                               {p.f[0].data() + row, p.f[1].data() + row, p.f[2].data() + row, p.f[3].data() + row},
-                               {p.c[0].data() + row, p.c[1].data() + row, p.c[2].data() + row},
-                               p.var.data() + row,
-                               sw.data(),
-                               {sr.data(), sg.data(), sb.data()},
-                               sv.data()};
-                for (int ty = -1; ty <= 1; ++ty) {
-                    const int yy = y + ty * step;
-                    if (yy < 0 || yy >= h) continue;
-                    for (int tx = -1; tx <= 1; ++tx) {
-                        const int dx = tx * step;
-                        // The tap's pixels within the image: x + dx in [0, w).
-                        add_tap(r, (ptrdiff_t(yy) - y) * w + dx, std::max(0, -dx), std::min(w, w - dx),
-                                kTap[tx + 1] * kTap[ty + 1], params.sigma_normal);
-                    }
-                }
-                // The centre tap always counts, so the weights' sum is at least 1/4.
-                float *o0 = c2[0].data() + row, *o1 = c2[1].data() + row, *o2 = c2[2].data() + row,
-                      *ov = var2.data() + row;
-#pragma omp simd
-                for (size_t x = 0; x < row_len; ++x) {
-                    const float inv = 1 / sw[x];
-                    o0[x] = sr[x] * inv;
-                    o1[x] = sg[x] * inv;
-                    o2[x] = sb[x] * inv;
-                    ov[x] = sv[x] * inv * inv;
-                }
-            }
+        for (int y = 0; y < h; ++y) atrous_row(a, y);
 #pragma omp single
-            {
-                for (int k = 0; k < 3; ++k) std::swap(p.c[k], c2[k]);
-                std::swap(p.var, var2);
-            }
+        {
+            for (int k = 0; k < 3; ++k) std::swap(p.c[k], p.c2[k]);
+            std::swap(p.var, p.var2);
+            std::swap(p.lum, p.lum2);
         }
     }
     remodulate_and_fade(input, params.fade_error, p, out);

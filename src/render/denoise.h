@@ -60,7 +60,7 @@ struct DenoiseWorkspace {
     std::vector<float> f[4];         // unit feature: normal and coverage by nothing
     std::vector<float> z, zgrad;     // depth and its local gradient (per pixel step)
     std::vector<float> raw_var;      // variance of the raw radiance's luminance
-    std::vector<float> lum, lum_raw, inv_l, inv_z, var_blur;  // per-pass scratch
+    std::vector<float> lum, lum2, lum_raw, var_blur;  // luminance of c (of c2), of the raw radiance; scratch
     // The final filter's: per half, the demodulated radiance and its variance, the patch
     // distances of one offset (summed along rows), the filtered sums and weights.
     std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4];
