@@ -465,12 +465,17 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
             }
         }
     }
-    for (int g = 0; g < 2; ++g)
+    for (int g = 0; g < 2; ++g) {
+        p.own_var[g].assign(n, 0.f);
         for (int k = 0; k < 3; ++k) {
             fill_unknown_variance(p.w, p.h, p.u[g][k], p.v[g][k]);
+            // The pixel's own variance, before the prefilter spreads its neighbours' into it:
+            // the one Stein's risk estimate asks for (denoise_nlmeans).
+            for (size_t i = 0; i < n; ++i) p.own_var[g][i] += p.v[g][k][i];
             blur3(p.w, p.h, p.v[g][k], p.var_blur);
             std::swap(p.v[g][k], p.var_blur);
         }
+    }
     p.clamped.assign(n, 0);
     if (!halves) return;
     // Fireflies: a rare bright sample lands in one half only, so each half's value is clamped
@@ -667,59 +672,95 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     const int w = p.w, h = p.h;
     const size_t n = out.pixels.size();
     const bool halves = input.half_count[0].size() == n && input.half_count[1].size() == n;
-    // Each candidate's image (the halves averaged by their counts) and its estimated error:
-    // Stein's unbiased risk estimate per half, which a filter linear in the half it filters
-    // allows (the weights come from the other half): |F - u|^2 - v + 2 (dF/du) v per channel,
-    // dF/du the centre's share of the weights, 1 over their sum.
+    // Each candidate's image (the halves averaged by their counts) and what it gains over the
+    // raw mean: Stein's unbiased risk estimate per half, which a filter linear in the half it
+    // filters allows (the weights come from the other half), |F - u|^2 - v + 2 (dF/du) v per
+    // channel, dF/du the centre's share of the weights, 1 over their sum, less the raw half's
+    // risk v: |F - u|^2 - 2 (1 - dF/du) v. The v is the pixel's own variance (unbiased; the
+    // prefiltered one, which the patch distances use, carries bright neighbours' noise into a
+    // dark pixel and makes its raw value look as noisy as theirs).
+    // The gains are averaged over a box to tame their noise, each first divided by the
+    // pixel's squared luminance plus 0.01 (the smaller of the candidate's and the raw one's,
+    // in radiance), so that the box compares relative errors, as relMSE does: in absolute
+    // terms a few bright noisy pixels outvote the dark ones beside them, whose every sample
+    // was dark and which the filter would light with the bright ones' noise.
     const float strengths[2] = {params.k, params.k_weak};
     for (int c = 0; c < 2; ++c) {
         nlm_filter(params, strengths[c], p);
         for (auto& plane : p.cand[c]) plane.resize(n);
+        p.own_gain[c].resize(n);
 #pragma omp parallel for schedule(static)
         for (long li = 0; li < long(n); ++li) {
             const size_t i = size_t(li);
             const double n0 = halves ? input.half_count[0][i] : 1, n1 = halves ? input.half_count[1][i] : 1;
             const double t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
-            float risk = 0;
-            for (int k = 0; k < 3; ++k) {
-                float fh[2];
-                for (int g = 0; g < 2; ++g) {
-                    const float inv = 1 / p.acc[g][3][i];
-                    fh[g] = p.acc[g][k][i] * inv;
-                    const float d = fh[g] - p.u[g][k][i], v = std::isfinite(p.v[g][k][i]) ? p.v[g][k][i] : 0.f;
-                    risk += d * d - v + 2 * inv * v;
+            float gain = 0;
+            for (int g = 0; g < 2; ++g) {
+                const float inv = 1 / p.acc[g][3][i];
+                float d2 = 0;
+                for (int k = 0; k < 3; ++k) {
+                    const float d = p.acc[g][k][i] * inv - p.u[g][k][i];
+                    d2 += d * d;
                 }
-                p.cand[c][k][i] = float(fh[0] + t * (fh[1] - fh[0]));
+                gain += d2 - 2 * (1 - inv) * p.own_var[g][i];
             }
-            p.cand[c][3][i] = risk;
+            float lum_f = 0, lum_raw = 0;
+            for (int k = 0; k < 3; ++k) {
+                const float f0 = p.acc[0][k][i] / p.acc[0][3][i], f1 = p.acc[1][k][i] / p.acc[1][3][i];
+                p.cand[c][k][i] = float(f0 + t * (f1 - f0));
+                lum_f += kLum[k] * p.cand[c][k][i] * p.demod[k][i];
+                lum_raw += kLum[k] * float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i])) * p.demod[k][i];
+            }
+            // Relative to the luminance (the risks are of the demodulated radiance: times the
+            // albedo's square, its channels' mean).
+            const float m = std::max(0.f, std::min(lum_f, lum_raw));
+            const float a = (p.demod[0][i] + p.demod[1][i] + p.demod[2][i]) / 3;
+            p.own_gain[c][i] = gain;
+            p.cand[c][3][i] = gain * a * a / (m * m + 0.01f);
         }
         box_mean(w, h, params.select_radius, p.cand[c][3], p.hbox[0], p.hbox[1]);
         std::swap(p.cand[c][3], p.hbox[1]);
     }
-    // The raw mean is the third candidate, its risk the halves' variances: where no filter
-    // is estimated to do better (a converged or noiseless region) the pixel stays raw.
-    std::vector<float>& raw_risk = p.cand[2][3];
-    raw_risk.resize(n);
-#pragma omp parallel for schedule(static)
-    for (long li = 0; li < long(n); ++li) {
-        float risk = 0;
-        for (int g = 0; g < 2; ++g)
-            for (int k = 0; k < 3; ++k) {
-                const float v = p.v[g][k][size_t(li)];
-                risk += std::isfinite(v) ? v : 0.f;
-            }
-        raw_risk[size_t(li)] = risk;
-    }
-    box_mean(w, h, params.select_radius, raw_risk, p.hbox[0], p.hbox[1]);
-    std::swap(raw_risk, p.hbox[1]);
-    // Per pixel the candidate of the smallest smoothed risk (the raw one: its clamped mean, or
-    // where nothing was clamped NaN, which remodulate_and_fade reads as the raw radiance, bit
-    // for bit).
+    // Per pixel the candidate of the largest estimated gain over the box, or the raw mean
+    // where neither gains (a converged or noiseless region). Then the pixel's own samples:
+    // - where the box keeps the raw mean but the pixel's own estimate says a filter gains (a
+    //   firefly among dark pixels, which the box's dark pixels outvote), that filter;
+    // - where the box filters but the result lies more than own_error_stop of the pixel's own
+    //   standard errors from its raw mean, the raw mean. By Chebyshev's inequality a mean is
+    //   that far from its expectation with probability at most 1 / own_error_stop^2 (about
+    //   1e-5, under one pixel of a 256x256 image): such a value is light the neighbours
+    //   carried in, not the pixel's. A pixel whose
+    //   samples are all alike (all dark: a shadow, or a caustic none of whose few paths hit)
+    //   has no standard error to judge by and keeps the box's choice.
+    // The raw candidate is the clamped mean, or where nothing was clamped NaN, which
+    // remodulate_and_fade reads as the raw radiance, bit for bit.
+    const float stop2 = params.own_error_stop * params.own_error_stop;
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < long(n); ++li) {
         const size_t i = size_t(li);
-        const int c = p.cand[1][3][i] < p.cand[0][3][i] ? 1 : 0;
-        if (p.cand[c][3][i] < raw_risk[i])
+        int c = p.cand[1][3][i] < p.cand[0][3][i] ? 1 : 0;
+        if (!(p.cand[c][3][i] < 0)) {
+            c = 2;
+            if (halves) {
+                float best = 0;
+                for (int o = 0; o < 2; ++o)
+                    if (p.own_gain[o][i] < best) {
+                        best = p.own_gain[o][i];
+                        c = o;
+                    }
+            }
+        } else if (halves && params.own_error_stop > 0) {
+            const double n0 = input.half_count[0][i], n1 = input.half_count[1][i];
+            const double t = n0 + n1 > 0 ? n1 / (n0 + n1) : 0.5;
+            float lum_f = 0, lum_raw = 0, var = 0;
+            for (int k = 0; k < 3; ++k) {
+                lum_f += kLum[k] * p.cand[c][k][i] * p.demod[k][i];
+                lum_raw += kLum[k] * float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i])) * p.demod[k][i];
+                var += kLum[k] * kLum[k] * input.variance[3 * i + size_t(k)];
+            }
+            if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = 2;
+        }
+        if (c < 2)
             for (int k = 0; k < 3; ++k) p.c[k][i] = p.cand[c][k][i];
         else if (!p.clamped[i])
             p.c[0][i] = NAN;

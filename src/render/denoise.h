@@ -62,8 +62,10 @@ struct DenoiseWorkspace {
     std::vector<float> raw_var;      // variance of the raw radiance's luminance
     std::vector<float> lum, lum2, lum_raw, var_blur;  // luminance of c (of c2), of the raw radiance; scratch
     // The final filter's: per half, the demodulated radiance and its variance, the patch
-    // distances of one offset (summed along rows), the filtered sums and weights.
-    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4];
+    // distances of one offset (summed along rows), the filtered sums and weights; per half the
+    // pixel's own variance (not prefiltered, summed over the channels); per candidate the
+    // pixel's own estimate of what filtering gains.
+    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4], own_var[2], own_gain[2];
     std::vector<uint8_t> clamped;  // per pixel: a half was clamped (a firefly)
 };
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
@@ -74,7 +76,8 @@ struct NlmParams {
     int patch = 1;              // patch: (2 patch + 1)^2 pixels
     float k = 0.45f;            // patch distance scale, in standard deviations of the difference
     float k_weak = 0.25f;       // the second candidate's (per pixel the one of least estimated error)
-    int select_radius = 3;      // the estimated errors are averaged over (2 r + 1)^2 pixels
+    int select_radius = 3;      // the estimated relative errors are averaged over (2 r + 1)^2 pixels
+    float own_error_stop = 300;  // a filtered value this many of the pixel's own standard errors off is refused
     float sigma_normal = 128;   // normal stop: exp(-sigma (1 - n.n'))
     float sigma_albedo = 0.1f;  // albedo stop: exp(-|a - a'|^2 / sigma^2)
     float sigma_depth = 1;      // depth stop in units of the local depth gradient times the offset
@@ -87,7 +90,9 @@ struct NlmParams {
 // times edge stops on normal, albedo and depth. Each half of the samples is filtered with
 // weights from the other half, so each filtered half is linear in its own samples and Stein's
 // unbiased risk estimate gives its error; per pixel, of the two strengths (k, k_weak) and
-// the raw mean, the one of least risk (averaged over a small box) is kept. The halves are
+// the raw mean, the one of least risk relative to the pixel's squared luminance (averaged
+// over a small box) is kept, with the pixel's own samples overruling the box where they are
+// decisive (docs/denoising.md). The halves are
 // averaged, the albedo multiplied back, and the result faded towards the raw radiance as a
 // pixel converges, as denoise_atrous does. Parallel over rows (OpenMP); the result does not
 // depend on the thread count.
@@ -95,6 +100,6 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, D
 
 // Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
 // The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
-inline constexpr uint64_t kDenoiseBytesPerPixel = (40 + 34) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
+inline constexpr uint64_t kDenoiseBytesPerPixel = (40 + 38) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
 
 }  // namespace kr
