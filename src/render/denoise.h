@@ -100,6 +100,6 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, D
 
 // Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
 // The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
-inline constexpr uint64_t kDenoiseBytesPerPixel = (40 + 38) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
+inline constexpr uint64_t kDenoiseBytesPerPixel = (39 + 38) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
 
 }  // namespace kr
