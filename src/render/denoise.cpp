@@ -435,6 +435,19 @@ bool same_surface(const Planes& p, size_t i, size_t j) {
     return i == j || (fd > 0.9f && da < 0.01f && std::fabs(p.z[i] - p.z[j]) <= 2 * (p.zgrad[i] + 1e-3f * p.z[i]));
 }
 
+// The second half's weight in pixel i's mean: its share of the samples where both halves have
+// some, else 1/2 (prepare_halves then gives both halves the mean itself). 1/2 without halves.
+double second_half_share(const DenoiseInput& in, bool halves, size_t i) {
+    if (!halves) return 0.5;
+    const double n0 = in.half_count[0][i], n1 = in.half_count[1][i];
+    return n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
+}
+
+// Channel k of pixel i's demodulated mean from its halves (t: second_half_share).
+float mean_of_halves(const Planes& p, int k, size_t i, double t) {
+    return float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i]));
+}
+
 // The guides of the final filter: per half g, the demodulated radiance u[g] and the variance
 // of its mean v[g] (3x3-prefiltered). A pixel without two non-empty halves takes the mean for
 // both, with the mean's variance.
@@ -524,8 +537,8 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
             for (int k = 0; k < 3; ++k) changed |= p.u[g][k][i] != p.acc[g][k][i];
         if (!changed) continue;
         p.clamped[i] = 1;
-        const double n0 = in.half_count[0][i], n1 = in.half_count[1][i], t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
-        for (int k = 0; k < 3; ++k) p.c[k][i] = float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i]));
+        const double t = second_half_share(in, true, i);
+        for (int k = 0; k < 3; ++k) p.c[k][i] = mean_of_halves(p, k, i, t);
     }
 }
 
@@ -692,8 +705,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
 #pragma omp parallel for schedule(static)
         for (long li = 0; li < long(n); ++li) {
             const size_t i = size_t(li);
-            const double n0 = halves ? input.half_count[0][i] : 1, n1 = halves ? input.half_count[1][i] : 1;
-            const double t = n0 > 0 && n1 > 0 ? n1 / (n0 + n1) : 0.5;
+            const double t = second_half_share(input, halves, i);
             float gain = 0;
             for (int g = 0; g < 2; ++g) {
                 const float inv = 1 / p.acc[g][3][i];
@@ -709,7 +721,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
                 const float f0 = p.acc[0][k][i] / p.acc[0][3][i], f1 = p.acc[1][k][i] / p.acc[1][3][i];
                 p.cand[c][k][i] = float(f0 + t * (f1 - f0));
                 lum_f += kLum[k] * p.cand[c][k][i] * p.demod[k][i];
-                lum_raw += kLum[k] * float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i])) * p.demod[k][i];
+                lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.demod[k][i];
             }
             // Relative to the luminance (the risks are of the demodulated radiance: times the
             // albedo's square, its channels' mean).
@@ -750,12 +762,11 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
                     }
             }
         } else if (halves && params.own_error_stop > 0) {
-            const double n0 = input.half_count[0][i], n1 = input.half_count[1][i];
-            const double t = n0 + n1 > 0 ? n1 / (n0 + n1) : 0.5;
+            const double t = second_half_share(input, true, i);
             float lum_f = 0, lum_raw = 0, var = 0;
             for (int k = 0; k < 3; ++k) {
                 lum_f += kLum[k] * p.cand[c][k][i] * p.demod[k][i];
-                lum_raw += kLum[k] * float(p.u[0][k][i] + t * (p.u[1][k][i] - p.u[0][k][i])) * p.demod[k][i];
+                lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.demod[k][i];
                 var += kLum[k] * kLum[k] * input.variance[3 * i + size_t(k)];
             }
             if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = 2;
