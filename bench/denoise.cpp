@@ -16,6 +16,8 @@
 //       noisy reference; the same term is subtracted for every image).
 //       With KR_BENCH_CACHE=DIR the renders are kept there as checkpoints and read back by a
 //       later run with the same scene, size, spp and seed (the filters are all that reruns).
+//       KR_BENCH_SEED=S renders the images at seed S instead of 1 (the reference stays at 99);
+//       KR_BENCH_WORST=N lists the N pixels where the final filter adds the most relMSE to raw's.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -177,7 +179,36 @@ int cost(int rounds, const std::string& scene_file, int final_rounds) {
     return 0;
 }
 
+// The pixels where the final filter adds the most to raw's relMSE (their share of the image's
+// relMSE difference, and the raw mean's standard error): where a loss comes from.
+void print_worst_pixels(const Developed& final, const Image& reference, const RenderState& state, int size, int count) {
+    std::vector<std::pair<double, size_t>> added;
+    double total = 0;
+    for (size_t i = 0; i < reference.pixels.size(); ++i) {
+        const double r = luminance(reference.pixels[i]);
+        const double raw = luminance(final.raw.pixels[i]) - r, filtered = luminance(final.radiance.pixels[i]) - r;
+        added.push_back({(filtered * filtered - raw * raw) / (r * r + 0.01) / double(reference.pixels.size()), i});
+        total += added.back().first;
+    }
+    std::sort(added.rbegin(), added.rend());
+    std::printf("  relMSE final - raw: %.6f; the %d pixels adding the most:\n", total, count);
+    for (int j = 0; j < count && size_t(j) < added.size(); ++j) {
+        const size_t i = added[size_t(j)].second;
+        std::printf("  x %zu y %zu adds %.6f: reference %.4f raw %.4f (standard error %.4f) final %.4f\n",
+                    i % size_t(size), i / size_t(size), added[size_t(j)].first, luminance(reference.pixels[i]),
+                    luminance(final.raw.pixels[i]), state.pixel_standard_error(i), luminance(final.radiance.pixels[i]));
+    }
+}
+
 int error(int size, int reference_spp, const std::vector<int>& spps, const std::vector<std::string>& scenes) {
+    const char* seed_text = std::getenv("KR_BENCH_SEED");
+    const char* worst_text = std::getenv("KR_BENCH_WORST");
+    const uint64_t seed = seed_text && *seed_text ? std::stoull(seed_text) : 1;
+    const int worst = worst_text && *worst_text ? std::stoi(worst_text) : 0;
+    if (seed == 99) {
+        std::fprintf(stderr, "keithray_bench_denoise: KR_BENCH_SEED 99 is the reference's seed\n");
+        return 2;
+    }
     std::printf("scene | spp | relMSE raw | relMSE a-trous | relMSE final | PSNR raw | PSNR a-trous | PSNR final | "
                 "less the reference's noise: relMSE raw | a-trous | final\n");
     for (const std::string& file : scenes) {
@@ -187,11 +218,11 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
         const Image reference = reference_state.radiance();
         const double ref_noise = reference_noise(reference_state);
         for (const int spp : spps) {
-            const RenderState state = render(p, spp, 1, name);
+            const RenderState state = render(p, spp, seed, name);
             DevelopOptions options;
             options.denoise = Denoise::on;
             options.sampling = p.settings;
-            options.sampling.seed = 1;
+            options.sampling.seed = seed;
             const RenderEstimates estimates = render_estimates(state, kAllLayers);
             options.interactive = true;
             const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
@@ -203,6 +234,7 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
                         atrous, filtered, psnr_srgb(final.raw, reference), psnr_srgb(fast.radiance, reference),
                         psnr_srgb(final.radiance, reference), raw - ref_noise, atrous - ref_noise, filtered - ref_noise);
             std::fflush(stdout);
+            if (worst > 0) print_worst_pixels(final, reference, state, size, worst);
         }
     }
     return 0;
