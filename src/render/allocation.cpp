@@ -2,6 +2,7 @@
 // the noise rule's mask of pixels still above their share of the error.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "render/render_state.h"
 
@@ -9,11 +10,23 @@ namespace kr {
 
 namespace {
 
+// The plan's per-pixel loops, compiled for AVX-512 and AVX2 beside the baseline and picked
+// at run time: their iterations are independent and GCC vectorises them. Without FMA
+// contraction (ISO C++ mode) the vector forms give the scalar ones' bits.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define KR_PLAN_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
+#define KR_INDEPENDENT_ITERATIONS _Pragma("GCC ivdep")
+#else
+#define KR_PLAN_CLONES
+#define KR_INDEPENDENT_ITERATIONS
+#endif
+
 // The 3x3 guard on per-pixel values (variances): each value replaced by the larger of itself
 // and the mean over its 3x3 neighbourhood (the cells inside the image). A few samples can
 // miss a rare bright path and show almost no variance; variance varies smoothly over the
 // image, so the neighbours guard against that. Separable, in two loops over rows: first
 // each row's 3-wide sums, then the guarded value from three rows of those sums.
+KR_PLAN_CLONES
 void sum_three_along_row(const double* values, double* sums, size_t width) {
     if (width == 1) {
         sums[0] = (0.0 + values[0]) + 0.0;
@@ -46,6 +59,65 @@ void guard_row(const double* values, const double* sums, const double* above, co
     at(0, edge);
     for (size_t x = 1; x + 1 < width; ++x) at(x, inner);
     if (width > 1) at(width - 1, edge);
+}
+
+// RenderState::luminance_sample_variance of a row's pixels, its test turned into a select.
+KR_PLAN_CLONES
+void sample_variance_row(const uint32_t* __restrict count, const Color* __restrict radiance,
+                         const double* __restrict luminance_sq, double* __restrict variance, size_t width) {
+KR_INDEPENDENT_ITERATIONS
+    for (size_t x = 0; x < width; ++x) {
+        const double n = count[x], mean = luminance(radiance[x]) / n;
+        const double v = std::max(0.0, (luminance_sq[x] - n * mean * mean) / (n - 1));
+        variance[x] = n < 2 || !std::isfinite(luminance_sq[x]) ? std::numeric_limits<double>::infinity() : v;
+    }
+}
+
+// A row's sampling weights: the standard deviation of each active pixel's guarded variance
+// (guard_row's value: the larger of its own and its 3x3 mean), 0 where inactive or unknown.
+KR_PLAN_CLONES
+void weight_row(const double* __restrict values, const double* __restrict sums, const double* __restrict above,
+                const double* __restrict below, const uint8_t* __restrict on, double* __restrict weight, size_t width) {
+    double rows = 1.0;
+    if (above) rows += 1.0;
+    if (below) rows += 1.0;
+    const double inner = rows * 3.0, edge = rows * (width > 1 ? 2.0 : 1.0);
+    const auto at = [&](size_t x, double cells) {
+        double sum = sums[x];
+        if (above) sum += above[x];
+        if (below) sum += below[x];
+        const double guarded = std::max(values[x], sum / cells);
+        const bool active = !on || on[x];
+        return active && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
+    };
+    weight[0] = at(0, edge);
+    // One loop per case of the rows around, so each vectorises without a test per pixel.
+    if (above && below) {
+KR_INDEPENDENT_ITERATIONS
+        for (size_t x = 1; x + 1 < width; ++x) {
+            const double guarded = std::max(values[x], ((sums[x] + above[x]) + below[x]) / inner);
+            weight[x] = (!on || on[x]) && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
+        }
+    } else {
+        for (size_t x = 1; x + 1 < width; ++x) weight[x] = at(x, inner);
+    }
+    if (width > 1) weight[width - 1] = at(width - 1, edge);
+}
+
+// A row's samples in the next pass: each active pixel's quota (its weight plus the floor,
+// scaled) added to its credit, the whole samples taken, the rest kept.
+KR_PLAN_CLONES
+void take_row(const double* __restrict weight, const uint8_t* __restrict on, double floor, double quota_scale,
+              float* __restrict credit, uint8_t* __restrict take, size_t width) {
+KR_INDEPENDENT_ITERATIONS
+    for (size_t x = 0; x < width; ++x) {
+        const double quota = (weight[x] + floor) * quota_scale;
+        const double sum = std::min<double>(credit[x] + quota, 4 * kMaxPassSamples);
+        const int whole = std::min(int(sum), kMaxPassSamples);
+        const bool active = !on || on[x];
+        take[x] = active ? static_cast<uint8_t>(whole) : uint8_t(0);
+        credit[x] = active ? static_cast<float>(sum - whole) : credit[x];
+    }
 }
 
 }  // namespace
@@ -130,8 +202,7 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
         const size_t start = row_start(guarded[k]);
-        for (size_t i = start; i < start + w; ++i)
-            variance_of[i] = luminance_sample_variance(count[i], radiance[i], luminance_sq[i]);
+        sample_variance_row(count + start, radiance + start, luminance_sq + start, variance_of + start, w);
         sum_three_along_row(variance_of + start, row_sums_of + start, w);
     }
     // Each pixel's variance guarded by its 3x3 neighbourhood (as update_adaptive), then its
@@ -143,17 +214,13 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
         const size_t start = row_start(y);
         const double* const above = y > 0 ? row_sums_of + row_start(y - 1) : nullptr;
         const double* const below = y + 1 < height ? row_sums_of + row_start(y + 1) : nullptr;
-        double row_weight = 0;
-        size_t row_active = 0;
-        double* const row_weight_of = weight_of + start;
         const uint8_t* const row_on = active ? active + start : nullptr;
-        guard_row(variance_of + start, row_sums_of + start, above, below, w, [&](size_t x, double guarded_variance) {
-            const bool on = !row_on || row_on[x];
-            const double weight_x = on && std::isfinite(guarded_variance) ? std::sqrt(guarded_variance) : 0.0;
-            row_weight_of[x] = weight_x;
-            row_weight += weight_x;
-            row_active += on;
-        });
+        weight_row(variance_of + start, row_sums_of + start, above, below, row_on, weight_of + start, w);
+        // The row's sum in order of x, as every process and thread count adds it.
+        double row_weight = 0;
+        for (size_t x = 0; x < w; ++x) row_weight += weight_of[start + x];
+        size_t row_active = w;
+        if (row_on) row_active = size_t(std::count_if(row_on, row_on + w, [](uint8_t on) { return on != 0; }));
         row_weight_active[2 * size_t(y)] = row_weight;
         row_weight_active[2 * size_t(y) + 1] = double(row_active);
     }
@@ -177,19 +244,10 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
+        // Quotas sum to the active pixel count: the pass costs what a uniform one does.
         const size_t start = row_start(own[k]);
-        for (size_t i = start; i < start + w; ++i) {
-            if (active && !active[i]) {
-                take_of[i] = 0;
-                continue;
-            }
-            // Quotas sum to the active pixel count: the pass costs what a uniform one does.
-            const double quota = (weight_of[i] + floor) * quota_scale;
-            const double credit = std::min<double>(credit_of[i] + quota, 4 * kMaxPassSamples);
-            const int take = std::min(int(credit), kMaxPassSamples);
-            take_of[i] = static_cast<uint8_t>(take);
-            credit_of[i] = static_cast<float>(credit - take);
-        }
+        take_row(weight_of + start, active ? active + start : nullptr, floor, quota_scale, credit_of + start,
+                 take_of + start, w);
     }
 }
 
