@@ -56,6 +56,17 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // columns of 16.
 constexpr size_t kMaxPacketSpheres = 16;
 
+#ifdef KR_X86_64_V4
+// Whether the CPU has GFNI, for the sixteen lanes' Sobol bit reversal (lane_sobol.inc).
+bool cpu_has_gfni() {
+    static const bool has = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("gfni") != 0;
+    }();
+    return has;
+}
+#endif
+
 // Where packets apply: path tracing on a scene whose rays the lanes can cast (one leaf of our
 // BVH, or the lane tree: SphereBvh::packets), not the plain path. Scenes with Embree's tree
 // only cast rays one by one.

@@ -219,6 +219,31 @@ private:
             const uint32_t n = kPlanned ? planned[x] : 1;
             const uint32_t first = index_of[x];
             index_of[x] = first + n;
+            if constexpr (kSobol && kPlanned) {
+                // A plan's counts are an irregular mix of 0, 1 and more, which branches on
+                // them mispredict: the pixel's first sample is filled in whether it has one or
+                // not and counted only where it has (n > 0), its index reversed every time.
+                slots_[pending].sampler.restart_sobol(key_of[x], first, reverse_bits(first));
+                xs[pending] = x;
+                ys[pending] = y;
+                pixels[pending] = row + size_t(x);
+                pending += n != 0;
+                if (pending == size_t(kSampleBatch)) {
+                    flush(pending);
+                    pending = 0;
+                }
+                for (uint32_t index = first + 1; index < first + n; ++index) {
+                    slots_[pending].sampler.restart_sobol(key_of[x], index, reverse_bits(index));
+                    xs[pending] = x;
+                    ys[pending] = y;
+                    pixels[pending] = row + size_t(x);
+                    if (++pending == size_t(kSampleBatch)) {
+                        flush(pending);
+                        pending = 0;
+                    }
+                }
+                continue;
+            }
             for (uint32_t index = first; index != first + n; ++index) {
                 if constexpr (kSobol) {
                     if (index != last_index) last_index = index, last_reversed = reverse_bits(index);

@@ -53,7 +53,7 @@ struct OnePath {
     static KR_LANES double sqrt(double x) { return std::sqrt(x); }
     static KR_LANES double lane(double x, int) { return x; }
     static KR_LANES void set_lane(double& x, int, double value) { x = value; }
-    static KR_LANES bool on(bool m, int) { return m; }
+    static KR_LANES unsigned bits(bool m) { return m; }  // the set lanes as bits
     static KR_LANES void sin_cos_turns(double t, double& s, double& c) { kr::sin_cos_turns(t, s, c); }
     static KR_LANES void concentric_disk(double u1, double u2, double& x, double& y) {
         const Vec2 d = sample_concentric_disk(u1, u2);
