@@ -38,27 +38,36 @@ void sum_three_along_row(const double* values, double* sums, size_t width) {
     sums[width - 1] = (values[width - 2] + values[width - 1]) + 0.0;
 }
 
-// The guarded values of one row: `values` and `sums` (its 3-wide sums) at the row's start,
-// `above` and `below` the 3-wide sums of the rows around it (nullptr outside the image);
-// calls guarded(x, value) in order of x.
-template <class F>
-void guard_row(const double* values, const double* sums, const double* above, const double* below, size_t width,
-               F&& guarded) {
-    // The cells each mean is over: 3 rows (or 2 at an edge) times 3 columns (2 at an edge),
-    // exact small integers.
+// The 3x3 guard's cells: how many values each mean is over, 3 rows (or 2 at an edge) times 3
+// columns (2 at an edge), exact small integers; `above` and `below` the 3-wide sums of the
+// rows around (nullptr outside the image).
+struct GuardCells {
+    double inner, edge;
+};
+GuardCells guard_cells(const double* above, const double* below, size_t width) {
     double rows = 1.0;
     if (above) rows += 1.0;
     if (below) rows += 1.0;
-    const double inner = rows * 3.0, edge = rows * (width > 1 ? 2.0 : 1.0);
-    const auto at = [&](size_t x, double cells) {
-        double sum = sums[x];
-        if (above) sum += above[x];
-        if (below) sum += below[x];
-        guarded(x, std::max(values[x], sum / cells));
-    };
-    at(0, edge);
-    for (size_t x = 1; x + 1 < width; ++x) at(x, inner);
-    if (width > 1) at(width - 1, edge);
+    return {rows * 3.0, rows * (width > 1 ? 2.0 : 1.0)};
+}
+// Pixel x's guarded value: the larger of its own and the mean over its 3x3 neighbourhood.
+inline double guarded_value(const double* values, const double* sums, const double* above, const double* below,
+                            size_t x, double cells) {
+    double sum = sums[x];
+    if (above) sum += above[x];
+    if (below) sum += below[x];
+    return std::max(values[x], sum / cells);
+}
+
+// The guarded values of one row: `values` and `sums` (its 3-wide sums) at the row's start,
+// `above` and `below` as for guard_cells; calls guarded(x, value) in order of x.
+template <class F>
+void guard_row(const double* values, const double* sums, const double* above, const double* below, size_t width,
+               F&& guarded) {
+    const GuardCells cells = guard_cells(above, below, width);
+    guarded(0, guarded_value(values, sums, above, below, 0, cells.edge));
+    for (size_t x = 1; x + 1 < width; ++x) guarded(x, guarded_value(values, sums, above, below, x, cells.inner));
+    if (width > 1) guarded(width - 1, guarded_value(values, sums, above, below, width - 1, cells.edge));
 }
 
 // RenderState::luminance_sample_variance of a row's pixels, its test turned into a select.
@@ -78,30 +87,24 @@ KR_INDEPENDENT_ITERATIONS
 KR_PLAN_CLONES
 void weight_row(const double* __restrict values, const double* __restrict sums, const double* __restrict above,
                 const double* __restrict below, const uint8_t* __restrict on, double* __restrict weight, size_t width) {
-    double rows = 1.0;
-    if (above) rows += 1.0;
-    if (below) rows += 1.0;
-    const double inner = rows * 3.0, edge = rows * (width > 1 ? 2.0 : 1.0);
-    const auto at = [&](size_t x, double cells) {
-        double sum = sums[x];
-        if (above) sum += above[x];
-        if (below) sum += below[x];
-        const double guarded = std::max(values[x], sum / cells);
-        const bool active = !on || on[x];
-        return active && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
+    const GuardCells cells = guard_cells(above, below, width);
+    const auto weight_of = [&](size_t x, double guarded) {
+        return (!on || on[x]) && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
     };
-    weight[0] = at(0, edge);
-    // One loop per case of the rows around, so each vectorises without a test per pixel.
+    const auto at = [&](size_t x, double cells_of) {
+        return weight_of(x, guarded_value(values, sums, above, below, x, cells_of));
+    };
+    weight[0] = at(0, cells.edge);
+    // The inner pixels of a row with both neighbours apart (the same sums, in the same
+    // order), so that loop vectorises without a test per pixel.
     if (above && below) {
 KR_INDEPENDENT_ITERATIONS
-        for (size_t x = 1; x + 1 < width; ++x) {
-            const double guarded = std::max(values[x], ((sums[x] + above[x]) + below[x]) / inner);
-            weight[x] = (!on || on[x]) && std::isfinite(guarded) ? std::sqrt(guarded) : 0.0;
-        }
+        for (size_t x = 1; x + 1 < width; ++x)
+            weight[x] = weight_of(x, std::max(values[x], ((sums[x] + above[x]) + below[x]) / cells.inner));
     } else {
-        for (size_t x = 1; x + 1 < width; ++x) weight[x] = at(x, inner);
+        for (size_t x = 1; x + 1 < width; ++x) weight[x] = at(x, cells.inner);
     }
-    if (width > 1) weight[width - 1] = at(width - 1, edge);
+    if (width > 1) weight[width - 1] = at(width - 1, cells.edge);
 }
 
 // A row's samples in the next pass: each active pixel's quota (its weight plus the floor,

@@ -214,6 +214,20 @@ private:
         // In a pass of one sample per pixel every pixel draws the same index, so its bit
         // reversal is kept from the pixel before.
         uint32_t last_index = 0, last_reversed = 0;
+        // The batch's next slot: pixel x's sample, its sampler made or restarted beforehand.
+        const auto fill = [&](int x) {
+            xs[pending] = x;
+            ys[pending] = y;
+            pixels[pending] = row + size_t(x);
+        };
+        // Counts the slot filled last where `taken`, and traces the batch once it is full.
+        const auto take = [&](bool taken) {
+            pending += taken;
+            if (pending == size_t(kSampleBatch)) {
+                flush(pending);
+                pending = 0;
+            }
+        };
         for (int x = 0; x < width; ++x) {
             if (kActive && !active[x]) continue;
             const uint32_t n = kPlanned ? planned[x] : 1;
@@ -223,24 +237,10 @@ private:
                 // A plan's counts are an irregular mix of 0, 1 and more, which branches on
                 // them mispredict: the pixel's first sample is filled in whether it has one or
                 // not and counted only where it has (n > 0), its index reversed every time.
-                slots_[pending].sampler.restart_sobol(key_of[x], first, reverse_bits(first));
-                xs[pending] = x;
-                ys[pending] = y;
-                pixels[pending] = row + size_t(x);
-                pending += n != 0;
-                if (pending == size_t(kSampleBatch)) {
-                    flush(pending);
-                    pending = 0;
-                }
-                for (uint32_t index = first + 1; index < first + n; ++index) {
+                for (uint32_t index = first; index == first || index < first + n; ++index) {
                     slots_[pending].sampler.restart_sobol(key_of[x], index, reverse_bits(index));
-                    xs[pending] = x;
-                    ys[pending] = y;
-                    pixels[pending] = row + size_t(x);
-                    if (++pending == size_t(kSampleBatch)) {
-                        flush(pending);
-                        pending = 0;
-                    }
+                    fill(x);
+                    take(index != first || n != 0);
                 }
                 continue;
             }
@@ -252,13 +252,8 @@ private:
                     new (&slots_[pending].sampler)
                         Sampler(settings_.estimator, settings_.seed, image_row + x, index, settings_.target_spp);
                 }
-                xs[pending] = x;
-                ys[pending] = y;
-                pixels[pending] = row + size_t(x);
-                if (++pending == size_t(kSampleBatch)) {
-                    flush(pending);
-                    pending = 0;
-                }
+                fill(x);
+                take(true);
             }
         }
         if (pending > 0) flush(pending);
