@@ -4,29 +4,22 @@
 #include <cmath>
 #include <limits>
 
+#include "core/vectorise.h"
 #include "render/render_state.h"
 
 namespace kr {
 
 namespace {
 
-// The plan's per-pixel loops, compiled for AVX-512 and AVX2 beside the baseline and picked
-// at run time: their iterations are independent and GCC vectorises them. Without FMA
-// contraction (ISO C++ mode) the vector forms give the scalar ones' bits.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define KR_PLAN_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
-#define KR_INDEPENDENT_ITERATIONS _Pragma("GCC ivdep")
-#else
-#define KR_PLAN_CLONES
-#define KR_INDEPENDENT_ITERATIONS
-#endif
+// The plan's per-pixel loops are compiled for AVX-512 and AVX2 too (KR_VECTOR_CLONES) and
+// vectorised, with the same bits as the scalar ones.
 
 // The 3x3 guard on per-pixel values (variances): each value replaced by the larger of itself
 // and the mean over its 3x3 neighbourhood (the cells inside the image). A few samples can
 // miss a rare bright path and show almost no variance; variance varies smoothly over the
 // image, so the neighbours guard against that. Separable, in two loops over rows: first
 // each row's 3-wide sums, then the guarded value from three rows of those sums.
-KR_PLAN_CLONES
+KR_VECTOR_CLONES
 void sum_three_along_row(const double* values, double* sums, size_t width) {
     if (width == 1) {
         sums[0] = (0.0 + values[0]) + 0.0;
@@ -70,21 +63,18 @@ void guard_row(const double* values, const double* sums, const double* above, co
     if (width > 1) guarded(width - 1, guarded_value(values, sums, above, below, width - 1, cells.edge));
 }
 
-// RenderState::luminance_sample_variance of a row's pixels, its test turned into a select.
-KR_PLAN_CLONES
+// RenderState::luminance_sample_variance of a row's pixels.
+KR_VECTOR_CLONES
 void sample_variance_row(const uint32_t* __restrict count, const Color* __restrict radiance,
                          const double* __restrict luminance_sq, double* __restrict variance, size_t width) {
 KR_INDEPENDENT_ITERATIONS
-    for (size_t x = 0; x < width; ++x) {
-        const double n = count[x], mean = luminance(radiance[x]) / n;
-        const double v = std::max(0.0, (luminance_sq[x] - n * mean * mean) / (n - 1));
-        variance[x] = n < 2 || !std::isfinite(luminance_sq[x]) ? std::numeric_limits<double>::infinity() : v;
-    }
+    for (size_t x = 0; x < width; ++x)
+        variance[x] = RenderState::luminance_sample_variance(count[x], radiance[x], luminance_sq[x]);
 }
 
 // A row's sampling weights: the standard deviation of each active pixel's guarded variance
 // (guard_row's value: the larger of its own and its 3x3 mean), 0 where inactive or unknown.
-KR_PLAN_CLONES
+KR_VECTOR_CLONES
 void weight_row(const double* __restrict values, const double* __restrict sums, const double* __restrict above,
                 const double* __restrict below, const uint8_t* __restrict on, double* __restrict weight, size_t width) {
     const GuardCells cells = guard_cells(above, below, width);
@@ -109,7 +99,7 @@ KR_INDEPENDENT_ITERATIONS
 
 // A row's samples in the next pass: each active pixel's quota (its weight plus the floor,
 // scaled) added to its credit, the whole samples taken, the rest kept.
-KR_PLAN_CLONES
+KR_VECTOR_CLONES
 void take_row(const double* __restrict weight, const uint8_t* __restrict on, double floor, double quota_scale,
               float* __restrict credit, uint8_t* __restrict take, size_t width) {
 KR_INDEPENDENT_ITERATIONS

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/math.h"
+#include "core/vectorise.h"
 
 namespace kr {
 
@@ -27,22 +28,6 @@ inline float fast_exp_neg(float x) {
 
 using Planes = DenoiseWorkspace;
 
-// Compiled for AVX-512 and AVX2 too where GCC can dispatch on the CPU: the a-trous filter's
-// loops, which the compiler vectorises.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define KR_DENOISE_CLONES __attribute__((target_clones("arch=x86-64-v4", "avx2", "default")))
-#else
-#define KR_DENOISE_CLONES
-#endif
-// A loop whose iterations are independent (its planes do not overlap): vectorised without
-// run-time alias checks, which the many planes of a loop would exceed.
-#if defined(__clang__)
-#define KR_INDEPENDENT_ITERATIONS _Pragma("clang loop vectorize(assume_safety)")
-#elif defined(__GNUC__)
-#define KR_INDEPENDENT_ITERATIONS _Pragma("GCC ivdep")
-#else
-#define KR_INDEPENDENT_ITERATIONS
-#endif
 
 // Where a pixel's variance is unknown (one sample): the luminance's variance over its 3x3
 // neighbourhood, the variance of one sample where the neighbours are alike.
@@ -76,7 +61,7 @@ void fill_unknown_variance(int w, int h, const std::vector<float>& lum, std::vec
 // 3x3 binomial blur of a plane (borders renormalised): SVGF's prefilter of the variance
 // before it scales the luminance stop. Row y; inside the border the weights sum to 1 exactly
 // and the taps are added in the same order, so both loops give the same sums.
-KR_DENOISE_CLONES
+KR_VECTOR_CLONES
 void blur3_row(const float* v, float* out, int w, int h, int y) {
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
     const auto border = [&](int x) {
@@ -123,7 +108,7 @@ void blur3(int w, int h, const std::vector<float>& v, std::vector<float>& out) {
 
 // prepare's per-pixel step, pixels [i0, i1): the demodulated radiance, the variances and
 // luminances (demodulated and raw), the unit feature vector and the depth.
-KR_DENOISE_CLONES
+KR_VECTOR_CLONES
 void prepare_pixels(const DenoiseInput& in, Planes& p, size_t i0, size_t i1) {
     const Color* __restrict rad = in.radiance->pixels.data();
     const float *__restrict variance = in.variance.data(), *__restrict albedo = in.albedo.data(),
@@ -177,7 +162,7 @@ KR_INDEPENDENT_ITERATIONS
 // The depth gradient of row y: per axis the smaller one-sided difference (the smooth side at
 // a silhouette; a side outside the image does not count), summed over the axes so that any
 // 3x3 tap's change on a plane stays below it.
-KR_DENOISE_CLONES
+KR_VECTOR_CLONES
 void depth_gradient_row(const float* z_plane, float* zgrad, int w, int h, int y) {
     const size_t row = size_t(y) * size_t(w);
     const float* __restrict z = z_plane + row;
@@ -321,7 +306,7 @@ template <bool Up, bool Down>
 
 // Row y of a pass, in up to three spans: where the left taps are outside (x < step), where
 // all are inside, where the right ones are outside (x >= w - step).
-KR_DENOISE_CLONES
+KR_VECTOR_CLONES
 void atrous_row(const AtrousPass& a, int y) {
     const size_t row = size_t(y) * size_t(a.w);
     const bool up = y - a.step >= 0, down = y + a.step < a.h;
@@ -342,7 +327,7 @@ void atrous_row(const AtrousPass& a, int y) {
 // then faded towards the raw radiance as its relative standard error drops (the
 // 3x3-prefiltered raw variance against the filtered luminance), so a converged pixel keeps
 // its raw value. A pixel whose p.c is NaN keeps its raw value exactly.
-KR_DENOISE_CLONES
+KR_VECTOR_CLONES
 void remodulate_and_fade_pixels(const Image& raw, const Planes& p, const float* raw_var, float t2, Image& out,
                                 size_t i0, size_t i1) {
     const float *__restrict c0 = p.c[0].data(), *__restrict c1 = p.c[1].data(), *__restrict c2 = p.c[2].data();

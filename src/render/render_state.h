@@ -141,9 +141,10 @@ public:
         const double n = count;
         // Below two samples there is no variance; a sum of squares that overflowed (radiance
         // above ~1e154) would give inf - inf: the variance is unknown, not zero.
-        if (n < 2 || !std::isfinite(luminance_sq_sum)) return std::numeric_limits<double>::infinity();
+        // (Computed, then selected: the plan's row loops vectorise it.)
         const double mean = luminance(sum) / n;
-        return std::max(0.0, (luminance_sq_sum - n * mean * mean) / (n - 1));  // unbiased
+        const double variance = std::max(0.0, (luminance_sq_sum - n * mean * mean) / (n - 1));  // unbiased
+        return n < 2 || !std::isfinite(luminance_sq_sum) ? std::numeric_limits<double>::infinity() : variance;
     }
     // Standard error of pixel `i`'s mean luminance, from its sample variance (infinite below
     // two samples).
