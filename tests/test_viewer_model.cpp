@@ -229,7 +229,8 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
 
 // render_pass's two ways of adding samples to their pixels (SSE2, and AVX2 where the CPU has
 // it) give the same sums bit for bit, over samples of every size, repeated pixels, samples
-// that are NaN or infinite, and one that would overflow its pixel's sum (all dropped).
+// that are NaN or infinite, and one that would overflow its pixel's sum (all dropped); a
+// pixel's samples one after another or between other pixels'.
 TEST(Accumulation, Avx2SumsAreSse2sBitForBit) {
     if (!accumulation_isa_available(AccumulationIsa::avx2)) GTEST_SKIP() << "this CPU has no AVX2";
     const size_t pixels = 7;
@@ -245,7 +246,8 @@ TEST(Accumulation, Avx2SumsAreSse2sBitForBit) {
         if (k % 97 == 5) r.radiance.y = std::nan("");
         if (k % 89 == 7) r.radiance.z = kInfinity;
         if (k == 3000) r.radiance.x = 1e308;  // pixel 3000 % 7's sum, then this one, overflows
-        where.push_back(size_t(k) % pixels);
+        // Runs of one pixel's samples, as a planned pass gives them, between single ones.
+        where.push_back(k > 0 && rng.next() < 0.6 ? where.back() : size_t(k) % pixels);
         results.push_back(r);
     }
     where[3001] = where[3000];

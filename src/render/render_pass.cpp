@@ -101,37 +101,62 @@ __attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums
                                                      const SampleResult* results, int count, uint64_t& rays,
                                                      uint64_t& nonfinite) {
     static_assert(offsetof(SampleResult, primary_distance) == 3 * sizeof(double), "one load reads a result's colour");
+    if (count <= 0) return;
     const PixelSums sums = pixel_sums;
     const __m256i xyz = _mm256_setr_epi64x(-1, -1, -1, 0);  // the lanes of a Color read from a pixel's sums
     const __m256d zero = _mm256_setzero_pd();
     uint64_t batch_rays = 0, dropped = 0;
+    // A planned pass gives a pixel its samples one after another: its sums stay in registers
+    // until a sample of another pixel comes, instead of being reloaded from the stores just
+    // made (a load that spans two stores waits for them to reach the cache).
+    size_t held = pixels[0];
+    __m256d sum = _mm256_maskload_pd(&sums.radiance[held].x, xyz);
+    __m256d lost = _mm256_maskload_pd(&sums.compensation[held].x, xyz);
+    __m256d sq = _mm256_maskload_pd(&sums.radiance_sq[held].x, xyz);
+    double depth = sums.depth[held], luminance_sq = sums.luminance_sq[held];
+    uint32_t samples = sums.count[held];
+    const auto store = [&] {
+        store_xyz(&sums.radiance[held].x, sum);
+        store_xyz(&sums.compensation[held].x, lost);
+        store_xyz(&sums.radiance_sq[held].x, sq);
+        sums.depth[held] = depth;
+        sums.luminance_sq[held] = luminance_sq;
+        sums.count[held] = samples;
+    };
     for (int k = 0; k < count; ++k) {
         const SampleResult& r = results[k];
         const size_t i = pixels[k];
         batch_rays += r.rays;
+        if (i != held) {
+            store();
+            held = i;
+            sum = _mm256_maskload_pd(&sums.radiance[i].x, xyz);
+            lost = _mm256_maskload_pd(&sums.compensation[i].x, xyz);
+            sq = _mm256_maskload_pd(&sums.radiance_sq[i].x, xyz);
+            depth = sums.depth[i];
+            luminance_sq = sums.luminance_sq[i];
+            samples = sums.count[i];
+        }
         // The sample's colour, its fourth lane (the depth) cleared, and the new sums.
         const __m256d x = _mm256_blend_pd(_mm256_loadu_pd(&r.radiance.x), zero, 0b1000);
-        double* sum = &sums.radiance[i].x;
-        const __m256d s = _mm256_maskload_pd(sum, xyz);
-        const __m256d t = s + x;
+        const __m256d t = sum + x;
         // Finite (the sample, and the sum not overflowed): t - t is 0 in every lane.
         if (_mm256_movemask_pd(_mm256_cmp_pd(t - t, zero, _CMP_EQ_OQ)) != 0b1111) {
             ++dropped;
             continue;
         }
-        store_xyz(sum, t);
-        double* lost = &sums.compensation[i].x;
-        // two_sum_error(s, x, t) written out: Clang passes no AVX vector to a function
+        // two_sum_error(sum, x, t) written out: Clang passes no AVX vector to a function
         // compiled without AVX.
-        const __m256d x_part = t - s;
-        store_xyz(lost, _mm256_maskload_pd(lost, xyz) + ((s - (t - x_part)) + (x - x_part)));
-        sums.depth[i] += r.primary_distance;
+        const __m256d x_part = t - sum;
+        lost = lost + ((sum - (t - x_part)) + (x - x_part));
+        sum = t;
+        depth += r.primary_distance;
         const double lum = luminance(r.radiance);
-        sums.luminance_sq[i] += lum * lum;
-        double* sq = &sums.radiance_sq[i].x;
-        store_xyz(sq, _mm256_maskload_pd(sq, xyz) + x * x);
-        sums.count[i] += 1;
+        luminance_sq += lum * lum;
+        sq = sq + x * x;
+        samples += 1;
     }
+    store();
     rays += batch_rays;
     nonfinite += dropped;
 }
