@@ -62,35 +62,13 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
 
 double sphere_light_pdf(const SphereGeom& light, const Vec3& p, const Vec3& wi, double distance,
                         const Vec3& n_light, LightSampling strategy) {
-    const Vec3 to_centre = light.centre - p;
-    const double d2 = dot(to_centre, to_centre);
-    const double r2 = light.radius * light.radius;
-    const bool outside = d2 > r2;
-    const double cos_abs = std::abs(dot(n_light, wi));
-    if (strategy == LightSampling::brief_area && outside) return 0;  // never combined
-    if (strategy == LightSampling::brief && outside) {
-        // Solid-angle density of the brief strategy's point at the (visible) hit.
-        const double cos_axis = -dot(n_light, to_centre) / std::sqrt(d2);
-        if (!(cos_abs > 0) || !(cos_axis > 0)) return 0;
-        const double area_density =
-            vertex::BriefProposal<OnePath>(light.radius, std::sqrt(d2), true).pdf(cos_axis) / (2 * kPi * r2);
-        return area_density * distance * distance / cos_abs;
-    }
-    if (strategy == LightSampling::cone && outside) return uniform_cone_pdf(vertex::cone_one_minus_cos<OnePath>(r2, d2));
-    if (!(cos_abs > 0)) return 0;
-    return distance * distance / (sphere_area(light) * cos_abs);
+    return vertex::sphere_light_pdf<vertex::OnePath>(strategy, light.centre, light.radius, p, wi, distance, n_light,
+                                                     true);
 }
 
 double light_emission_scale(const SphereGeom& light, const Vec3& p, const Vec3& wi, const Vec3& n_light,
                             LightSampling strategy) {
-    const Vec3 from_centre = p - light.centre;
-    const double d2 = dot(from_centre, from_centre);
-    if (!is_brief(strategy) || !(d2 > light.radius * light.radius)) return 1.0;
-    // The brief's integrand over the light's area has cos_axis where the exact one has the
-    // light-side cosine: in solid angle, L cos_axis / cos_light instead of L.
-    const double cos_axis = dot(n_light, from_centre) / std::sqrt(d2);
-    const double cos_light = std::abs(dot(n_light, wi));
-    return cos_light > 0 && cos_axis > 0 ? cos_axis / cos_light : 0.0;
+    return vertex::light_emission_scale<vertex::OnePath>(strategy, light.centre, light.radius, p, wi, n_light);
 }
 
 }  // namespace kr

@@ -53,12 +53,10 @@ double emission_weight(const RenderScene& scene, LightSampling sampling, const A
     if (history.full_emission || hit.sphere == history.last_sphere) return 1;
     // The light sample at the last vertex counted all of this light, or could have found this
     // point too: then the two strategies are weighed by the power heuristic.
-    if (!combines_with_bsdf(sampling)) return 0;
     const SphereGeom& geom = scene.spheres[hit.sphere];
-    const double p_light = light.select_prob * sphere_light_pdf(geom, history.last_p, incoming, hit.t, hit.n, sampling);
-    const double p_bsdf = history.last_bsdf_pdf;
-    return light_emission_scale(geom, history.last_p, incoming, hit.n, sampling) * p_bsdf * p_bsdf /
-           (p_bsdf * p_bsdf + p_light * p_light);
+    return vertex::emission_mis_weight<vertex::OnePath>(sampling, geom.centre, geom.radius, light.select_prob,
+                                                        history.last_p, incoming, hit.t, hit.n,
+                                                        history.last_bsdf_pdf, true);
 }
 
 bool sample_one_light(const RenderScene& scene, const RenderSettings& settings, const Material& m, const Hit& hit,
