@@ -97,6 +97,19 @@ __attribute__((target("avx2"))) inline void store_xyz(double* p, __m256d v) {
     _mm_store_sd(p + 2, _mm256_extractf128_pd(v, 1));
 }
 
+// A pixel's sums, held in registers, stored. (A function of this target, not a lambda: a
+// lambda is compiled without AVX2, and would take the vectors through memory.)
+__attribute__((target("avx2"), always_inline)) inline void store_sums(const PixelSums& sums, size_t i, __m256d sum,
+                                                                     __m256d lost, __m256d sq, double depth,
+                                                                     double luminance_sq, uint32_t count) {
+    store_xyz(&sums.radiance[i].x, sum);
+    store_xyz(&sums.compensation[i].x, lost);
+    store_xyz(&sums.radiance_sq[i].x, sq);
+    sums.depth[i] = depth;
+    sums.luminance_sq[i] = luminance_sq;
+    sums.count[i] = count;
+}
+
 __attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums, const size_t* pixels,
                                                      const SampleResult* results, int count, uint64_t& rays,
                                                      uint64_t& nonfinite) {
@@ -115,20 +128,12 @@ __attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums
     __m256d sq = _mm256_maskload_pd(&sums.radiance_sq[held].x, xyz);
     double depth = sums.depth[held], luminance_sq = sums.luminance_sq[held];
     uint32_t samples = sums.count[held];
-    const auto store = [&] {
-        store_xyz(&sums.radiance[held].x, sum);
-        store_xyz(&sums.compensation[held].x, lost);
-        store_xyz(&sums.radiance_sq[held].x, sq);
-        sums.depth[held] = depth;
-        sums.luminance_sq[held] = luminance_sq;
-        sums.count[held] = samples;
-    };
     for (int k = 0; k < count; ++k) {
         const SampleResult& r = results[k];
         const size_t i = pixels[k];
         batch_rays += r.rays;
         if (i != held) {
-            store();
+            store_sums(sums, held, sum, lost, sq, depth, luminance_sq, samples);
             held = i;
             sum = _mm256_maskload_pd(&sums.radiance[i].x, xyz);
             lost = _mm256_maskload_pd(&sums.compensation[i].x, xyz);
@@ -156,7 +161,7 @@ __attribute__((target("avx2"))) void accumulate_avx2(const PixelSums& pixel_sums
         sq = sq + x * x;
         samples += 1;
     }
-    store();
+    store_sums(sums, held, sum, lost, sq, depth, luminance_sq, samples);
     rays += batch_rays;
     nonfinite += dropped;
 }
