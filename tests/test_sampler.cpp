@@ -248,6 +248,19 @@ TEST(Sobol, VertexNumbersLeftOutDoNotShiftOthers) {
         }
 }
 
+// render_pass works out a row's keys at once (Sampler::pixel_keys, in vectors where the CPU
+// has them): each the key of its pixel, for rows of any length and any start.
+TEST(Sobol, RowOfPixelKeysIsEachPixelsKey) {
+    for (uint64_t seed : {0ull, 7ull, 1ull << 40})
+        for (uint64_t first : {0ull, 511ull, (1ull << 33) - 5})
+            for (size_t count : {size_t(1), size_t(7), size_t(16), size_t(37), size_t(512)}) {
+                std::vector<uint32_t> keys(count + 1, 0xdeadbeefu);
+                Sampler::pixel_keys(seed, first, count, keys.data());
+                for (size_t i = 0; i < count; ++i) EXPECT_EQ(keys[i], Sampler::pixel_key(seed, first + i)) << i;
+                EXPECT_EQ(keys[count], 0xdeadbeefu);  // nothing past the row
+            }
+}
+
 // render_pass keeps each pixel's Sobol key (Sampler::pixel_key) and builds its samplers from
 // it: the same numbers as the sampler built from the seed and the pixel.
 TEST(Sobol, SamplerFromThePixelKeyIsTheSame) {

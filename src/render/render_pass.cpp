@@ -334,17 +334,12 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     bool stopped = false;
     const bool sobol = settings.estimator == Estimator::sobol;
     const size_t pixels = px.sample_count.size();  // the held rows' (RenderState::reset)
-    if (sobol && (px.sobol_keys.size() != pixels || px.sobol_keys_seed != settings.seed)) {
+    // The Sobol keys, where not yet worked out for this seed: each row's by the thread that
+    // samples it, before it does.
+    const bool fill_keys = sobol && (px.sobol_keys.size() != pixels || px.sobol_keys_seed != settings.seed);
+    if (fill_keys) {
         px.sobol_keys.resize(pixels);
         px.sobol_keys_seed = settings.seed;
-        // Each key from the pixel's place in the image.
-#pragma omp parallel for schedule(static)
-        for (int y = 0; y < height; ++y) {
-            if (!state.holds_row(y)) continue;
-            const size_t start = state.row_start(y), first = size_t(y) * size_t(width);
-            for (size_t x = 0; x < size_t(width); ++x)
-                px.sobol_keys[start + x] = Sampler::pixel_key(settings.seed, uint64_t(first + x));
-        }
     }
     const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
     const bool avx2 = avx2_accumulation();
@@ -354,7 +349,11 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < height; ++y) {
-            if ((rows_active && !rows_active[y]) || !state.holds_row(y)) continue;
+            if (!state.holds_row(y)) continue;
+            if (fill_keys)  // every held row's, sampled or not
+                Sampler::pixel_keys(settings.seed, uint64_t(y) * uint64_t(width), size_t(width),
+                                    px.sobol_keys.data() + state.row_start(y));
+            if (rows_active && !rows_active[y]) continue;
             if (stop && stop->load(std::memory_order_relaxed)) {
                 stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
                 continue;

@@ -9,12 +9,38 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/image.h"
 #include "render/settings.h"
 
 namespace kr {
+
+// An allocator whose resize() leaves the new elements uninitialised, for a buffer written
+// whole before it is read: its pages are first touched where it is written (in parallel),
+// not zeroed beforehand by one thread.
+template <class T>
+struct UninitialisedAllocator : std::allocator<T> {
+    template <class U>
+    struct rebind {
+        using other = UninitialisedAllocator<U>;
+    };
+    UninitialisedAllocator() = default;
+    template <class U>
+    UninitialisedAllocator(const UninitialisedAllocator<U>&) noexcept {}
+    template <class U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
 
 // A RenderState's per-pixel buffers. The pass engine (render_pass, plan_pass,
 // update_adaptive), checkpoints and the process exchange of PassHooks write them through
@@ -42,8 +68,9 @@ struct PixelBuffers {
     std::vector<float> sample_credit;  // adaptive allocation: fractions of a sample carried over
     std::array<std::vector<double>, 3> allocation_scratch;  // plan_pass's and update_adaptive's buffers
     // The Sobol samplers' per-pixel keys (Sampler::pixel_key) for sobol_keys_seed: the same in
-    // every pass, so render_pass works them out once (empty until a Sobol pass).
-    std::vector<uint32_t> sobol_keys;
+    // every pass, so render_pass works them out once, row by row in its first Sobol pass
+    // (empty until then).
+    std::vector<uint32_t, UninitialisedAllocator<uint32_t>> sobol_keys;
     uint64_t sobol_keys_seed = 0;
     // The denoiser's split of each pixel's samples into two independent halves (empty unless
     // RenderState::track_halves): the compensated radiance sums and the counts of the samples

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/vectorise.h"
+
 namespace kr {
 
 Sampler::Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t index, int target)
@@ -13,6 +15,12 @@ Sampler::Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t in
       target_(std::max(target, 1)) {
     // Sobol samples draw every number from the sequence, so only the others need a stream.
     if (estimator != Estimator::sobol) rng_ = Rng::for_sample(seed, pixel, index);
+}
+
+KR_VECTOR_CLONES
+void Sampler::pixel_keys(uint64_t seed, uint64_t first_pixel, size_t count, uint32_t* keys) {
+    KR_INDEPENDENT_ITERATIONS
+    for (size_t i = 0; i < count; ++i) keys[i] = pixel_key(seed, first_pixel + i);
 }
 
 Vec2 Sampler::pixel() {

@@ -3,6 +3,7 @@
 // Owen-scrambled Sobol sequence that stays stratified at every sample count.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
@@ -148,6 +149,8 @@ public:
     static uint32_t pixel_key(uint64_t seed, uint64_t pixel) {
         return uint32_t(mix64(seed ^ mix64(pixel + 0x51ed270b2f4c1d3dull)));
     }
+    // The keys of `count` pixels from `first_pixel` on (a row's), in vectors where the CPU has them.
+    static void pixel_keys(uint64_t seed, uint64_t first_pixel, size_t count, uint32_t* keys);
     // For tools and tests that trace rays by hand: the uniform estimator on one RNG stream.
     explicit Sampler(const Rng& rng) : estimator_(Estimator::uniform), rng_(rng) {}
 
