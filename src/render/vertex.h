@@ -11,8 +11,8 @@
 // below needs: splat, index (an int in every lane), select (of Reals, Vecs, Masks and
 // Indices), any, mask_not, sqrt, lane/set_lane/on (one lane,
 // for the rare steps done one lane at a time), and the maths of sampling: sin_cos_turns,
-// concentric_disk, cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize
-// and log_positive. OnePath's are core's scalar functions; the lanes' are their lane-wise
+// concentric_disk, cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize,
+// log_positive and expm1 (of the lanes a mask names). OnePath's are core's scalar functions; the lanes' are their lane-wise
 // copies, operation for operation, so the lanes trace one path's paths up to rounding.
 //
 // The templates themselves are in vertex.inc, which this header includes into kr::vertex and
@@ -67,6 +67,7 @@ struct OnePath {
     static KR_LANES Vec3 to_world(const Vec3& n, const Vec3& local) { return Frame::from_normal(n).to_world(local); }
     static KR_LANES Vec3 normalize(const Vec3& v) { return kr::normalize(v); }
     static KR_LANES double log_positive(double x, bool) { return kr::log_positive(x); }
+    static KR_LANES double expm1(double x, bool) { return std::expm1(x); }
 };
 
 // One path's material, as the vertex code reads a material (the lanes read columns by sphere).
