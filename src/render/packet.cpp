@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -261,6 +262,28 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
     } else {
         for (int k = 0; k < count; ++k) results[k] = trace_sample(scene, settings, rays[k], *samplers[k]);
     }
+}
+
+bool sobol_camera_lanes(PacketKernels kernels) {
+    return kernels == PacketKernels::x86_64_v4_float || kernels == PacketKernels::x86_64_v3_float;
+}
+
+void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
+                                int width, int height, const int* xs, const int* ys, const uint32_t* keys,
+                                const uint32_t* index_reversed, int count, SampleResult* results) {
+#ifdef KR_X86_64_V4
+    if (kernels == PacketKernels::x86_64_v4_float)
+        return packet_f16::trace_sobol_camera_lanes(scene, settings, width, height, xs, ys, keys, index_reversed, count,
+                                                    results);
+#endif
+#ifdef KR_X86_64_V3
+    if (kernels == PacketKernels::x86_64_v3_float)
+        return packet_f8::trace_sobol_camera_lanes(scene, settings, width, height, xs, ys, keys, index_reversed, count,
+                                                   results);
+#endif
+    (void)kernels, (void)scene, (void)settings, (void)width, (void)height, (void)xs, (void)ys, (void)keys;
+    (void)index_reversed, (void)count, (void)results;
+    throw std::logic_error("trace_sobol_camera_samples: kernels without Sobol camera lanes");
 }
 
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,

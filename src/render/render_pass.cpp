@@ -195,16 +195,24 @@ PixelSums pixel_sums_of(PixelBuffers& px) {
 // in the order they were drawn, so every pixel's sums are those of tracing them one by one.
 class PassThread {
 public:
-    PassThread(const RenderScene& scene, const RenderSettings& settings, RenderState& state, bool avx2)
-        : scene_(scene), settings_(settings), state_(state), sums_(pixel_sums_of(state.buffers())), avx2_(avx2) {
+    PassThread(const RenderScene& scene, const RenderSettings& settings, RenderState& state, bool avx2,
+               PacketKernels kernels)
+        : scene_(scene),
+          settings_(settings),
+          state_(state),
+          sums_(pixel_sums_of(state.buffers())),
+          avx2_(avx2),
+          kernels_(kernels),
+          sobol_lanes_(sobol_camera_lanes(kernels)) {
         PixelBuffers& px = state.buffers();
         sample_index_ = px.sample_index.data();
         sobol_keys_ = px.sobol_keys.data();
         active_ = px.active.empty() ? nullptr : px.active.data();
         pass_samples_ = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
         for (int k = 0; k < kSampleBatch; ++k) {
-            // A Sobol pass restarts these samplers in place (restart_sobol); the other
-            // estimators make each one anew.
+            // A Sobol pass keeps its samples as keys and indices, and restarts these samplers
+            // from them in place where the kernels take samplers; the other estimators make
+            // each one anew.
             new (&slots_[k].sampler) Sampler(0, 0, 0);
             samplers_[k] = &slots_[k].sampler;
         }
@@ -244,7 +252,8 @@ private:
         // In a pass of one sample per pixel every pixel draws the same index, so its bit
         // reversal is kept from the pixel before.
         uint32_t last_index = 0, last_reversed = 0;
-        // The batch's next slot: pixel x's sample, its sampler made or restarted beforehand.
+        // The batch's next slot: pixel x's sample, its sampler made (or its Sobol key and
+        // index set) beforehand.
         const auto fill = [&](int x) {
             xs[pending] = x;
             ys[pending] = y;
@@ -254,7 +263,7 @@ private:
         const auto take = [&](bool taken) {
             pending += taken;
             if (pending == size_t(kSampleBatch)) {
-                flush(pending);
+                flush<kSobol>(pending);
                 pending = 0;
             }
         };
@@ -268,7 +277,7 @@ private:
                 // them mispredict: the pixel's first sample is filled in whether it has one or
                 // not and counted only where it has (n > 0), its index reversed every time.
                 for (uint32_t index = first; index == first || index < first + n; ++index) {
-                    slots_[pending].sampler.restart_sobol(key_of[x], index, reverse_bits(index));
+                    set_sobol(pending, key_of[x], index, reverse_bits(index));
                     fill(x);
                     take(index != first || n != 0);
                 }
@@ -277,7 +286,7 @@ private:
             for (uint32_t index = first; index != first + n; ++index) {
                 if constexpr (kSobol) {
                     if (index != last_index) last_index = index, last_reversed = reverse_bits(index);
-                    slots_[pending].sampler.restart_sobol(key_of[x], index, last_reversed);
+                    set_sobol(pending, key_of[x], index, last_reversed);
                 } else {
                     new (&slots_[pending].sampler)
                         Sampler(settings_.estimator, settings_.seed, image_row + x, index, settings_.target_spp);
@@ -286,12 +295,27 @@ private:
                 take(true);
             }
         }
-        if (pending > 0) flush(pending);
+        if (pending > 0) flush<kSobol>(pending);
     }
 
+    void set_sobol(size_t slot, uint32_t key, uint32_t index, uint32_t index_reversed) {
+        keys_[slot] = key;
+        indices_[slot] = index;
+        index_reversed_[slot] = index_reversed;
+    }
+
+    template <bool kSobol>
     __attribute__((noinline)) void flush(size_t count_of) {
         const int count = int(count_of);
-        trace_camera_samples(scene_, settings_, state_.width, state_.height, xs_, ys_, samplers_, count, results_);
+        const int width = state_.width, height = state_.height;
+        if (kSobol && sobol_lanes_ && count > 1) {
+            trace_sobol_camera_samples(kernels_, scene_, settings_, width, height, xs_, ys_, keys_, index_reversed_,
+                                       count, results_);
+        } else {
+            if constexpr (kSobol)
+                for (int k = 0; k < count; ++k) slots_[k].sampler.restart_sobol(keys_[k], indices_[k], index_reversed_[k]);
+            trace_camera_samples(scene_, settings_, width, height, xs_, ys_, samplers_, count, results_);
+        }
         accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
     }
 
@@ -300,6 +324,8 @@ private:
     const RenderState& state_;
     const PixelSums sums_;
     const bool avx2_;
+    const PacketKernels kernels_;
+    const bool sobol_lanes_;  // Sobol batches go to trace_sobol_camera_samples
     uint32_t* sample_index_;
     const uint32_t* sobol_keys_;
     const uint8_t* active_;
@@ -310,6 +336,7 @@ private:
         SamplerSlot() {}
     } slots_[kSampleBatch];
     Sampler* samplers_[kSampleBatch];
+    uint32_t keys_[kSampleBatch], indices_[kSampleBatch], index_reversed_[kSampleBatch];  // Sobol samples
     int xs_[kSampleBatch], ys_[kSampleBatch];
     size_t pixels_[kSampleBatch];
     SampleResult results_[kSampleBatch];
@@ -343,9 +370,10 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     }
     const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
     const bool avx2 = avx2_accumulation();
+    const PacketKernels kernels = packet_kernels(scene, settings);
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
-        PassThread thread(scene, settings, state, avx2);
+        PassThread thread(scene, settings, state, avx2, kernels);
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < height; ++y) {

@@ -67,6 +67,17 @@ enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_
 inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
+
+// Whether these kernels (packet_kernels' answer) make camera rays and trace them in lanes for
+// Sobol samples given as keys and indices (trace_sobol_camera_samples): the float lanes.
+bool sobol_camera_lanes(PacketKernels kernels);
+// trace_camera_samples for `count` samples (more than one) of Sobol samplers known by their
+// pixel keys and reversed sample indices, each the sampler Sampler(keys[i], index,
+// index_reversed[i]) gives before it has drawn anything, with `kernels` of which
+// sobol_camera_lanes holds: no Sampler is made (render_pass's batches).
+void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
+                                int width, int height, const int* xs, const int* ys, const uint32_t* keys,
+                                const uint32_t* index_reversed, int count, SampleResult* results);
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
 // within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
