@@ -242,12 +242,12 @@ void camera_rays(const RenderScene& scene, const RenderSettings& settings, int w
 
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results) {
-    bool camera_rays = true;  // as trace_packet takes them
-    for (int k = 0; k < count; ++k)
-        camera_rays &=
+    const PacketKernels kernels = count > 1 ? packet_kernels(scene, settings) : PacketKernels::one_path;
+    bool camera_rays = kernels != PacketKernels::one_path;  // as trace_packet takes them
+    for (int k = 0; k < count && camera_rays; ++k)
+        camera_rays =
             rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
-    const PacketKernels kernels = packet_kernels(scene, settings);
-    if (camera_rays && count > 1 && kernels != PacketKernels::one_path) {
+    if (camera_rays) {
 #ifdef KR_X86_64_V4
         if (kernels == PacketKernels::x86_64_v4_float)
             return packet_f16::trace_packet(scene, settings, rays, samplers, count, results);
@@ -289,15 +289,16 @@ void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene,
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results) {
 #ifdef KR_X86_64_V3
-    bool sobol = count > 1;
+    const PacketKernels kernels = count > 1 ? packet_kernels(scene, settings) : PacketKernels::one_path;
+    bool sobol = sobol_camera_lanes(kernels);
     for (int k = 0; k < count && sobol; ++k) sobol = samplers[k]->sobol() && samplers[k]->dimension() == 0;
-    const PacketKernels kernels = sobol ? packet_kernels(scene, settings) : PacketKernels::one_path;
+    if (sobol) {
 #ifdef KR_X86_64_V4
-    if (kernels == PacketKernels::x86_64_v4_float)
-        return packet_f16::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
+        if (kernels == PacketKernels::x86_64_v4_float)
+            return packet_f16::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
 #endif
-    if (kernels == PacketKernels::x86_64_v3_float)
         return packet_f8::trace_camera_lanes(scene, settings, width, height, xs, ys, samplers, count, results);
+    }
 #endif
     Ray rays[kSampleBatch];
     for (int first = 0; first < count; first += kSampleBatch) {

@@ -210,8 +210,8 @@ public:
         active_ = px.active.empty() ? nullptr : px.active.data();
         pass_samples_ = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
         for (int k = 0; k < kSampleBatch; ++k) {
-            // A Sobol pass keeps its samples as keys and indices, and restarts these samplers
-            // from them in place where the kernels take samplers; the other estimators make
+            // A Sobol pass restarts these samplers in place (restart_sobol), or for the float
+            // lanes keeps its samples' keys and indices instead; the other estimators make
             // each one anew.
             new (&slots_[k].sampler) Sampler(0, 0, 0);
             samplers_[k] = &slots_[k].sampler;
@@ -298,10 +298,15 @@ private:
         if (pending > 0) flush<kSobol>(pending);
     }
 
+    // Slot `slot`'s Sobol sample: its key and index for the float lanes, else its sampler.
     void set_sobol(size_t slot, uint32_t key, uint32_t index, uint32_t index_reversed) {
-        keys_[slot] = key;
-        indices_[slot] = index;
-        index_reversed_[slot] = index_reversed;
+        if (sobol_lanes_) {
+            keys_[slot] = key;
+            indices_[slot] = index;
+            index_reversed_[slot] = index_reversed;
+        } else {
+            slots_[slot].sampler.restart_sobol(key, index, index_reversed);
+        }
     }
 
     template <bool kSobol>
@@ -312,7 +317,7 @@ private:
             trace_sobol_camera_samples(kernels_, scene_, settings_, width, height, xs_, ys_, keys_, index_reversed_,
                                        count, results_);
         } else {
-            if constexpr (kSobol)
+            if (kSobol && sobol_lanes_)  // a batch of one sample: one path, from its sampler
                 for (int k = 0; k < count; ++k) slots_[k].sampler.restart_sobol(keys_[k], indices_[k], index_reversed_[k]);
             trace_camera_samples(scene_, settings_, width, height, xs_, ys_, samplers_, count, results_);
         }
