@@ -393,6 +393,47 @@ TEST_P(Packet, CameraRaysAreOneByOnes) {
         }
 }
 
+// Sobol camera samples given as pixel keys and indices (trace_sobol_camera_samples, what
+// render_pass hands the float lanes) are those trace_camera_samples gives for the samplers
+// made from them, bit for bit: with each kernel, for a batch of one (made into a sampler and
+// traced as one path), within a lane group, across chunks of kSampleBatch, through a pinhole
+// and a thin lens. (CameraSamplesAreOneByOnes holds the samplers' entry to one path's
+// samples.)
+TEST_P(Packet, SobolSamplesAsKeysAreSamplersSamples) {
+    RenderScene scene = brief_scene(3);
+    const int width = scene.renderer.width, height = scene.renderer.height;
+    for (double lens_radius : {0.0, 0.2})
+        for (int count : {1, 2, 17, kSampleBatch + 45}) {
+            scene.camera.lens_radius = lens_radius;
+            const RenderSettings settings = settings_of(scene);
+            const size_t n = static_cast<size_t>(count);
+            std::vector<uint32_t> keys(n), indices(n), reversed(n);
+            std::vector<std::optional<Sampler>> made(n);
+            std::vector<Sampler*> samplers(n);
+            std::vector<int> xs(n), ys(n);
+            for (size_t k = 0; k < n; ++k) {
+                xs[k] = int(k * 37) % width, ys[k] = int(k * 101) % height;
+                keys[k] = Sampler::pixel_key(9, uint64_t(ys[k]) * uint64_t(width) + uint64_t(xs[k]));
+                indices[k] = uint32_t(k % 11), reversed[k] = reverse_bits(indices[k]);
+                samplers[k] = &made[k].emplace(keys[k], indices[k], reversed[k]);
+            }
+            std::vector<SampleResult> from_keys(n), from_samplers(n);
+            trace_sobol_camera_samples(packet_kernels(scene, settings), scene, settings, width, height, xs.data(),
+                                       ys.data(), keys.data(), reversed.data(), indices.data(), count,
+                                       from_keys.data());
+            trace_camera_samples(scene, settings, width, height, xs.data(), ys.data(), samplers.data(), count,
+                                 from_samplers.data());
+            int differ = 0;
+            for (size_t k = 0; k < n; ++k) {
+                const SampleResult &a = from_keys[k], &b = from_samplers[k];
+                differ += !(a.radiance.x == b.radiance.x && a.radiance.y == b.radiance.y &&
+                            a.radiance.z == b.radiance.z && a.primary_distance == b.primary_distance &&
+                            a.rays == b.rays);
+            }
+            EXPECT_EQ(differ, 0) << count << " samples, lens " << lens_radius;
+        }
+}
+
 // Camera samples traced from pixel positions (trace_camera_samples: with Sobol samplers and a
 // pinhole, the single-precision lanes make the camera rays themselves) against camera_ray and
 // trace_sample one by one: counts below, at and above a lane group and a batch, and the thin

@@ -21,7 +21,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <stdexcept>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -270,20 +269,31 @@ bool sobol_camera_lanes(PacketKernels kernels) {
 
 void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
                                 int width, int height, const int* xs, const int* ys, const uint32_t* keys,
-                                const uint32_t* index_reversed, int count, SampleResult* results) {
+                                const uint32_t* index_reversed, const uint32_t* indices, int count,
+                                SampleResult* results) {
 #ifdef KR_X86_64_V4
-    if (kernels == PacketKernels::x86_64_v4_float)
+    if (count > 1 && kernels == PacketKernels::x86_64_v4_float)
         return packet_f16::trace_sobol_camera_lanes(scene, settings, width, height, xs, ys, keys, index_reversed, count,
                                                     results);
 #endif
 #ifdef KR_X86_64_V3
-    if (kernels == PacketKernels::x86_64_v3_float)
+    if (count > 1 && kernels == PacketKernels::x86_64_v3_float)
         return packet_f8::trace_sobol_camera_lanes(scene, settings, width, height, xs, ys, keys, index_reversed, count,
                                                    results);
 #endif
-    (void)kernels, (void)scene, (void)settings, (void)width, (void)height, (void)xs, (void)ys, (void)keys;
-    (void)index_reversed, (void)count, (void)results;
-    throw std::logic_error("trace_sobol_camera_samples: kernels without Sobol camera lanes");
+    (void)kernels;
+    // Other kernels, or a batch of one sample (one path): the samplers made.
+    for (int first = 0; first < count; first += kSampleBatch) {
+        const int n = std::min(kSampleBatch, count - first);
+        std::vector<Sampler> samplers;
+        samplers.reserve(size_t(n));
+        Sampler* pointers[kSampleBatch];
+        for (int k = 0; k < n; ++k) {
+            samplers.emplace_back(keys[first + k], indices[first + k], index_reversed[first + k]);
+            pointers[k] = &samplers.back();
+        }
+        trace_camera_samples(scene, settings, width, height, xs + first, ys + first, pointers, n, results + first);
+    }
 }
 
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,

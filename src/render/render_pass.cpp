@@ -313,14 +313,11 @@ private:
     __attribute__((noinline)) void flush(size_t count_of) {
         const int count = int(count_of);
         const int width = state_.width, height = state_.height;
-        if (kSobol && sobol_lanes_ && count > 1) {
+        if (kSobol && sobol_lanes_)
             trace_sobol_camera_samples(kernels_, scene_, settings_, width, height, xs_, ys_, keys_, index_reversed_,
-                                       count, results_);
-        } else {
-            if (kSobol && sobol_lanes_)  // a batch of one sample: one path, from its sampler
-                for (int k = 0; k < count; ++k) slots_[k].sampler.restart_sobol(keys_[k], indices_[k], index_reversed_[k]);
+                                       indices_, count, results_);
+        else
             trace_camera_samples(scene_, settings_, width, height, xs_, ys_, samplers_, count, results_);
-        }
         accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
     }
 

@@ -68,16 +68,21 @@ inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
 
-// Whether these kernels (packet_kernels' answer) make camera rays and trace them in lanes for
-// Sobol samples given as keys and indices (trace_sobol_camera_samples): the float lanes.
+// Whether these kernels (packet_kernels' answer) make camera rays and trace paths in lanes
+// straight from Sobol samples given as keys and indices (trace_sobol_camera_samples): the
+// float lanes.
 bool sobol_camera_lanes(PacketKernels kernels);
-// trace_camera_samples for `count` samples (more than one) of Sobol samplers known by their
-// pixel keys and reversed sample indices, each the sampler Sampler(keys[i], index,
-// index_reversed[i]) gives before it has drawn anything, with `kernels` of which
-// sobol_camera_lanes holds: no Sampler is made (render_pass's batches).
+// trace_camera_samples for `count` samples of Sobol samplers known by their pixel keys and
+// sample indices (with their bit reversals), each the sampler Sampler(keys[i], indices[i],
+// index_reversed[i]) before it has drawn anything; `kernels` is packet_kernels' answer for
+// the scene and settings. Where sobol_camera_lanes(kernels) holds and the batch has more
+// than one sample, no Sampler is made (render_pass's batches); otherwise the samplers are
+// made and trace_camera_samples takes them.
 void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
                                 int width, int height, const int* xs, const int* ys, const uint32_t* keys,
-                                const uint32_t* index_reversed, int count, SampleResult* results);
+                                const uint32_t* index_reversed, const uint32_t* indices, int count,
+                                SampleResult* results);
+
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
 // within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
