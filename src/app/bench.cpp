@@ -230,7 +230,7 @@ int bench_throughput(const BenchOptions& o) {
                 name += " (lens " + std::to_string(o.lens).substr(0, 6) + ": " +
                         std::to_string(int(std::lround(100 * median(mrays[1]) / std::max(median(mrays[0]), 1e-9)))) +
                         " % of its Mrays/s)";
-            std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.0f | %s |\n", name.c_str(),
+            std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.1f | %s |\n", name.c_str(),
                         std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
                         median(mrays[c]), estimate, median(pass_ms[c]),
                         std::string(packet_kernels_names.name(packet_kernels(cameras[c], settings))).c_str());
