@@ -1,19 +1,21 @@
 // The physics of a path vertex, written once over the lane type: the materials' lobes,
 // scattering and smooth (diffuse) lobe, the Fresnel split, the pinhole camera's ray
 // direction, the choice of a light, the spherical lights' `brief` and `cone` samples, the
-// light a sample brings with its MIS weight, crossing a dielectric and Russian roulette. One path (material.cpp, light.cpp, integrator.cpp) instantiates it with OnePath,
-// one double wide; the SIMD kernels (packet_lanes.inc) with their lanes, four doubles or eight
+// light a sample brings with its MIS weight, the lights' densities and the MIS weight of
+// emission a BSDF-sampled ray finds, crossing a dielectric and Russian roulette. One path
+// (material.cpp, light.cpp, path.cpp, integrator.cpp) instantiates it with OnePath, one double
+// wide; the SIMD kernels (packet_lanes.inc) with their lanes, four doubles, or eight or sixteen
 // floats. So a new material or light is written here, once, for both.
 //
 // A lane type L gives: Real (the numbers), Scalar (one lane's number), Mask (comparisons of
 // Reals), Index (indices) and Vec (three Reals, with +, -, unary -, * by a Real or a Vec, and
-// dot found by argument-dependent lookup); kWidth lanes; and the few operations the code
-// below needs: splat, index (an int in every lane), select (of Reals, Vecs, Masks and
-// Indices), any, mask_not, sqrt, lane/set_lane/on (one lane,
-// for the rare steps done one lane at a time), and the maths of sampling: sin_cos_turns,
-// concentric_disk, cosine_hemisphere, uniform_sphere, uniform_cone, to_world (Frame::from_normal), normalize,
-// log_positive and expm1 (of the lanes a mask names). OnePath's are core's scalar functions; the lanes' are their lane-wise
-// copies, operation for operation, so the lanes trace one path's paths up to rounding.
+// dot found by argument-dependent lookup); kWidth lanes; and the few operations the code below
+// needs: splat, index (an int in every lane), select (of Reals, Vecs, Masks and Indices), any,
+// mask_not, sqrt, lane/set_lane/on (one lane, for the rare steps done one lane at a time), and
+// the maths of sampling: sin_cos_turns, concentric_disk, cosine_hemisphere, uniform_sphere,
+// uniform_cone, to_world (Frame::from_normal), normalize, log_positive and expm1 (of the lanes
+// a mask names). OnePath's are core's scalar functions; the lanes' are their lane-wise copies,
+// operation for operation, so the lanes trace one path's paths up to rounding.
 //
 // The templates themselves are in vertex.inc, which this header includes into kr::vertex and
 // packet_lanes.inc into each build of the kernels (vertex.inc says why). They are forced
