@@ -419,8 +419,7 @@ TEST_P(Packet, SobolSamplesAsKeysAreSamplersSamples) {
             }
             std::vector<SampleResult> from_keys(n), from_samplers(n);
             trace_sobol_camera_samples(packet_kernels(scene, settings), scene, settings, width, height, xs.data(),
-                                       ys.data(), keys.data(), reversed.data(), indices.data(), count,
-                                       from_keys.data());
+                                       ys.data(), keys.data(), reversed.data(), count, from_keys.data());
             trace_camera_samples(scene, settings, width, height, xs.data(), ys.data(), samplers.data(), count,
                                  from_samplers.data());
             int differ = 0;

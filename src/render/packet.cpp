@@ -269,8 +269,7 @@ bool sobol_camera_lanes(PacketKernels kernels) {
 
 void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
                                 int width, int height, const int* xs, const int* ys, const uint32_t* keys,
-                                const uint32_t* index_reversed, const uint32_t* indices, int count,
-                                SampleResult* results) {
+                                const uint32_t* index_reversed, int count, SampleResult* results) {
 #ifdef KR_X86_64_V4
     if (count > 1 && kernels == PacketKernels::x86_64_v4_float)
         return packet_f16::trace_sobol_camera_lanes(scene, settings, width, height, xs, ys, keys, index_reversed, count,
@@ -289,7 +288,8 @@ void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene,
         samplers.reserve(size_t(n));
         Sampler* pointers[kSampleBatch];
         for (int k = 0; k < n; ++k) {
-            samplers.emplace_back(keys[first + k], indices[first + k], index_reversed[first + k]);
+            const uint32_t reversed = index_reversed[first + k];  // reverse_bits is its own inverse
+            samplers.emplace_back(keys[first + k], reverse_bits(reversed), reversed);
             pointers[k] = &samplers.back();
         }
         trace_camera_samples(scene, settings, width, height, xs + first, ys + first, pointers, n, results + first);

@@ -298,11 +298,11 @@ private:
         if (pending > 0) flush<kSobol>(pending);
     }
 
-    // Slot `slot`'s Sobol sample: its key and index for the float lanes, else its sampler.
+    // Slot `slot`'s Sobol sample: its key and reversed index for the float lanes, else its
+    // sampler.
     void set_sobol(size_t slot, uint32_t key, uint32_t index, uint32_t index_reversed) {
         if (sobol_lanes_) {
             keys_[slot] = key;
-            indices_[slot] = index;
             index_reversed_[slot] = index_reversed;
         } else {
             slots_[slot].sampler.restart_sobol(key, index, index_reversed);
@@ -315,7 +315,7 @@ private:
         const int width = state_.width, height = state_.height;
         if (kSobol && sobol_lanes_)
             trace_sobol_camera_samples(kernels_, scene_, settings_, width, height, xs_, ys_, keys_, index_reversed_,
-                                       indices_, count, results_);
+                                       count, results_);
         else
             trace_camera_samples(scene_, settings_, width, height, xs_, ys_, samplers_, count, results_);
         accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
@@ -338,7 +338,7 @@ private:
         SamplerSlot() {}
     } slots_[kSampleBatch];
     Sampler* samplers_[kSampleBatch];
-    uint32_t keys_[kSampleBatch], indices_[kSampleBatch], index_reversed_[kSampleBatch];  // Sobol samples
+    uint32_t keys_[kSampleBatch], index_reversed_[kSampleBatch];  // Sobol samples
     int xs_[kSampleBatch], ys_[kSampleBatch];
     size_t pixels_[kSampleBatch];
     SampleResult results_[kSampleBatch];

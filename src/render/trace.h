@@ -73,15 +73,14 @@ PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& set
 // float lanes.
 bool sobol_camera_lanes(PacketKernels kernels);
 // trace_camera_samples for `count` samples of Sobol samplers known by their pixel keys and
-// sample indices (with their bit reversals), each the sampler Sampler(keys[i], indices[i],
-// index_reversed[i]) before it has drawn anything; `kernels` is packet_kernels' answer for
+// bit-reversed sample indices, each the sampler Sampler(keys[i], reverse_bits(
+// index_reversed[i])) before it has drawn anything; `kernels` is packet_kernels' answer for
 // the scene and settings. Where sobol_camera_lanes(kernels) holds and the batch has more
 // than one sample, no Sampler is made (render_pass's batches); otherwise the samplers are
 // made and trace_camera_samples takes them.
 void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
                                 int width, int height, const int* xs, const int* ys, const uint32_t* keys,
-                                const uint32_t* index_reversed, const uint32_t* indices, int count,
-                                SampleResult* results);
+                                const uint32_t* index_reversed, int count, SampleResult* results);
 
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
