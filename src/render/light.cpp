@@ -62,13 +62,14 @@ bool sample_sphere_light(const SphereGeom& light, const Vec3& p, LightSampling s
 
 double sphere_light_pdf(const SphereGeom& light, const Vec3& p, const Vec3& wi, double distance,
                         const Vec3& n_light, LightSampling strategy) {
-    return vertex::sphere_light_pdf<vertex::OnePath>(strategy, light.centre, light.radius, p, wi, distance, n_light,
-                                                     true);
+    const vertex::LightHit<vertex::OnePath> hit(strategy, light.centre, light.radius, p, wi, n_light);
+    return vertex::sphere_light_pdf<vertex::OnePath>(strategy, hit, light.radius, distance, true);
 }
 
 double light_emission_scale(const SphereGeom& light, const Vec3& p, const Vec3& wi, const Vec3& n_light,
                             LightSampling strategy) {
-    return vertex::light_emission_scale<vertex::OnePath>(strategy, light.centre, light.radius, p, wi, n_light);
+    return vertex::light_emission_scale<vertex::OnePath>(
+        strategy, vertex::LightHit<vertex::OnePath>(strategy, light.centre, light.radius, p, wi, n_light));
 }
 
 }  // namespace kr
