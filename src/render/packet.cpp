@@ -213,7 +213,8 @@ bool float_lanes_fit(const RenderScene& scene) {
         if (!in_range(light.radiance)) return false;
     for (const PointLight& light : scene.point_lights)
         if (!in_range(light.intensity)) return false;
-    return true;
+    // Gaps: surfaces and lights no nearer each other than the lanes' rounding resolves.
+    return scene.float_gaps_resolved;
 }
 
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {

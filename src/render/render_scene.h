@@ -69,6 +69,9 @@ struct RenderScene {
     SphereBvh bvh;  // over `spheres`; built by prepare_scene (call build_accel after edits)
     AccelBackend accel_backend = AccelBackend::automatic;  // which BVH build_accel makes
     bool linear_scan = false;  // test every sphere instead of the BVH (the plain path, for checks)
+    // float_resolves_gaps (precision.h) of the spheres and lights, as prepare_scene and
+    // build_accel found it: whether single-precision lanes may cast its rays.
+    bool float_gaps_resolved = false;
 
     // Closest hit within [tmin, tmax]. Fills `hit` and returns true if there is one.
     bool intersects(const Ray& ray, Hit& hit) const;
@@ -77,7 +80,9 @@ struct RenderScene {
     // The same two by testing every sphere in turn: the plain path the BVH is checked against.
     bool intersects_linear(const Ray& ray, Hit& hit) const;
     bool is_occluded_linear(const Ray& ray) const;
-    void build_accel() { bvh.build(spheres, accel_backend); }
+    // Builds the BVH over `spheres` (after edits to them or to the lights) and checks the gaps
+    // between them again.
+    void build_accel();
     size_t light_count() const { return point_lights.size() + area_lights.size(); }
 };
 

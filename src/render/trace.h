@@ -85,7 +85,8 @@ void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene,
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
 // distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
 // within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
-// inside their range (2^-60 to 2^60; a light of 1e30 is double's).
+// inside their range (2^-60 to 2^60; a light of 1e30 is double's), and its rays resolve
+// the gaps between its surfaces and lights (scene.float_gaps_resolved, render/precision.h).
 bool float_lanes_fit(const RenderScene& scene);
 
 }  // namespace kr
