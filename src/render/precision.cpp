@@ -3,7 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 namespace kr {
@@ -57,16 +58,11 @@ bool float_resolves_gaps(const RenderScene& scene) {
         }
     }
 
-    // Pairs of spheres whose surfaces come within a tolerance: a sweep along x over the
-    // spheres' boxes grown by the largest tolerance (no pair nearer is missed).
+    // Pairs of spheres whose surfaces come within a tolerance, found in a uniform grid over
+    // the spheres' boxes grown by half the largest tolerance (no pair nearer is missed).
     double margin = 0;
     for (const SphereGeom& s : spheres)
         margin = std::max({margin, end_tolerance(s, kFloatEpsilon), 2 * hit_tolerance(s, s)});
-    std::vector<size_t> order(spheres.size());
-    std::iota(order.begin(), order.end(), size_t{0});
-    std::sort(order.begin(), order.end(), [&](size_t i, size_t j) {
-        return spheres[i].centre.x - spheres[i].radius < spheres[j].centre.x - spheres[j].radius;
-    });
     const auto emitting = [&](size_t s) {
         const int light = scene.sphere_light.empty() ? -1 : scene.sphere_light[s];
         return light >= 0 && emits(scene.area_lights[size_t(light)].radiance);
@@ -75,6 +71,9 @@ bool float_resolves_gaps(const RenderScene& scene) {
     // other, and a light's within the end tolerance of any other surface.
     const auto pair_resolved = [&](size_t i, size_t j) {
         const SphereGeom &a = spheres[i], &b = spheres[j];
+        const Vec3 apart = a.centre - b.centre;
+        const double reach = a.radius + b.radius + margin;
+        if (std::abs(apart.x) > reach || std::abs(apart.y) > reach || std::abs(apart.z) > reach) return true;
         const double hit = hit_tolerance(a, b);
         if (near_surface_fraction(a, b, hit) > kFloatNearFraction ||
             near_surface_fraction(b, a, hit) > kFloatNearFraction)
@@ -85,18 +84,57 @@ bool float_resolves_gaps(const RenderScene& scene) {
             return false;
         return true;
     };
-    for (size_t k = 0; k < order.size(); ++k) {
-        const SphereGeom& a = spheres[order[k]];
-        const double hi_x = a.centre.x + a.radius + margin;
-        for (size_t m = k + 1; m < order.size(); ++m) {
-            const SphereGeom& b = spheres[order[m]];
-            if (b.centre.x - b.radius > hi_x) break;
-            const Vec3 apart = a.centre - b.centre;
-            const double reach = a.radius + b.radius + margin;
-            if (std::abs(apart.y) > reach || std::abs(apart.z) > reach) continue;
-            if (!pair_resolved(order[k], order[m])) return false;
+    // Cells of twice the median radius (plus the margin); a sphere whose grown box spans
+    // more than 4 cells on an axis (the brief's walls) is paired with every other sphere.
+    std::vector<double> radii;
+    for (const SphereGeom& s : spheres) radii.push_back(s.radius);
+    if (radii.empty()) return true;
+    std::nth_element(radii.begin(), radii.begin() + ptrdiff_t(radii.size() / 2), radii.end());
+    const double cell = 2 * radii[radii.size() / 2] + margin;
+    const auto cell_of = [&](double x) { return int64_t(std::floor(x / cell)); };
+    struct Key {
+        int64_t x, y, z;
+        bool operator==(const Key&) const = default;
+    };
+    struct KeyHash {
+        size_t operator()(const Key& k) const {
+            return size_t(uint64_t(k.x) * 0x9E3779B97F4A7C15ull ^ uint64_t(k.y) * 0xC2B2AE3D27D4EB4Full ^
+                          uint64_t(k.z) * 0x165667B19E3779F9ull);
         }
+    };
+    std::unordered_map<Key, std::vector<size_t>, KeyHash> grid;
+    std::vector<size_t> large;
+    const auto lower = [&](const SphereGeom& s) { return s.centre - Vec3(s.radius + margin / 2); };
+    const auto upper = [&](const SphereGeom& s) { return s.centre + Vec3(s.radius + margin / 2); };
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const Vec3 lo = lower(spheres[i]), hi = upper(spheres[i]);
+        const int64_t x0 = cell_of(lo.x), y0 = cell_of(lo.y), z0 = cell_of(lo.z);
+        const int64_t x1 = cell_of(hi.x), y1 = cell_of(hi.y), z1 = cell_of(hi.z);
+        if (!(x1 - x0 < 4 && y1 - y0 < 4 && z1 - z0 < 4)) {  // also where the cells overflow
+            large.push_back(i);
+            continue;
+        }
+        for (int64_t x = x0; x <= x1; ++x)
+            for (int64_t y = y0; y <= y1; ++y)
+                for (int64_t z = z0; z <= z1; ++z) grid[{x, y, z}].push_back(i);
     }
+    // Each pair of small spheres once: in the cell holding the lower corner of their boxes'
+    // overlap.
+    for (const auto& [key, members] : grid)
+        for (size_t m = 0; m < members.size(); ++m)
+            for (size_t n = m + 1; n < members.size(); ++n) {
+                const SphereGeom &a = spheres[members[m]], &b = spheres[members[n]];
+                const Vec3 la = lower(a), lb = lower(b);
+                const Key first{cell_of(std::max(la.x, lb.x)), cell_of(std::max(la.y, lb.y)),
+                                cell_of(std::max(la.z, lb.z))};
+                if (first == key && !pair_resolved(members[m], members[n])) return false;
+            }
+    // The large spheres with every other (two large ones once).
+    std::vector<char> is_large(spheres.size(), 0);
+    for (size_t i : large) is_large[i] = 1;
+    for (size_t i : large)
+        for (size_t j = 0; j < spheres.size(); ++j)
+            if (j != i && !(is_large[j] && j < i) && !pair_resolved(i, j)) return false;
     return true;
 }
 

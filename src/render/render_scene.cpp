@@ -231,7 +231,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
     // viewer's latency after a camera edit (about 80 of 140 ms).
     if (previous && previous->accel_backend == rs.accel_backend && previous->spheres == rs.spheres) {
         rs.bvh = previous->bvh;
-        rs.float_gaps_resolved = float_resolves_gaps(rs);
+        rs.float_gaps_resolved = rs.bvh.packets() && float_resolves_gaps(rs);
     } else {
         rs.build_accel();
     }
@@ -240,7 +240,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
 
 void RenderScene::build_accel() {
     bvh.build(spheres, accel_backend);
-    float_gaps_resolved = float_resolves_gaps(*this);
+    float_gaps_resolved = bvh.packets() && float_resolves_gaps(*this);
 }
 
 }  // namespace kr

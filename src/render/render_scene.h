@@ -70,7 +70,8 @@ struct RenderScene {
     AccelBackend accel_backend = AccelBackend::automatic;  // which BVH build_accel makes
     bool linear_scan = false;  // test every sphere instead of the BVH (the plain path, for checks)
     // float_resolves_gaps (precision.h) of the spheres and lights, as prepare_scene and
-    // build_accel found it: whether single-precision lanes may cast its rays.
+    // build_accel found it: whether single-precision lanes may cast its rays (false, and not
+    // examined, where its BVH gives the lanes nothing to cast them with).
     bool float_gaps_resolved = false;
 
     // Closest hit within [tmin, tmax]. Fills `hit` and returns true if there is one.
