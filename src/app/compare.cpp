@@ -31,7 +31,8 @@ be read, 2 on bad usage. At least one criterion is needed:
   --max-rmse X       RMS error at most X (radiance of two HDR images; else 8-bit values
                      over 255)
   --max-relmse X     relative MSE, mean of (t - r)^2 / (r^2 + 0.01), at most X
-  --statistical      both EXR renders with their variance layer: fails when the images
+  --statistical      both EXR renders with their variance layer (of a denoised render,
+                     its raw.R/G/B are tested, not its biased R, G, B): fails when the images
                      differ by more than their noise explains (per 8x8 block and channel,
                      Welch z test, blocks of 8, 16, ... up to the whole image,
                      Bonferroni over all of them, plus a chi-square over the 8x8
@@ -190,6 +191,10 @@ int run_compare(int argc, char** argv) {
                           stats->worst_channel == 0 ? "R" : stats->worst_channel == 1 ? "G" : "B",
                           stats->worst_size, stats->worst_size, stats->worst_x, stats->worst_y, stats->chi_square, stats->chi_square_limit, opt.stats.alpha);
             add(buf);
+            // A denoised render is biased: its raw radiance was tested, and the line says so.
+            for (const InputImage* in : {&test, &reference})
+                if (&tested_radiance(in->radiance) == &in->radiance.raw && (in == &test || in->name != test.name))
+                    add((show_user_text(in->name) + " is denoised: its raw.R/G/B tested").c_str());
         }
         if (opt.diff) {
             const Rgb8Image picture = stats ? false_colour(stats->pixel_z, test.rgb8.width, test.rgb8.height, stats->z_limit)
