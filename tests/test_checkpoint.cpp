@@ -248,6 +248,7 @@ TEST(Checkpoint, RefusesNumbersNoRenderWrites) {
         {"sum of squared luminance nan", [&](PixelBuffers& px) { px.luminance_sq_sum[at] = nan; }},
         {"sum of depths -3", [&](PixelBuffers& px) { px.depth_sum[at] = -3; }},
         {"samples accumulated but", [&](PixelBuffers& px) { px.sample_count[at] = px.sample_index[at] + 1; }},
+        {"samples drawn in 12 passes (at most 64 a pass)", [&](PixelBuffers& px) { px.sample_index[at] = 12 * 64 + 1; }},
         {"sums without a sample", [&](PixelBuffers& px) { px.sample_count[at] = 0, px.half_count[at] = 0; }},
         {"mask is 7", [&](PixelBuffers& px) { px.active[at] = 7; }},
         {"carried fraction of a sample nan", [&](PixelBuffers& px) { px.sample_credit[at] = float(nan); }},

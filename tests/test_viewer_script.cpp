@@ -194,7 +194,9 @@ TEST_F(ViewOutputs, TwoOutputsNamingOneFileAreRefused) {
         EXPECT_NE(p.find("are one file"), std::string::npos) << p;
     }
     std::filesystem::create_directories(dir / "folder.ppm");
-    EXPECT_NE(problem({"--save-image", d + "folder.ppm"}).find("folder.ppm"), std::string::npos);
+    const std::string folder = problem({"--save-image", d + "folder.ppm"});
+    EXPECT_EQ(folder.rfind("--save-image \"", 0), 0u) << folder;
+    EXPECT_NE(folder.find("folder.ppm\": is a folder"), std::string::npos) << folder;
     // Saving the edited scene over its own file is what Save does.
     EXPECT_EQ(problem({"--save-scene", d + "s.json", "--frames", "1"}), "");
 }

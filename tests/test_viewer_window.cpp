@@ -737,7 +737,8 @@ TEST_F(ViewerWindow, RenderTooLargeForMemoryIsAnErrorNotAnAbort) {
     EXPECT_FALSE(fs::exists(dir / "x.ppm"));
 }
 
-// A status file that cannot be written fails the scripted run (once said, exit 1).
+// A status file that cannot be written fails the scripted run (a folder: refused before the
+// window opens, naming the flag; exit 1).
 TEST_F(ViewerWindow, StatusFileThatCannotBeWrittenFailsTheRun) {
     fs::create_directories(dir / "folder");
     const ViewRun v = keithray("view '" + scene(1) + "' --spp 1 --frames 1 --screenshot '" + (dir / "x.ppm").string() +

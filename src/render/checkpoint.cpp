@@ -144,9 +144,10 @@ std::string differences(const std::string& checkpoint, const std::string& here) 
 // "" when every pixel holds: finite radiance sums, compensations, half sums and carried
 // fractions; sums of squares and of depths that are not NaN and not negative (a square's
 // sum may overflow to +inf, documented as an unknown variance); at most as many samples
-// accumulated as drawn, and in a half as in the pixel; no sums without samples; a mask of 0
-// and 1; carried fractions within what the allocation carries.
-std::string first_bad_pixel(const PixelBuffers& px, int width) {
+// accumulated as drawn, and in a half as in the pixel; no more drawn than `passes` passes
+// give (kMaxPassSamples each); no sums without samples; a mask of 0 and 1; carried fractions
+// within what the allocation carries.
+std::string first_bad_pixel(const PixelBuffers& px, int width, int passes) {
     const size_t n = px.sample_count.size();
     auto finite = [](const Color& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); };
     auto not_negative = [](double v) { return v >= 0; };  // false for NaN
@@ -175,6 +176,9 @@ std::string first_bad_pixel(const PixelBuffers& px, int width) {
             why = "its sum of depths " + number_text(px.depth_sum[i]) + " is negative or NaN";
         else if (count > px.sample_index[i])
             why = std::to_string(count) + " samples accumulated but " + std::to_string(px.sample_index[i]) + " drawn";
+        else if (uint64_t(px.sample_index[i]) > uint64_t(passes) * kMaxPassSamples)
+            why = std::to_string(px.sample_index[i]) + " samples drawn in " + std::to_string(passes) + " passes (at most " +
+                  std::to_string(kMaxPassSamples) + " a pass)";
         else if (count == 0 && (px.radiance_sum[i] != Color() || px.radiance_compensation[i] != Color() ||
                                 sq != Color() || px.luminance_sq_sum[i] != 0 || px.depth_sum[i] != 0))
             why = "sums without a sample";
@@ -324,7 +328,7 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     if (r.left() != sizeof(uint64_t) || restored.passes < 0) refuse("checkpoint damaged (unexpected layout)");
     // A valid checksum says the bytes are those written, not that a render wrote them: the
     // numbers must be ones a render holds, or they would reach every layer of the image.
-    if (const std::string bad = first_bad_pixel(px, width); !bad.empty())
+    if (const std::string bad = first_bad_pixel(px, width, restored.passes); !bad.empty())
         refuse("checkpoint holds numbers no render writes, nothing resumed: " + bad);
     state = std::move(restored);
 }

@@ -199,13 +199,13 @@ std::string view_files_problem(const ViewOptions& o) {
                        " are one file: both would be written, the last one winning; give each output its own file";
     // Every output checked as its writer will check it (a folder, a device, a read-only
     // file), before the run rather than at its end.
-    std::vector<fs::path> targets;
-    for (const auto& [flag, output] : outputs) targets.push_back(output);
-    try {
-        check_output_targets(targets);
-    } catch (const std::runtime_error& e) {
-        return e.what();
-    }
+    for (const auto& output : outputs) try {
+            check_output_targets({output.second});
+        } catch (const std::runtime_error& e) {
+            // The writer's message starts with the file: the flag goes before it.
+            const std::string name = named(output);
+            return name.substr(0, name.size() - quoted_path(output.second).size()) + e.what();
+        }
     return "";
 }
 
