@@ -514,6 +514,14 @@ TEST_F(HdrCli, CompareExitStatusVerdictAndDiffImage) {
     EXPECT_EQ(run("compare a.exr --statistical").status, 2);
     EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff ./b.exr").status, 2);  // never over an input
     EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff d.exr").status, 2);    // 8-bit picture only
+    // The statistical test's settings without the test mean nothing: bad usage, naming the flag.
+    for (const char* flag : {"--alpha 0.01", "--block 4"}) {
+        r = run(std::string("compare a.exr b.exr --max-rmse 1 ") + flag);
+        EXPECT_EQ(r.status, 2) << flag;
+        EXPECT_EQ(r.err.rfind("error: " + std::string(flag).substr(0, std::string(flag).find(' ')) + " sets the statistical test", 0), 0u)
+            << r.err;
+    }
+    EXPECT_EQ(run("compare a.exr b.exr --statistical --alpha 0.01 --block 4").status, 0);
     EXPECT_GT(read_hdr(dir / "b.exr").rgb.size(), 0u);
 }
 

@@ -86,6 +86,7 @@ struct CompareOptions {
 CompareOptions parse_compare(int argc, char** argv) {
     CompareOptions o;
     std::vector<std::string> files;
+    std::string test_flag;  // --alpha or --block, which only the statistical test reads
     for (ArgCursor args(argc, argv); args.next();) {
         const std::string& arg = args.arg();
         if (arg == "-h" || arg == "--help") throw UsageError{};
@@ -93,8 +94,8 @@ CompareOptions parse_compare(int argc, char** argv) {
         else if (arg == "--max-rmse") o.max_rmse = parse_number(arg, args.value(), 0, 1e30);
         else if (arg == "--max-relmse") o.max_relmse = parse_number(arg, args.value(), 0, 1e30);
         else if (arg == "--statistical") o.statistical = true;
-        else if (arg == "--alpha") o.stats.alpha = parse_number(arg, args.value(), 1e-300, 0.5);
-        else if (arg == "--block") o.stats.block = int(parse_integer(arg, args.value(), 1, 4096));
+        else if (arg == "--alpha") o.stats.alpha = parse_number(arg, args.value(), 1e-300, 0.5), test_flag = arg;
+        else if (arg == "--block") o.stats.block = int(parse_integer(arg, args.value(), 1, 4096)), test_flag = arg;
         else if (arg == "--diff") o.diff = args.value();
         else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + quote_user_text(arg)};
         else files.push_back(arg);
@@ -102,6 +103,8 @@ CompareOptions parse_compare(int argc, char** argv) {
     if (files.size() != 2) throw UsageError{"compare needs two image files, TEST and REFERENCE"};
     if (!o.min_psnr && !o.max_rmse && !o.max_relmse && !o.statistical)
         throw UsageError{"compare needs a criterion: --min-psnr, --max-rmse, --max-relmse or --statistical"};
+    if (!test_flag.empty() && !o.statistical)
+        throw UsageError{test_flag + " sets the statistical test: give --statistical too (the thresholds do not read it)"};
     o.test = files[0];
     o.reference = files[1];
     if (o.diff) {
