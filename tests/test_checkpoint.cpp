@@ -10,12 +10,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstring>
+#include <functional>
+#include <limits>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <thread>
 
+#include "core/hash.h"
 #include "render/checkpoint.h"
 #include "scene/save.h"
 #include "test_util.h"
@@ -164,14 +168,23 @@ TEST(Checkpoint, RefusesAnotherSceneSettingsSizeOrDamage) {
 
     RenderSettings other = settings;
     other.seed = 7;
-    expect_refused(refusal(bytes, checkpoint_key(authored, scene, other, rule)), "\"seed=0\" in the checkpoint, \"seed=7\" here");
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, other, rule)), "the seed (--seed): 0 in the checkpoint, 7 here");
     StopRule noisier = rule;
     noisier.noise = 0.5;
-    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, noisier)), "noise=");
-    // The pass limit, an open-ended render's implicit cap included.
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, noisier)),
+                   "the noise rule's target (--noise): none in the checkpoint, 0.5 here");
+    // The pass limit, an open-ended render's implicit cap included, named as such; every
+    // setting that differs is named (a --noise render without --spp: both).
     StopRule capped = rule;
     capped.max_passes = 65536;
-    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, capped)), "passes=65536\" here");
+    expect_refused(refusal(bytes, checkpoint_key(authored, scene, settings, capped)),
+                   "the pass limit (--spp): 2 in the checkpoint, 65536 (the cap of a --time or --noise render without "
+                   "--spp) here");
+    capped.noise = 0.01;
+    const std::string both = refusal(bytes, checkpoint_key(authored, scene, settings, capped));
+    expect_refused(both, "the pass limit (--spp): 2 in the checkpoint, 65536 (the cap");
+    expect_refused(both, "; the noise rule's target (--noise): none in the checkpoint, 0.01 here");
+    EXPECT_EQ(both.find("passes="), std::string::npos) << both;
     StopRule timed = rule;
     timed.seconds = 5;  // more or less time goes on to the same samples
     EXPECT_EQ(refusal(bytes, checkpoint_key(authored, scene, settings, timed)), "(accepted)");
@@ -188,6 +201,75 @@ TEST(Checkpoint, RefusesAnotherSceneSettingsSizeOrDamage) {
     newer[20] = 9;  // the version, after the 20-byte magic
     expect_refused(refusal(newer, key), "version 9");
     expect_refused(refusal("P6 1 1 255\n...", key), "not a keithray checkpoint");
+}
+
+// A checkpoint whose checksum holds but whose numbers no render writes (edited, or written
+// by a faulty program) is refused naming the file and the first such pixel: NaN would
+// otherwise reach every layer of the image. Sums of squares that overflowed to +inf are
+// what a render of radiance above 1e154 writes: accepted.
+TEST(Checkpoint, RefusesNumbersNoRenderWrites) {
+    const Scene authored = test::brief_scene(6, 8);
+    const RenderScene scene = prepare_scene(authored);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    settings.target_spp = 12;
+    StopRule rule;
+    rule.max_passes = 12;
+    rule.noise = 1e-3;  // never met: the noise rule's mask
+    rule.min_samples = 8;
+    RenderState state(8, 8);
+    state.track_halves();  // the denoiser's halves
+    render_until(scene, settings, state, rule);
+    ASSERT_FALSE(state.active().empty());
+    ASSERT_FALSE(state.sample_credit().empty());
+    const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
+    const size_t at = 2 * 8 + 5;  // pixel (5, 2)
+    ASSERT_GE(state.sample_count()[at], 2u);
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+
+    auto decoded = [&](const std::function<void(PixelBuffers&)>& change) -> std::string {
+        RenderState edited = state;
+        change(edited.buffers());
+        RenderState target(8, 8);
+        try {
+            decode_checkpoint(encode_checkpoint(key, edited), "run/r.ckpt", key, target);
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(target.passes, 0);
+            return e.what();
+        }
+        return "(accepted)";
+    };
+    EXPECT_EQ(decoded([](PixelBuffers&) {}), "(accepted)");
+    EXPECT_EQ(decoded([&](PixelBuffers& px) { px.radiance_sq_sum[at].y = px.luminance_sq_sum[at] = inf; }), "(accepted)");
+    const std::pair<const char*, std::function<void(PixelBuffers&)>> cases[] = {
+        {"radiance sum (0.5, nan,", [&](PixelBuffers& px) { px.radiance_sum[at] = Color(0.5, nan, 0.5); }},
+        {"radiance sum (inf,", [&](PixelBuffers& px) { px.radiance_sum[at].x = inf; }},
+        {"compensation", [&](PixelBuffers& px) { px.radiance_compensation[at].z = nan; }},
+        {"sum of squared radiance", [&](PixelBuffers& px) { px.radiance_sq_sum[at].x = -1; }},
+        {"sum of squared luminance nan", [&](PixelBuffers& px) { px.luminance_sq_sum[at] = nan; }},
+        {"sum of depths -3", [&](PixelBuffers& px) { px.depth_sum[at] = -3; }},
+        {"samples accumulated but", [&](PixelBuffers& px) { px.sample_count[at] = px.sample_index[at] + 1; }},
+        {"samples drawn in 12 passes (at most 64 a pass)", [&](PixelBuffers& px) { px.sample_index[at] = 12 * 64 + 1; }},
+        {"sums without a sample", [&](PixelBuffers& px) { px.sample_count[at] = 0, px.half_count[at] = 0; }},
+        {"mask is 7", [&](PixelBuffers& px) { px.active[at] = 7; }},
+        {"carried fraction of a sample nan", [&](PixelBuffers& px) { px.sample_credit[at] = float(nan); }},
+        {"carried fraction of a sample -1", [&](PixelBuffers& px) { px.sample_credit[at] = -1; }},
+        {"half's radiance sum", [&](PixelBuffers& px) { px.half_sum[at].y = inf; }},
+        {"a half of", [&](PixelBuffers& px) { px.half_count[at] = px.sample_count[at] + 1; }},
+    };
+    for (const auto& [what, change] : cases) {
+        const std::string message = decoded(change);
+        EXPECT_EQ(message.rfind("run/r.ckpt: checkpoint holds numbers no render writes", 0), 0u) << what << ": " << message;
+        EXPECT_NE(message.find("pixel (5, 2): "), std::string::npos) << what << ": " << message;
+        EXPECT_NE(message.find(what), std::string::npos) << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+    // The first bad pixel, row by row.
+    const std::string first = decoded([&](PixelBuffers& px) {
+        px.radiance_sum[at].x = nan;
+        px.depth_sum[at + 9] = nan;
+        px.depth_sum[3] = -1;
+    });
+    EXPECT_NE(first.find("pixel (3, 0): its sum of depths -1"), std::string::npos) << first;
 }
 
 namespace {
@@ -245,8 +327,8 @@ TEST_F(CheckpointCli, InterruptedAndResumedIsByteForByteTheWholeRender) {
     // Another seed: refused, one line naming the flag, the file and the difference.
     const test::CommandResult refused = cli_here(common + "--seed 3 -o other.ppm --resume r.ckpt");
     EXPECT_EQ(refused.status, 1);
-    EXPECT_EQ(refused.err, "error: --resume r.ckpt: checkpoint of other settings: \"seed=0\" in the checkpoint, "
-                           "\"seed=3\" here; nothing rendered\n");
+    EXPECT_EQ(refused.err, "error: --resume r.ckpt: checkpoint of other settings: the seed (--seed): 0 in the checkpoint, "
+                           "3 here; nothing rendered\n");
     EXPECT_FALSE(fs::exists(dir / "other.ppm"));
 }
 
@@ -421,12 +503,23 @@ TEST_F(CheckpointCli, OpenEndedRenderResumedPlainlyIsRefused) {
     ASSERT_EQ(first.status, 0) << first.err;
     const test::CommandResult refused = cli_here(common + "--resume r.ckpt");
     EXPECT_EQ(refused.status, 1);
-    EXPECT_NE(refused.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("the pass limit (--spp): 65536 (the cap of a --time or --noise render without --spp) "
+                               "in the checkpoint"),
+              std::string::npos)
+        << refused.err;
+    EXPECT_NE(refused.err.find("the noise rule's target (--noise): 0.5 in the checkpoint, none here"), std::string::npos)
+        << refused.err;
     // A --time render likewise (it may have stopped by its time or at the cap).
     ASSERT_EQ(cli_here(common + "--time 0.2 --checkpoint t.ckpt --every 0").status, 0);
     const test::CommandResult timed = cli_here(common + "--resume t.ckpt");
     EXPECT_EQ(timed.status, 1);
-    EXPECT_NE(timed.err.find("\"passes=65536\" in the checkpoint"), std::string::npos) << timed.err;
+    EXPECT_NE(timed.err.find("the pass limit (--spp): 65536 (the cap"), std::string::npos) << timed.err;
+    // The other way round, the issue's case: a render of a pass limit resumed with a noise rule.
+    ASSERT_EQ(cli_here(common + "--spp 3 --checkpoint s.ckpt --every 0").status, 0);
+    const test::CommandResult noisy = cli_here(common + "--noise 0.5 --resume s.ckpt");
+    EXPECT_EQ(noisy.status, 1);
+    EXPECT_NE(noisy.err.find("the noise rule's target (--noise): none in the checkpoint, 0.5 here"), std::string::npos)
+        << noisy.err;
     const test::CommandResult again = cli_here(common + "--noise 0.5 --resume r.ckpt");
     EXPECT_EQ(again.status, 0) << again.err;
 }
@@ -449,4 +542,33 @@ TEST_F(CheckpointCli, CheckpointTargetIsCheckedBeforeRendering) {
         EXPECT_FALSE(fs::exists(dir / "out.ppm")) << target;
     }
     EXPECT_EQ(test::read_file(dir / "ro.ckpt"), "old");
+}
+
+// The issue's case on the command line: a checkpoint with a valid checksum whose first
+// pixel's radiance sum is NaN. Resuming refuses it, one line naming the file and the pixel;
+// no image is written (it would be NaN in every layer).
+TEST_F(CheckpointCli, CheckpointWithNanSumsIsRefusedNamingThePixel) {
+    small_scene(8);
+    const std::string common = "render scene.json -q --threads 1 --spp 4 ";
+    ASSERT_EQ(cli_here(common + "-o first.exr --checkpoint r.ckpt --every 0").status, 0);
+    std::string bytes = test::read_file(dir / "r.ckpt");
+    // The layout of render/checkpoint.h: magic, version, scene, key length and key, width,
+    // height, passes, rays, non-finite count, then the first pixel's radiance sum.
+    size_t at = 20 + 4 + 8;
+    uint32_t key_length = 0;
+    std::memcpy(&key_length, bytes.data() + at, 4);
+    at += 4 + key_length + 4 + 4 + 4 + 8 + 8;
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    std::memcpy(bytes.data() + at + sizeof(double), &nan, sizeof nan);  // its green
+    const uint64_t checksum = fnv1a(std::string_view(bytes).substr(0, bytes.size() - 8));
+    std::memcpy(bytes.data() + bytes.size() - 8, &checksum, 8);
+    std::ofstream(dir / "nan.ckpt", std::ios::binary) << bytes;
+    const test::CommandResult r = cli_here(common + "-o resumed.exr --resume nan.ckpt");
+    EXPECT_EQ(r.status, 1);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find("nan.ckpt: checkpoint holds numbers no render writes"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("pixel (0, 0): its radiance sum ("), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "resumed.exr"));
+    // The untouched checkpoint resumes.
+    EXPECT_EQ(cli_here(common + "-o resumed.exr --resume r.ckpt").status, 0);
 }

@@ -23,6 +23,7 @@
 #include "core/image_hdr.h"
 #include "render/aov.h"
 #include "render/outputs.h"
+#include "scene/save.h"
 #include "test_util.h"
 #include "core/image_io.h"
 
@@ -237,6 +238,33 @@ TEST(HdrStatistics, MissingOrUnknownVarianceNamesTheFile) {
     } catch (const std::runtime_error& e) {
         EXPECT_EQ(std::string(e.what()).rfind("ref.exr: pixel (5, 0) has no variance estimate", 0), 0u) << e.what();
     }
+}
+
+// A denoised render's R, G, B are biased; its variance layer belongs to its raw mean
+// (raw.R/G/B). The test compares the raw means wherever an image holds them: a filter that
+// moved R, G, B far from them (noiseless pixels included) is no change of the render.
+TEST(HdrStatistics, DenoisedImagesAreTestedByTheirRawRadiance) {
+    HdrImage raw = layered_image(16, 16);
+    for (float& v : raw.variance)
+        if (std::isinf(v)) v = 1;
+    raw.variance[3 * 40] = raw.variance[3 * 40 + 1] = raw.variance[3 * 40 + 2] = 0;  // a noiseless pixel
+    HdrImage denoised = raw;
+    denoised.raw = raw.rgb;
+    for (float& v : denoised.rgb) v = v * 1.5f + 100;  // the filter's bias, far beyond the noise
+    EXPECT_EQ(&tested_radiance(denoised), &denoised.raw);
+    EXPECT_EQ(&tested_radiance(raw), &raw.rgb);
+    for (const auto& [a, b] : {std::pair{&denoised, &raw}, std::pair{&raw, &denoised}, std::pair{&denoised, &denoised}}) {
+        const StatisticalResult r = statistical_compare(*a, "a.exr", *b, "b.exr", {});
+        EXPECT_TRUE(r.agree);
+        EXPECT_EQ(r.max_abs_z, 0);
+    }
+    // A change of the raw mean is still found, at the pixel that changed.
+    HdrImage changed = denoised;
+    changed.raw[3 * 40] += 1;
+    const StatisticalResult r = statistical_compare(changed, "a.exr", raw, "b.exr", {});
+    EXPECT_FALSE(r.agree);
+    EXPECT_EQ(r.worst_x, 40 % 16);
+    EXPECT_EQ(r.worst_y, 40 / 16);
 }
 
 TEST(HdrStatistics, NormalQuantileMatchesKnownValues) {
@@ -486,6 +514,14 @@ TEST_F(HdrCli, CompareExitStatusVerdictAndDiffImage) {
     EXPECT_EQ(run("compare a.exr --statistical").status, 2);
     EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff ./b.exr").status, 2);  // never over an input
     EXPECT_EQ(run("compare a.exr b.exr --max-rmse 1 --diff d.exr").status, 2);    // 8-bit picture only
+    // The statistical test's settings without the test mean nothing: bad usage, naming the flag.
+    for (const char* flag : {"--alpha 0.01", "--block 4"}) {
+        r = run(std::string("compare a.exr b.exr --max-rmse 1 ") + flag);
+        EXPECT_EQ(r.status, 2) << flag;
+        EXPECT_EQ(r.err.rfind("error: " + std::string(flag).substr(0, std::string(flag).find(' ')) + " sets the statistical test", 0), 0u)
+            << r.err;
+    }
+    EXPECT_EQ(run("compare a.exr b.exr --statistical --alpha 0.01 --block 4").status, 0);
     EXPECT_GT(read_hdr(dir / "b.exr").rgb.size(), 0u);
 }
 
@@ -541,6 +577,66 @@ TEST_F(HdrCli, HugeFiniteMeansStayFiniteInTheFiles) {
     const test::CommandResult self = run("compare huge.exr huge.exr --statistical");
     EXPECT_EQ(self.status, 0) << self.out << self.err;
     EXPECT_EQ(run("compare huge.pfm huge.pfm --max-rmse 0").status, 0);
+}
+
+// Radiance whose squares overflow a double (an area light of 1e200): the mean is stored as
+// float's largest and so is its variance, never infinity, which marks fewer than two
+// samples. Every layer of the EXR (raw and denoised included) and of the PFM and its depth
+// file is finite, and `compare --statistical` of the render against itself agrees.
+TEST_F(HdrCli, VarianceOfRadianceWhoseSquaresOverflowIsStoredAsFloatsLargest) {
+    test::SceneBuilder b;
+    b.sphere({0, 0, 0}, 1, b.material(MaterialType::diffuse, Color(0.5)));
+    b.emitter({0, 3, -2}, 0.5, Color(1e200), b.material(MaterialType::diffuse, Color(0)));
+    b.scene.cameras[0].fov = 8;
+    b.scene.renderer.type = RendererType::pt;
+    b.scene.renderer.samples = 4;
+    b.scene.renderer.depth = 2;
+    save_scene_json(b.scene, dir / "bright.json");
+    ASSERT_EQ(run("render bright.json -q --threads 1 -o bright.exr").status, 0);
+    ASSERT_EQ(run("render bright.json -q --threads 1 -o bright.pfm").status, 0);
+    const test::CommandResult denoised = run("render bright.json -q --threads 1 --denoise -o denoised.exr");
+    ASSERT_EQ(denoised.status, 0) << denoised.err;
+    const HdrImage exr = read_hdr(dir / "bright.exr"), pfm = read_hdr(dir / "bright.pfm"),
+                   depth = read_hdr(dir / "bright-depth.pfm"), den = read_hdr(dir / "denoised.exr");
+    size_t saturated = 0;
+    for (const HdrImage* image : {&exr, &den})
+        for (uint32_t n : image->samples) ASSERT_GE(n, 2u);
+    for (const std::vector<float>* layer :
+         {&exr.rgb, &exr.variance, &exr.depth, &exr.albedo, &exr.normal, &den.rgb, &den.raw, &den.variance, &den.albedo,
+          &den.normal, &pfm.rgb, &depth.rgb})
+        for (float v : *layer) {
+            ASSERT_TRUE(std::isfinite(v));
+            saturated += v == std::numeric_limits<float>::max();
+        }
+    size_t saturated_variance = 0;
+    for (float v : exr.variance) saturated_variance += v == std::numeric_limits<float>::max();
+    EXPECT_GT(saturated_variance, 0u);  // the squares overflowed
+    EXPECT_GT(saturated, saturated_variance);
+    const test::CommandResult self = run("compare bright.exr bright.exr --statistical");
+    EXPECT_EQ(self.status, 0) << self.out << self.err;
+    const test::CommandResult raw = run("compare denoised.exr bright.exr --statistical");
+    EXPECT_EQ(raw.status, 0) << raw.out << raw.err;
+}
+
+// `compare --statistical` of a denoised render tests its raw radiance and says so on the
+// verdict line; the thresholds compare what the file shows (R, G, B).
+TEST_F(HdrCli, StatisticalCompareOfADenoisedRenderTestsItsRawRadiance) {
+    write_scene("s.json");
+    ASSERT_EQ(run("render s.json -q --spp 8 --seed 1 --denoise -o d.exr").status, 0);
+    ASSERT_EQ(run("render s.json -q --spp 8 --seed 2 -o r.exr").status, 0);
+    const HdrImage d = read_hdr(dir / "d.exr");
+    ASSERT_EQ(d.raw.size(), d.rgb.size());
+    ASSERT_NE(d.raw, d.rgb);  // the filter changed the image
+    for (const std::string args : {"compare d.exr r.exr --statistical", "compare r.exr d.exr --statistical"}) {
+        const test::CommandResult r = run(args);
+        EXPECT_EQ(r.status, 0) << args << "\n" << r.out << r.err;
+        EXPECT_EQ(r.out.rfind("agree: ", 0), 0u) << r.out;
+        EXPECT_NE(r.out.find("d.exr is denoised: its raw.R/G/B tested"), std::string::npos) << r.out;
+        EXPECT_EQ(r.out.find("r.exr is denoised"), std::string::npos) << r.out;
+        EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    }
+    const test::CommandResult plain = run("compare r.exr d.exr --max-rmse 1e9");
+    EXPECT_EQ(plain.out.find("denoised"), std::string::npos) << plain.out;
 }
 
 // The depth layer: a hit farther than the miss value (1e6) keeps its distance; a miss is 1e6.

@@ -99,6 +99,38 @@ TEST_F(RobustRuns, ViewerOutputsNeverReplaceItsInputs) {
     EXPECT_EQ(test::read_file(dir / "ref-depth.ppm"), "reference depth");
 }
 
+// Viewer flags that would mean nothing are refused before a window opens or a file is
+// written, with one error line naming the flag: a pixel outside the image (exit 1, once the
+// scene's size is known), a drag without a selection or an empty region (bad usage, exit 2),
+// two outputs naming one file (exit 1).
+TEST_F(RobustRuns, ViewerFlagsThatMeanNothingAreRefused) {
+    scene_file();  // 8x8 pixels
+    const std::pair<std::string, std::string> cases[] = {
+        {"--frames 1 --select 100,2 --move-selection 3,3", "--select 100,2 is outside the 8x8 image"},
+        {"--frames 1 --click-focus 4,8", "--click-focus 4,8 is outside the 8x8 image"},
+        {"--frames 1 --region 0,0 9,8", "--region 0,0 9,8 reaches outside the 8x8 image"},
+        {"--frames 1 --region 20,20 30,30", "--region 20,20 30,30 reaches outside"},
+        {"--frames 1 --move-selection 3,3", "--move-selection drags the selection"},
+        {"--frames 1 --region 4,4 4,8", "an empty region"},
+        {"--frames 1 --region 6,6 2,2", "an empty region"},
+        {"--frames 1 --screenshot same.ppm --save-image same.ppm", "--screenshot \"same.ppm\" and --save-image \"same.ppm\""},
+        {"--frames 1 --save-image out.ppm --save-scene out.ppm", "are one file"},
+        {"--frames 1 --save-image out.ppm --screenshot out-depth.ppm", "--save-image's depth file \"out-depth.ppm\""},
+    };
+    for (const auto& [flags, message] : cases) {
+        const test::CommandResult r = here(exe() + " view scene.json --save-image out.ppm " + flags);
+        const bool usage = message.find("drags") != std::string::npos || message.find("empty") != std::string::npos;
+        EXPECT_EQ(r.status, usage ? 2 : 1) << flags << "\n" << r.err;
+        EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+        EXPECT_NE(r.err.substr(0, r.err.find('\n')).find(message), std::string::npos) << flags << "\n" << r.err;
+        // One error line (bad usage adds the pointer to --help).
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), usage ? 2 : 1) << r.err;
+        EXPECT_EQ(r.err.find("window GL"), std::string::npos) << "a window opened: " << r.err;
+        for (const char* name : {"out.ppm", "out-depth.ppm", "same.ppm", "same-depth.ppm"})
+            EXPECT_FALSE(fs::exists(dir / name)) << flags << ": " << name;
+    }
+}
+
 // A viewer image named for a format it does not write is refused before the window opens:
 // a .jpg anywhere, and an HDR name for the 8-bit shots (a PPM's bytes under out.exr before).
 TEST_F(RobustRuns, ViewerImageNamesMatchWhatIsWritten) {

@@ -5,8 +5,11 @@
 #include <chrono>
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "core/image_hdr.h"
+#include "core/args.h"
 #include "core/image_io.h"
 #include "render/outputs.h"
 #include "scene/load.h"
@@ -15,6 +18,7 @@
 #include "viewer/latency.h"
 #include "viewer/save_dialog.h"
 #include "viewer/script.h"
+#include "viewer/view_options.h"
 
 namespace {
 
@@ -99,6 +103,102 @@ TEST(Script, EditsGoThroughTheEditPath) {
     EXPECT_EQ(m.camera().alpha, 0.25);
     EXPECT_TRUE(m.camera().position.x != before.position.x || m.camera().position.z != before.position.z);
     EXPECT_GT(m.camera().focal_distance, 0);
+}
+
+ViewOptions parse_view(std::vector<std::string> args) {
+    args.insert(args.begin(), {"keithray", "view", "s.json"});
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    return parse_view_options(int(argv.size()), argv.data());
+}
+
+// The usage error a command line gives, or "" when it parses.
+std::string usage_error(const std::vector<std::string>& args) {
+    try {
+        parse_view(args);
+    } catch (const UsageError& e) {
+        return e.message;
+    }
+    return "";
+}
+
+// Flags whose combination or values would mean nothing are refused by the command line
+// alone, naming the flag: a drag of no selection, an empty, inverted or fractional region.
+TEST(ViewOptions, FlagsThatWouldMeanNothingAreUsageErrors) {
+    EXPECT_EQ(usage_error({"--select", "3,4", "--move-selection", "5,-6", "--region", "0,0", "8,8"}), "");
+    const std::pair<std::vector<std::string>, const char*> cases[] = {
+        {{"--move-selection", "5,-6"}, "--move-selection drags the selection: give --select X,Y too"},
+        {{"--region", "10,10", "10,20"}, "--region X0,Y0 X1,Y1 refines the pixels [X0, X1) x [Y0, Y1): it needs X0 < X1"},
+        {{"--region", "10,10", "20,10"}, "got \"10,10 20,10\", an empty region"},
+        {{"--region", "30,30", "10,10"}, "got \"30,30 10,10\", an empty region"},
+        {{"--region", "0.5,0", "8,8"}, "--region takes whole image pixels, got \"0.5,0 8,8\""},
+    };
+    for (const auto& [args, message] : cases) {
+        const std::string error = usage_error(args);
+        EXPECT_NE(error.find(message), std::string::npos) << error;
+        EXPECT_EQ(error.find('\n'), std::string::npos) << error;
+    }
+}
+
+// Pixels of the command line outside the image (checked once the scene's size is known,
+// before a window opens): each refused naming its flag and the image's size.
+TEST(ViewOptions, PixelsOutsideTheImageAreRefused) {
+    const int w = 64, h = 48;
+    EXPECT_EQ(script_problem(parse_view({"--select", "63,47", "--click-focus", "0,0", "--probe", "10,20", "--region", "0,0",
+                                         "64,48"}),
+                             w, h),
+              "");
+    const std::pair<std::vector<std::string>, const char*> cases[] = {
+        {{"--select", "64,10"}, "--select 64,10 is outside the 64x48 image (pixels 0 to 63 across, 0 to 47 down)"},
+        {{"--select", "-0.5,10", "--move-selection", "5,5"}, "--select -0.5,10 is outside the 64x48 image"},
+        {{"--select", "3,900"}, "--select 3,900 is outside"},
+        {{"--click-focus", "10,48"}, "--click-focus 10,48 is outside the 64x48 image"},
+        {{"--probe", "-1,0"}, "--probe -1,0 is outside the 64x48 image"},
+        {{"--region", "-1,0", "8,8"}, "--region -1,0 8,8 reaches outside the 64x48 image (at most 0,0 64,48)"},
+        {{"--region", "60,40", "65,48"}, "--region 60,40 65,48 reaches outside"},
+        {{"--region", "100,100", "200,200"}, "--region 100,100 200,200 reaches outside"},
+    };
+    for (const auto& [args, message] : cases) {
+        const std::string problem = script_problem(parse_view(args), w, h);
+        EXPECT_EQ(problem.rfind(message, 0), 0u) << problem;
+    }
+}
+
+class ViewOutputs : public kr::test::ScratchDirTest {};
+
+// Two outputs of one run naming one file (a saved image's depth file included) would both
+// be written, the last one winning: refused before anything is opened, naming both flags.
+// So is an output its writer would refuse, a folder.
+TEST_F(ViewOutputs, TwoOutputsNamingOneFileAreRefused) {
+    const std::string d = dir.string() + "/";
+    auto problem = [&](std::vector<std::string> args) {
+        ViewOptions o = parse_view(args);
+        o.scene = dir / "s.json";
+        return view_files_problem(o);
+    };
+    EXPECT_EQ(problem({"--frames", "1", "--screenshot", d + "a.ppm", "--save-image", d + "b.ppm", "--save-scene",
+                       d + "c.json", "--stats-json", d + "d.json", "--status-file", d + "e.txt", "--window-shot",
+                       d + "f.png"}),
+              "");
+    const std::pair<std::vector<std::string>, std::vector<const char*>> cases[] = {
+        {{"--save-scene", d + "x.ppm", "--save-image", d + "x.ppm"}, {"--save-image ", "and --save-scene "}},
+        {{"--screenshot", d + "x.ppm", "--save-image", d + "x.ppm"}, {"--screenshot ", "and --save-image "}},
+        {{"--screenshot", d + "x-depth.ppm", "--save-image", d + "x.ppm"}, {"--screenshot ", "and --save-image's depth file "}},
+        {{"--save-image", d + "x.ppm", "--window-shot", d + "sub/../x-depth.ppm"}, {"--window-shot ", "and --save-image's depth file "}},
+        {{"--stats-json", d + "s.txt", "--status-file", d + "s.txt"}, {"--stats-json ", "and --status-file "}},
+        {{"--screenshot", d + "w.png", "--window-shot", d + "w.png"}, {"--screenshot ", "and --window-shot "}},
+    };
+    for (const auto& [args, words] : cases) {
+        const std::string p = problem(args);
+        for (const char* word : words) EXPECT_NE(p.find(word), std::string::npos) << word << " in " << p;
+        EXPECT_NE(p.find("are one file"), std::string::npos) << p;
+    }
+    std::filesystem::create_directories(dir / "folder.ppm");
+    const std::string folder = problem({"--save-image", d + "folder.ppm"});
+    EXPECT_EQ(folder.rfind("--save-image \"", 0), 0u) << folder;
+    EXPECT_NE(folder.find("folder.ppm\": is a folder"), std::string::npos) << folder;
+    // Saving the edited scene over its own file is what Save does.
+    EXPECT_EQ(problem({"--save-scene", d + "s.json", "--frames", "1"}), "");
 }
 
 class SaveDialog : public kr::test::ScratchDirTest {};

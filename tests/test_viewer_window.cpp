@@ -511,6 +511,18 @@ TEST_F(ViewerWindow, ClickSelectsDeleteUndoDuplicateAndMove) {
     EXPECT_NE(r["generation_after"], r["generation_before_move"]);  // the move changed the image
 }
 
+// The command line's edits apply in an interactive run as in a scripted one (they were
+// taken and ignored): --select selects sphere 01 of scene 3, --region sets the region.
+TEST_F(ViewerWindow, StartEditsApplyInAnInteractiveRun) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "start_edits", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    const kr::Scene three = kr::load_scene_file(kr::test::brief_scene_file(3)).scene;
+    ASSERT_NE(r["selected"], "none");
+    EXPECT_EQ(three.primitives[size_t(std::stoi(r["selected"]))].id, "sphere 01");
+    EXPECT_EQ(r["region"], "100,120,300,260");
+}
+
 // Missing item 1, the picture: sphere 01 of scene 3 selected (a click on it) and dragged by
 // (-60, -40) image pixels. The window's pixels are the CPU-computed image: the headless
 // render of the saved (moved) scene, with the selection's outline (sphere_outline of the
@@ -725,7 +737,8 @@ TEST_F(ViewerWindow, RenderTooLargeForMemoryIsAnErrorNotAnAbort) {
     EXPECT_FALSE(fs::exists(dir / "x.ppm"));
 }
 
-// A status file that cannot be written fails the scripted run (once said, exit 1).
+// A status file that cannot be written fails the scripted run (a folder: refused before the
+// window opens, naming the flag; exit 1).
 TEST_F(ViewerWindow, StatusFileThatCannotBeWrittenFailsTheRun) {
     fs::create_directories(dir / "folder");
     const ViewRun v = keithray("view '" + scene(1) + "' --spp 1 --frames 1 --screenshot '" + (dir / "x.ppm").string() +

@@ -9,7 +9,10 @@ scenario=$1 keithray=$2 scene=$3 dir=$4
 status="$dir/status.txt"
 limit=${VIEWER_INPUT_LIMIT:-240}  # seconds for any one condition, on a loaded machine
 
-"$keithray" view "$scene" --spp 2 --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
+# The command line's edits apply in an interactive run too (start_edits).
+start_edits=()
+[[ $scenario == start_edits ]] && start_edits=(--select 344,410 --region 100,120 300,260)
+"$keithray" view "$scene" --spp 2 "${start_edits[@]}" --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
 pid=$!
 trap 'kill $pid 2>/dev/null' EXIT
 
@@ -72,6 +75,11 @@ echo "generation_before=$(field generation)"
 echo "spp_before=$(field spp)"
 
 case $scenario in
+start_edits)
+    # --select and --region of an interactive run: what the status line reports once done.
+    echo "selected=$(field selected)"
+    echo "region=$(field region)"
+    ;;
 jitter_click)
     # Press, one pixel of jitter each way while held, release: a click, not an orbit. Each
     # step waits until a frame has seen it (the window reads the pointer once per frame).

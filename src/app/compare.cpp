@@ -31,7 +31,8 @@ be read, 2 on bad usage. At least one criterion is needed:
   --max-rmse X       RMS error at most X (radiance of two HDR images; else 8-bit values
                      over 255)
   --max-relmse X     relative MSE, mean of (t - r)^2 / (r^2 + 0.01), at most X
-  --statistical      both EXR renders with their variance layer: fails when the images
+  --statistical      both EXR renders with their variance layer (of a denoised render,
+                     its raw.R/G/B are tested, not its biased R, G, B): fails when the images
                      differ by more than their noise explains (per 8x8 block and channel,
                      Welch z test, blocks of 8, 16, ... up to the whole image,
                      Bonferroni over all of them, plus a chi-square over the 8x8
@@ -85,6 +86,7 @@ struct CompareOptions {
 CompareOptions parse_compare(int argc, char** argv) {
     CompareOptions o;
     std::vector<std::string> files;
+    std::string test_flag;  // --alpha or --block, which only the statistical test reads
     for (ArgCursor args(argc, argv); args.next();) {
         const std::string& arg = args.arg();
         if (arg == "-h" || arg == "--help") throw UsageError{};
@@ -92,8 +94,8 @@ CompareOptions parse_compare(int argc, char** argv) {
         else if (arg == "--max-rmse") o.max_rmse = parse_number(arg, args.value(), 0, 1e30);
         else if (arg == "--max-relmse") o.max_relmse = parse_number(arg, args.value(), 0, 1e30);
         else if (arg == "--statistical") o.statistical = true;
-        else if (arg == "--alpha") o.stats.alpha = parse_number(arg, args.value(), 1e-300, 0.5);
-        else if (arg == "--block") o.stats.block = int(parse_integer(arg, args.value(), 1, 4096));
+        else if (arg == "--alpha") o.stats.alpha = parse_number(arg, args.value(), 1e-300, 0.5), test_flag = arg;
+        else if (arg == "--block") o.stats.block = int(parse_integer(arg, args.value(), 1, 4096)), test_flag = arg;
         else if (arg == "--diff") o.diff = args.value();
         else if (!arg.empty() && arg[0] == '-') throw UsageError{"unknown option " + quote_user_text(arg)};
         else files.push_back(arg);
@@ -101,6 +103,8 @@ CompareOptions parse_compare(int argc, char** argv) {
     if (files.size() != 2) throw UsageError{"compare needs two image files, TEST and REFERENCE"};
     if (!o.min_psnr && !o.max_rmse && !o.max_relmse && !o.statistical)
         throw UsageError{"compare needs a criterion: --min-psnr, --max-rmse, --max-relmse or --statistical"};
+    if (!test_flag.empty() && !o.statistical)
+        throw UsageError{test_flag + " sets the statistical test: give --statistical too (the thresholds do not read it)"};
     o.test = files[0];
     o.reference = files[1];
     if (o.diff) {
@@ -190,6 +194,10 @@ int run_compare(int argc, char** argv) {
                           stats->worst_channel == 0 ? "R" : stats->worst_channel == 1 ? "G" : "B",
                           stats->worst_size, stats->worst_size, stats->worst_x, stats->worst_y, stats->chi_square, stats->chi_square_limit, opt.stats.alpha);
             add(buf);
+            // A denoised render is biased: its raw radiance was tested, and the line says so.
+            for (const InputImage* in : {&test, &reference})
+                if (&tested_radiance(in->radiance) == &in->radiance.raw && (in == &test || in->name != test.name))
+                    add((show_user_text(in->name) + " is denoised: its raw.R/G/B tested").c_str());
         }
         if (opt.diff) {
             const Rgb8Image picture = stats ? false_colour(stats->pixel_z, test.rgb8.width, test.rgb8.height, stats->z_limit)

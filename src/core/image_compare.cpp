@@ -66,6 +66,10 @@ double normal_upper_quantile(double p) {
     return 0.5 * (lo + hi);
 }
 
+const std::vector<float>& tested_radiance(const HdrImage& image) {
+    return image.raw.size() == image.rgb.size() ? image.raw : image.rgb;
+}
+
 StatisticalResult statistical_compare(const HdrImage& test, const std::string& test_name, const HdrImage& reference,
                                       const std::string& reference_name, const StatisticalSettings& settings) {
     if (test.width != reference.width || test.height != reference.height)
@@ -85,6 +89,10 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
                                          std::to_string(i / 3 / size_t(image->width)) +
                                          ") has no variance estimate (fewer than 2 samples, or squares beyond a double's range); "
                                          "--statistical needs at least 2 per pixel");
+    // The means tested: a denoised render's raw ones (raw.R/G/B), which its variance layer
+    // describes; its R, G, B are biased by the filter.
+    const std::vector<float>& test_rgb = tested_radiance(test);
+    const std::vector<float>& reference_rgb = tested_radiance(reference);
     // Degrees of freedom of a pixel's variance: its sample count less one (a file without the
     // samples layer is taken as large-sample).
     auto dof = [](const HdrImage& image, size_t i) {
@@ -140,8 +148,8 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
                 const size_t j = 3 * i + size_t(k);
                 const double va = test_var[j], vb = reference_var[j];
                 BlockSums& b = level[(size_t(y / block) * size_t(bx) + size_t(x / block)) * 3 + size_t(k)];
-                b.diff += double(test.rgb[j]) - double(reference.rgb[j]);
-                b.var += va + vb + rounding_floor(test.rgb[j], reference.rgb[j]);
+                b.diff += double(test_rgb[j]) - double(reference_rgb[j]);
+                b.var += va + vb + rounding_floor(test_rgb[j], reference_rgb[j]);
                 b.var_by_dof += va * va / dof(test, i) + vb * vb / dof(reference, i);
             }
         }
@@ -198,8 +206,8 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
     // exact: its values differing beyond float rounding is a change whatever the blocks say.
     for (size_t j = 0; j < 3 * n; ++j)
         if (test.variance[j] == 0 && reference.variance[j] == 0) {
-            const double d = double(test.rgb[j]) - double(reference.rgb[j]);
-            if (d * d > rounding_floor(test.rgb[j], reference.rgb[j])) {
+            const double d = double(test_rgb[j]) - double(reference_rgb[j]);
+            if (d * d > rounding_floor(test_rgb[j], reference_rgb[j])) {
                 out.max_abs_z = std::numeric_limits<double>::infinity();
                 out.worst_x = int(j / 3 % size_t(test.width));
                 out.worst_y = int(j / 3 / size_t(test.width));
@@ -214,8 +222,8 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
     for (size_t i = 0; i < n; ++i) {
         double worst = 0;
         for (size_t j = 3 * i; j < 3 * i + 3; ++j) {
-            const double d = double(test.rgb[j]) - double(reference.rgb[j]);
-            const double v = test_var[j] + reference_var[j] + rounding_floor(test.rgb[j], reference.rgb[j]);
+            const double d = double(test_rgb[j]) - double(reference_rgb[j]);
+            const double v = test_var[j] + reference_var[j] + rounding_floor(test_rgb[j], reference_rgb[j]);
             worst = std::max(worst, v > 0 ? std::abs(d) / std::sqrt(v) : (d != 0 ? 1e30 : 0.0));
         }
         out.pixel_z[i] = float(std::min(worst, 1e30));

@@ -44,6 +44,9 @@ struct StatisticalResult {
     double chi_square = 0, chi_square_limit = 0;
     std::vector<float> pixel_z;  // per pixel, the largest |z| of its own difference over the channels
 };
+// The means the test compares: a denoised render's raw radiance (its raw.R/G/B layer, the
+// mean its variance layer belongs to) where the image holds one, else its R, G, B.
+const std::vector<float>& tested_radiance(const HdrImage& image);
 // Throws std::runtime_error naming the file when a variance layer is missing or a pixel has
 // no variance estimate (fewer than two samples), std::invalid_argument when sizes differ.
 StatisticalResult statistical_compare(const HdrImage& test, const std::string& test_name, const HdrImage& reference,

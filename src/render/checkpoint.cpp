@@ -1,5 +1,6 @@
 #include "render/checkpoint.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "core/hash.h"
+#include "core/limits.h"
 #include "core/text.h"
 #include "render/trace.h"
 #include "scene/save.h"
@@ -79,18 +81,121 @@ private:
     size_t at_ = 0;
 };
 
-// The first word of `a` and `b` ("name=value") that differs, as "name=A in the checkpoint,
-// name=B here".
-std::string first_difference(const std::string& checkpoint, const std::string& here) {
+// A key's setting in words, for a refusal: what it is (with the flag that sets it) and how
+// its value reads. Unknown names (a key of another keithray) show as they are.
+struct SettingWords {
+    std::string_view name;  // as in the key
+    const char* words;
+};
+constexpr SettingWords kSettingWords[] = {
+    {"integrator", "the integrator (--integrator)"},
+    {"estimator", "the estimator (--estimator)"},
+    {"allocation", "the sample allocation (--allocation)"},
+    {"light-sampling", "the light sampling (--light-sampling)"},
+    {"depth", "the path depth (--depth)"},
+    {"spp", "the target samples per pixel (--spp)"},
+    {"rr-depth", "the Russian roulette depth"},
+    {"seed", "the seed (--seed)"},
+    {"kernels", "the SIMD kernels (--kernels)"},
+    {"passes", "the pass limit (--spp)"},
+    {"noise", "the noise rule's target (--noise)"},
+    {"min-samples", "the noise rule's samples per pixel before it trusts a variance"},
+    {"adapt-every", "the noise rule's passes between checks"},
+};
+
+// A value of setting `name` as a refusal shows it: the noise target 0 as "none", the pass
+// cap of an open-ended render named as such.
+std::string value_words(std::string_view name, std::string_view value) {
+    if (name == "noise" && value == "0") return "none";
+    if (name == "passes" && value == std::to_string(kMaxOpenEndedPasses))
+        return std::string(value) + " (the cap of a --time or --noise render without --spp)";
+    return show_user_text(value, 40);
+}
+
+// Every "name=value" word of `checkpoint` and `here` that differs, in words: "the seed
+// (--seed): 0 in the checkpoint, 7 here; ...". The keys list their names in one order.
+std::string differences(const std::string& checkpoint, const std::string& here) {
     std::istringstream a(checkpoint), b(here);
-    std::string wa, wb;
+    std::string wa, wb, out;
     while (true) {
         const bool more_a = bool(a >> wa), more_b = bool(b >> wb);
-        if (!more_a && !more_b) return "settings differ";
-        if (!more_a) wa = "(none)";
-        if (!more_b) wb = "(none)";
-        if (wa != wb) return quote_user_text(wa) + " in the checkpoint, " + quote_user_text(wb) + " here";
+        if (!more_a && !more_b) break;
+        if (!more_a) wa.clear();
+        if (!more_b) wb.clear();
+        if (wa == wb) continue;
+        const size_t ea = wa.find('='), eb = wb.find('=');
+        const std::string_view name_a = std::string_view(wa).substr(0, ea), name_b = std::string_view(wb).substr(0, eb);
+        if (!more_a || !more_b || ea == std::string::npos || eb == std::string::npos || name_a != name_b) {
+            // Keys of another layout: the words themselves.
+            out += (out.empty() ? "" : "; ") + (more_a ? quote_user_text(wa) : std::string("(none)")) +
+                   " in the checkpoint, " + (more_b ? quote_user_text(wb) : std::string("(none)")) + " here";
+            break;
+        }
+        std::string what = quote_user_text(name_a);
+        for (const SettingWords& s : kSettingWords)
+            if (s.name == name_a) what = s.words;
+        out += (out.empty() ? "" : "; ") + what + ": " + value_words(name_a, std::string_view(wa).substr(ea + 1)) +
+               " in the checkpoint, " + value_words(name_b, std::string_view(wb).substr(eb + 1)) + " here";
     }
+    return out.empty() ? "settings differ" : out;
+}
+
+// The first pixel (row by row) whose numbers no render writes, as "pixel (x, y): what", or
+// "" when every pixel holds: finite radiance sums, compensations, half sums and carried
+// fractions; sums of squares and of depths that are not NaN and not negative (a square's
+// sum may overflow to +inf, documented as an unknown variance); at most as many samples
+// accumulated as drawn, and in a half as in the pixel; no more drawn than `passes` passes
+// give (kMaxPassSamples each); no sums without samples; a mask of 0 and 1; carried fractions
+// within what the allocation carries.
+std::string first_bad_pixel(const PixelBuffers& px, int width, int passes) {
+    const size_t n = px.sample_count.size();
+    auto finite = [](const Color& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); };
+    auto not_negative = [](double v) { return v >= 0; };  // false for NaN
+    auto colour = [](const Color& c) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "(%g, %g, %g)", c.x, c.y, c.z);
+        return std::string(buf);
+    };
+    auto number_text = [](double v) {
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", v);
+        return std::string(buf);
+    };
+    for (size_t i = 0; i < n; ++i) {
+        std::string why;
+        const uint32_t count = px.sample_count[i];
+        const Color& sq = px.radiance_sq_sum[i];
+        if (!finite(px.radiance_sum[i])) why = "its radiance sum " + colour(px.radiance_sum[i]) + " is not finite";
+        else if (!finite(px.radiance_compensation[i]))
+            why = "its radiance sum's compensation " + colour(px.radiance_compensation[i]) + " is not finite";
+        else if (!not_negative(sq.x) || !not_negative(sq.y) || !not_negative(sq.z))
+            why = "its sum of squared radiance " + colour(sq) + " is negative or NaN";
+        else if (!not_negative(px.luminance_sq_sum[i]))
+            why = "its sum of squared luminance " + number_text(px.luminance_sq_sum[i]) + " is negative or NaN";
+        else if (!not_negative(px.depth_sum[i]))
+            why = "its sum of depths " + number_text(px.depth_sum[i]) + " is negative or NaN";
+        else if (count > px.sample_index[i])
+            why = std::to_string(count) + " samples accumulated but " + std::to_string(px.sample_index[i]) + " drawn";
+        else if (uint64_t(px.sample_index[i]) > uint64_t(passes) * kMaxPassSamples)
+            why = std::to_string(px.sample_index[i]) + " samples drawn in " + std::to_string(passes) + " passes (at most " +
+                  std::to_string(kMaxPassSamples) + " a pass)";
+        else if (count == 0 && (px.radiance_sum[i] != Color() || px.radiance_compensation[i] != Color() ||
+                                sq != Color() || px.luminance_sq_sum[i] != 0 || px.depth_sum[i] != 0))
+            why = "sums without a sample";
+        else if (!px.active.empty() && px.active[i] > 1)
+            why = "its noise-rule mask is " + std::to_string(px.active[i]) + ", not 0 or 1";
+        else if (!px.sample_credit.empty() &&
+                 !(px.sample_credit[i] >= 0 && px.sample_credit[i] <= 4.0f * float(kMaxPassSamples)))
+            why = "its carried fraction of a sample " + number_text(px.sample_credit[i]) + " is outside [0, " +
+                  std::to_string(4 * kMaxPassSamples) + "]";
+        else if (!px.half_sum.empty() && !finite(px.half_sum[i]))
+            why = "its half's radiance sum " + colour(px.half_sum[i]) + " is not finite";
+        else if (!px.half_count.empty() && px.half_count[i] > count)
+            why = "a half of " + std::to_string(px.half_count[i]) + " samples out of " + std::to_string(count);
+        if (!why.empty())
+            return "pixel (" + std::to_string(i % size_t(width)) + ", " + std::to_string(i / size_t(width)) + "): " + why;
+    }
+    return "";
 }
 
 }  // namespace
@@ -200,7 +305,7 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
                std::to_string(expected.width) + "x" + std::to_string(expected.height));
     if (scene != expected.scene)
         refuse("checkpoint of another scene (the scene's content differs from the one rendered then)");
-    if (settings != expected.settings) refuse("checkpoint of other settings: " + first_difference(settings, expected.settings));
+    if (settings != expected.settings) refuse("checkpoint of other settings: " + differences(settings, expected.settings));
     RenderState restored(width, height);
     const size_t n = restored.sample_count().size();
     PixelBuffers& px = restored.buffers();
@@ -221,6 +326,10 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
         r.get_all(px.half_count, n);
     }
     if (r.left() != sizeof(uint64_t) || restored.passes < 0) refuse("checkpoint damaged (unexpected layout)");
+    // A valid checksum says the bytes are those written, not that a render wrote them: the
+    // numbers must be ones a render holds, or they would reach every layer of the image.
+    if (const std::string bad = first_bad_pixel(px, width, restored.passes); !bad.empty())
+        refuse("checkpoint holds numbers no render writes, nothing resumed: " + bad);
     state = std::move(restored);
 }
 

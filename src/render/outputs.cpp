@@ -1,5 +1,6 @@
 #include "render/outputs.h"
 
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -113,6 +114,15 @@ HdrImage hdr_from_developed(Developed image) {
     out.normal = std::move(image.normal);
     out.samples = std::move(image.samples);
     out.variance = std::move(image.variance);
+    // Infinite marks a variance unknown for want of samples. A pixel of 2 samples or more has
+    // one only where its squares overflowed a double (radiance above ~1e154): a variance far
+    // beyond float's range, stored as its largest, as its mean is.
+    if (out.samples.size() == out.pixel_count() && out.variance.size() == 3 * out.pixel_count())
+        for (size_t i = 0; i < out.samples.size(); ++i)
+            if (out.samples[i] >= 2)
+                for (size_t k = 3 * i; k < 3 * i + 3; ++k)
+                    if (out.variance[k] == std::numeric_limits<float>::infinity())
+                        out.variance[k] = std::numeric_limits<float>::max();
     if (!image.raw.pixels.empty()) out.raw = floats(image.raw.pixels);
     return out;
 }

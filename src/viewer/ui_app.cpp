@@ -62,6 +62,11 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
     } catch (const SceneError& e) {
         messages_.error = e.what();
     }
+    // The command line's pixels must lie in the image, checked before a window opens.
+    if (model_.has_scene())
+        if (const std::string problem = script_problem(options_, model_.scene().renderer.width, model_.scene().renderer.height);
+            !problem.empty())
+            throw std::runtime_error(problem + "; nothing opened or written");
     ui_.files.watch.watch(options_.scene);
     if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene());
     CompareTool& tool = ui_.compare;

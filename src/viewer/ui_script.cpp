@@ -20,8 +20,9 @@ ScriptRun::ScriptRun(const ViewOptions& options)
 bool ScriptRun::start(PanelContext& ctx) {
     // The --timeout clock started with this object, before the scene was loaded and the
     // window opened: whatever is slow there counts.
-    if (!options_.scripted() || !ctx.model.has_scene()) return true;
-    // The scripted edits go through the same functions as the mouse and the panels.
+    if (!ctx.model.has_scene()) return true;
+    // The command line's edits, in an interactive run too, go through the same functions as
+    // the mouse and the panels.
     const bool ok = apply_script_edits(options_, ctx.model, [&](Edit kind, const auto& change) { return ctx.edit(kind, change); });
     if (!ok) return false;
     if (const auto& r = options_.region) ctx.ui.region = PixelBox{(*r)[0], (*r)[1], (*r)[2], (*r)[3]};
@@ -44,7 +45,8 @@ bool ScriptRun::start(PanelContext& ctx) {
             ctx.edit(Edit::object, [&](Scene& sc, ViewerSettings&) { own_shape(sc, p).centre = to; });
         }
     }
-    if (options_.reference && !ctx.ui.compare.comparison.reference()) {
+    // A scripted run needs its image B; the window shows why it is missing.
+    if (options_.scripted() && options_.reference && !ctx.ui.compare.comparison.reference()) {
         std::fprintf(stderr, "error: %s\n", ctx.messages.error.c_str());
         return false;
     }

@@ -1,6 +1,8 @@
 #include "viewer/view_options.h"
 
 #include <cmath>
+#include <cstdio>
+#include <string_view>
 #include <vector>
 
 #include "core/file_write.h"
@@ -37,13 +39,17 @@ constexpr const char* kViewOnlyOptions = R"(  --unlimited           keep refinin
   --zoom Z              show the image at Z screen pixels per pixel (up to 16) about its centre
   --probe X,Y           lock the pixel inspector on image pixel (X, Y)
   -h, --help            this text
-Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run):
+Edits made at the start, as the mouse makes them (pixels within the image):
   --aperture A          make the camera a thin lens of aperture radius A
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
   --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
   --select X,Y          a click at image pixel (X, Y): selects the sphere there
   --move-selection DX,DY  then drag the selection by (DX, DY) image pixels in the view plane
-  --region X0,Y0 X1,Y1  refine only the image pixels [X0, X1) x [Y0, Y1) (the B key's box)
+                        (needs --select)
+  --region X0,Y0 X1,Y1  refine only the image pixels [X0, X1) x [Y0, Y1) (the B key's box;
+                        X0 < X1, Y0 < Y1, whole pixels)
+Scripted runs (tests, measurements; the window still opens, e.g. under xvfb-run; each
+output its own file):
   --frames N            accumulate N full-resolution passes (at most the target spp)
   --screenshot OUT.ppm  then write the image region as drawn by the display shader (.png: as PNG)
   --save-scene OUT.json then save the edited scene
@@ -85,8 +91,15 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--select") o.select = parse_pair(arg, value());
         else if (arg == "--move-selection") o.move_selection = parse_pair(arg, value());
         else if (arg == "--region") {
-            const auto a = parse_pair(arg, value());  // "X0,Y0" then "X1,Y1": two pairs
-            const auto b = parse_pair(arg, value());
+            const std::string first = value(), second = value();  // "X0,Y0" then "X1,Y1": two pairs
+            const auto a = parse_pair(arg, first), b = parse_pair(arg, second);
+            const std::string given = quote_user_text(first + " " + second, 60);
+            for (const double v : {a.first, a.second, b.first, b.second})
+                if (v != std::floor(v)) throw UsageError{"--region takes whole image pixels, got " + given};
+            // The pixels [X0, X1) x [Y0, Y1): none when a side is empty or inverted.
+            if (!(a.first < b.first && a.second < b.second))
+                throw UsageError{"--region X0,Y0 X1,Y1 refines the pixels [X0, X1) x [Y0, Y1): it needs X0 < X1 and "
+                                 "Y0 < Y1, got " + given + ", an empty region"};
             o.region = std::array<int, 4>{int(a.first), int(a.second), int(b.first), int(b.second)};
         }
         else if (arg == "--frames") o.frames = int(parse_integer(arg, value(), 1, kMaxSamples));
@@ -120,6 +133,9 @@ ViewOptions parse_view_options(int argc, char** argv) {
             have_scene = true;
         }
     }
+    // A drag of the selection needs one: without --select it would move nothing.
+    if (o.move_selection && !o.select)
+        throw UsageError{"--move-selection drags the selection: give --select X,Y too (the sphere to drag)"};
     if (!have_scene) {
         o.scene = "res/scenes/assignment_03.json";
 #ifdef KEITHRAY_SCENES_DIR
@@ -170,6 +186,48 @@ std::string view_files_problem(const ViewOptions& o) {
     // Saving the edited scene onto its own file is what Save does; onto the reference it is not.
     if (o.save_scene && o.reference && same_file(*o.save_scene, *o.reference))
         return "--save-scene " + quoted_path(*o.save_scene) + " would overwrite --reference " + quoted_path(*o.reference);
+    // Two outputs of one run naming one file would both be written, the last one winning.
+    if (o.save_scene) outputs.push_back({"--save-scene", *o.save_scene});
+    auto named = [&](const std::pair<const char*, fs::path>& output) {
+        const bool depth = o.save_image && std::string_view(output.first) == "--save-image" && output.second != *o.save_image;
+        return std::string(output.first) + (depth ? "'s depth file " : " ") + quoted_path(output.second);
+    };
+    for (size_t a = 0; a < outputs.size(); ++a)
+        for (size_t b = a + 1; b < outputs.size(); ++b)
+            if (same_file(outputs[a].second, outputs[b].second))
+                return named(outputs[a]) + " and " + named(outputs[b]) +
+                       " are one file: both would be written, the last one winning; give each output its own file";
+    // Every output checked as its writer will check it (a folder, a device, a read-only
+    // file), before the run rather than at its end.
+    for (const auto& output : outputs) try {
+            check_output_targets({output.second});
+        } catch (const std::runtime_error& e) {
+            // The writer's message starts with the file: the flag goes before it.
+            const std::string name = named(output);
+            return name.substr(0, name.size() - quoted_path(output.second).size()) + e.what();
+        }
+    return "";
+}
+
+std::string script_problem(const ViewOptions& o, int width, int height) {
+    const std::string size = std::to_string(width) + "x" + std::to_string(height);
+    auto outside = [&](const char* flag, double x, double y) -> std::string {
+        if (x >= 0 && x < width && y >= 0 && y < height) return "";
+        char at[64];
+        std::snprintf(at, sizeof at, "%.10g,%.10g", x, y);
+        return std::string(flag) + " " + at + " is outside the " + size + " image (pixels 0 to " +
+               std::to_string(width - 1) + " across, 0 to " + std::to_string(height - 1) + " down)";
+    };
+    if (o.select)
+        if (std::string p = outside("--select", o.select->first, o.select->second); !p.empty()) return p;
+    if (o.click_focus)
+        if (std::string p = outside("--click-focus", o.click_focus->first, o.click_focus->second); !p.empty()) return p;
+    if (o.probe)
+        if (std::string p = outside("--probe", o.probe->first, o.probe->second); !p.empty()) return p;
+    if (const auto& r = o.region; r && ((*r)[0] < 0 || (*r)[1] < 0 || (*r)[2] > width || (*r)[3] > height))
+        return "--region " + std::to_string((*r)[0]) + "," + std::to_string((*r)[1]) + " " + std::to_string((*r)[2]) +
+               "," + std::to_string((*r)[3]) + " reaches outside the " + size + " image (at most 0,0 " +
+               std::to_string(width) + "," + std::to_string(height) + ")";
     return "";
 }
 

@@ -54,7 +54,14 @@ ViewOptions parse_view_options(int argc, char** argv);
 // watches its scene, and opening a FIFO would block before the --timeout clock could end
 // the run), or an output (--screenshot, --window-shot, --save-image and its depth file,
 // --stats-json, --status-file; --save-scene onto the reference) that would replace an input.
+// Also two outputs naming one file (--save-image's depth file included), and an output its
+// writer would refuse (a folder, a device, a read-only file).
 std::string view_files_problem(const ViewOptions& options);
+
+// What makes the command line's pixels mean nothing in a `width` x `height` image, checked
+// once the scene is loaded and before the window opens, or "" if nothing: --select,
+// --click-focus or --probe outside it, a --region reaching outside it.
+std::string script_problem(const ViewOptions& options, int width, int height);
 
 // `keithray view --help`: the shared flags from their table, then the viewer's own.
 std::string view_usage();
