@@ -148,6 +148,17 @@ tree)
   rm -rf "$tmp/prefix"
   check_docs "$tmp/copy"
   check_program "$tmp/copy"
+  # The program alone, without its share/: no bundled scenes, and a clear refusal naming
+  # where it looked and what to pass (exit 2), never a scene found elsewhere.
+  mkdir -p "$tmp/alone/bin" "$tmp/alone/work"
+  cp "$tmp/copy/bin/keithray" "$tmp/alone/bin/"
+  cd "$tmp/alone/work"
+  status=0
+  ../bin/keithray render -q >out.txt 2>err.txt || status=$?
+  [ "$status" = 2 ] || fail "render without scene or share/: exit $status"
+  grep -q "no bundled scenes found (looked in .*/alone/share/keithray.*give a SCENE.json" err.txt ||
+    fail "render without scene or share/ says: $(cat err.txt)"
+  [ ! -e output ] || fail "render without scene or share/ wrote output/"
   ;;
 package)
   command -v dpkg-deb >/dev/null || fail "dpkg-deb missing"
