@@ -35,9 +35,12 @@ fi
 #   RobustJson.HundredThousandPrimitives: loads, prepares and renders 100,000 spheres,
 #       minutes under a sanitizer. RobustJson.HugeArrays keeps a large file in the
 #       sanitized runs.
+#   Install.*: install, package and run the program as a user gets it (tests/install_check.sh):
+#       about the install layout, not memory or threads; the viewer and render they run are
+#       the ones the other tests run sanitized.
 skip='^(Scenes/PathTracedReference\.|Scenes/WhittedReference\.|ReferenceSensitivity\.'
 skip+='|Scenes/GlDisplay\.MatchesCpuToneMap/assignment_0[4578]_'
-skip+='|RobustJson\.HundredThousandPrimitives$)'
+skip+='|RobustJson\.HundredThousandPrimitives$|^Install\.)'
 # Under ASan only: ViewerWindow.ScriptedEditsScreenshotMatchesHeadlessRender, the window
 # screenshot-vs-headless image check after scripted edits (80 to 170 s under ASan, the
 # longest test of the run). The other two window tests still run under ASan, and all three

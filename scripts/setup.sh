@@ -18,6 +18,10 @@ packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev xvfb xdotool xauth
           # python3 reads a window back from the X server for the window tests (tests/x_window_shot.py)
           python3
+          # the install tests (tests/install_check.sh): the Debian package's dependencies
+          # (dpkg-shlibdeps, which CPack runs), the man page shown with man -l, the desktop
+          # entry checked by desktop-file-validate
+          dpkg-dev man-db desktop-file-utils
           # the sanitizer and fuzzing builds (scripts/check_sanitizers.sh): clang, its
           # sanitizer and libFuzzer runtimes, its OpenMP runtime (whose archer tool makes
           # OpenMP visible to ThreadSanitizer) and llvm-symbolizer for the reports' stacks

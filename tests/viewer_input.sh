@@ -80,6 +80,20 @@ start_edits)
     echo "selected=$(field selected)"
     echo "region=$(field region)"
     ;;
+save_where)
+    # Ctrl+S on a read-only scene (a bundled one of the install tree): the window asks where
+    # to save; Return saves at the name it offers (NAME.json in the current folder), which
+    # becomes the scene's file: a second Ctrl+S saves there without asking.
+    xdotool key ctrl+s
+    wait_for 'question=save-where' || exit 1
+    echo "asked=save-where"
+    xdotool key Return
+    wait_for 'question=none' || exit 1
+    xdotool key ctrl+s
+    xdotool key F1
+    wait_for 'help=1' || exit 1
+    echo "question_after=$(sed -E 's/.*question=([^ ]*).*/\1/' "$status")"
+    ;;
 jitter_click)
     # Press, one pixel of jitter each way while held, release: a click, not an orbit. Each
     # step waits until a frame has seen it (the window reads the pointer once per frame).

@@ -34,7 +34,7 @@ constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
---throughput  renders each scene (default: every res/scenes/*.json) at F times its own
+--throughput  renders each scene (default: the bundled scenes) at F times its own
               sample count (default F = 1/32, at least 1 spp), --runs times (default 3),
               and prints the median seconds and Mrays/s (all rays: camera, bounce, shadow),
               the seconds the file's full sample count takes at that speed, and the median
@@ -61,6 +61,12 @@ constexpr const char* kBenchUsage = R"(Usage:
               of them (default auto).
 --write-stress writes such a scene as a scene file (for the viewer).
 )";
+
+}  // namespace
+
+const char* bench_usage() { return kBenchUsage; }
+
+namespace {
 
 double now_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();

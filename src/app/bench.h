@@ -13,4 +13,9 @@ int run_bench(int argc, char** argv);
 // as samples and seconds grow, per configuration.
 int bench_convergence(int argc, char** argv);
 
+// Their help texts (`keithray bench --help`, `keithray bench --convergence --help`), which
+// the man page and the shell completion are made from (app/docs.h).
+const char* bench_usage();
+const char* convergence_usage();
+
 }  // namespace kr

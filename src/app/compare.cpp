@@ -43,6 +43,13 @@ be read, 2 on bad usage. At least one criterion is needed:
                      --statistical, else the RMS over the channels) with a colour bar
 )";
 
+constexpr const char* kPsnrUsage = R"(Usage: keithray psnr IMAGE REFERENCE
+
+Prints the PSNR in dB of two 8-bit images (PPM or PNG, e.g. a render against the brief's
+reference), or "rmse X relmse Y" of two HDR ones (OpenEXR or PFM). Exit status: 0, 1 when
+a file cannot be read or the sizes differ, 2 on bad usage.
+)";
+
 // An image as compared: its radiance when it is HDR, and its 8-bit form (an HDR image tone
 // mapped by the default sigmoid).
 struct InputImage {
@@ -129,7 +136,14 @@ int failed(const std::exception& e) {
 
 }  // namespace
 
+const char* compare_usage() { return kCompareUsage; }
+const char* psnr_usage() { return kPsnrUsage; }
+
 int run_psnr(int argc, char** argv) {
+    if (argc == 3 && (std::string(argv[2]) == "-h" || std::string(argv[2]) == "--help")) {
+        std::fputs(kPsnrUsage, stdout);
+        return 0;
+    }
     if (argc != 4) {
         std::fprintf(stderr, "error: psnr needs two image files (OpenEXR, PFM, PPM or PNG)\n");
         return 2;

@@ -10,4 +10,9 @@ int run_psnr(int argc, char** argv);
 // agree, 1 when they do not (or a file is bad), 2 on bad usage.
 int run_compare(int argc, char** argv);
 
+// Their help texts (`keithray compare --help`, `keithray psnr --help`), which the man page
+// and the shell completion are made from (app/docs.h).
+const char* compare_usage();
+const char* psnr_usage();
+
 }  // namespace kr

@@ -127,7 +127,7 @@ constexpr const char* kUsage = R"(Usage:
   keithray bench --convergence [SCENE.json ...] [--configs LIST] [--scale F] [--spp N]
                  [--reference-factor K] [--reference IMAGE] [--out DIR] [--threads N]
 
-Renders each scene (default: every res/scenes/*.json) with each configuration, side by
+Renders each scene (default: the bundled scenes) with each configuration, side by
 side, at F times the file's resolution (default 0.25), checking the error after 1, 2, 4,
 ... samples per pixel up to N (default: the file's sample count). Configurations are
 INTEGRATOR/LIGHT/ESTIMATOR[/ALLOCATION] items separated by commas, e.g.
@@ -142,7 +142,7 @@ The error of each configuration is measured against a converged render of the im
 converges to (the brief's light estimator and WRT converge to their own images), rendered
 with Sobol samples at K times N spp (default K = 4) and cached under DIR/cache. The
 reference's own remaining variance is subtracted from the squared error. --reference uses
-a given image instead (an 8-bit PPM or PNG such as res/references/*: PSNR only).
+a given image instead (an 8-bit PPM or PNG such as a bundled reference: PSNR only).
 
 Times are CPU seconds of all threads together, each configuration rendering one pass in
 turn: other processes on shared cores neither inflate them nor favour one configuration.
@@ -494,6 +494,8 @@ struct Bench {
 };
 
 }  // namespace
+
+const char* convergence_usage() { return kUsage; }
 
 int bench_convergence(int argc, char** argv) {
     Options o;

@@ -19,9 +19,11 @@
 #include "app/bench.h"
 #include "app/cluster.h"
 #include "app/compare.h"
+#include "app/docs.h"
 #include "app/progress.h"
 #include "app/view_ranks.h"
 #include "core/args.h"
+#include "core/data_dir.h"
 #include "core/image.h"
 #include "core/limits.h"
 #include "core/memory.h"
@@ -32,9 +34,12 @@
 #include "render/options.h"
 #include "render/outputs.h"
 #include "render/progressive.h"
+#include "render/trace.h"
 #include "scene/load.h"
 #include "scene/scene_list.h"
 #include "viewer/gl_offscreen.h"
+#include "viewer/compare_view.h"
+#include "viewer/view_options.h"
 #include "viewer/viewer.h"
 
 namespace fs = std::filesystem;
@@ -42,9 +47,9 @@ using namespace kr;
 
 namespace {
 
-constexpr const char* kUsageHead = R"(keithray: a progressive ray tracer for sphere scenes
+constexpr const char* kTitle = "keithray: a progressive ray tracer for sphere scenes\n\n";
 
-Usage:
+constexpr const char* kSynopsis = R"(Usage:
   keithray render [SCENE.json ...] [options]
   keithray psnr IMAGE REFERENCE            PSNR in dB of two 8-bit images (PPM or PNG);
                                             RMSE and relative MSE of two HDR ones (EXR, PFM)
@@ -53,10 +58,14 @@ Usage:
   keithray bench --throughput|--stress ...  speed figures ('keithray bench --help')
   keithray view [SCENE.json] [options]      interactive viewer (GLFW window; see
                                             'keithray view --help' and README.md)
-  keithray --help
+  keithray --help | --version
+)";
 
-With no SCENE, renders every *.json in res/scenes/. Defaults come from each scene
-file's renderer block; the options below override them.
+// render's own text before its options (the man page's render section starts with it).
+constexpr const char* kRenderIntro = R"(
+With no SCENE, renders the bundled scenes (the brief's eight, installed with keithray)
+into output/ under the current folder. Defaults come from each scene file's renderer
+block; the options below override them.
 
 Options:
 )";
@@ -105,7 +114,78 @@ could not be written), 2 on bad usage.
 )";
 
 // keithray's and render's --help: the flags render shares with view from their table.
-std::string usage() { return kUsageHead + shared_flags_help() + kRenderOnlyOptions; }
+std::string render_options_help() { return kRenderIntro + shared_flags_help() + kRenderOnlyOptions; }
+std::string usage() { return kTitle + std::string(kSynopsis) + render_options_help(); }
+
+// `keithray --version`: what this build and this CPU run.
+int print_version() {
+    std::printf("keithray %s\n", KEITHRAY_VERSION);
+    std::printf("build: %s, %s\n", KEITHRAY_BUILD_TYPE, KEITHRAY_COMPILER);
+    const PacketKernels kernels = cpu_kernels(PacketIsa::best);
+    const std::string name(packet_kernels_names.name(kernels));
+    if (kernels == PacketKernels::one_path)
+        std::printf("SIMD kernels on this CPU: none, one path at a time (%s)\n",
+                    cpu_kernels(PacketIsa::any) == PacketKernels::x86_64 ? "the CPU lacks AVX2 and FMA"
+                                                                        : "not built for this CPU");
+    else
+        std::printf("SIMD kernels on this CPU: %s (%s paths at a time in single precision; x86-64-v3 lanes, "
+                    "four in double, where a scene's sizes need it)\n",
+                    name.c_str(), kernels == PacketKernels::x86_64_v4_float ? "sixteen" : "eight");
+#ifdef KEITHRAY_HAVE_EMBREE
+    std::printf("Embree: yes (%s): scenes of more than 32 spheres\n", KEITHRAY_EMBREE_VERSION);
+#else
+    std::printf("Embree: no: every scene uses keithray's own BVH\n");
+#endif
+    std::printf("MPI: %s\n", KEITHRAY_MPI_BUILT ? "yes (Open MPI): mpirun -np N keithray render | view"
+                                                : "no: one process per render");
+    std::printf("viewer: yes (keithray view: GLFW and Dear ImGui; render --gl: OSMesa)\n");
+    const std::optional<DataDir>& data = data_dir();
+    if (data)
+        std::printf("bundled scenes: %s (%s)\n", data->path.string().c_str(), data->installed ? "installed" : "build tree");
+    else
+        std::printf("bundled scenes: none found (looked in %s)\n", data_dir_places().c_str());
+    return 0;
+}
+
+// The commands as their help texts describe them: the man page and the completion's source.
+std::vector<CommandHelp> command_helps() {
+    const auto names = [](const auto& table) {
+        std::vector<std::string> out;
+        for (const std::string_view n : table.names) out.emplace_back(n);
+        return out;
+    };
+    return {
+        {"render", "render scenes headless into image files", render_options_help(), "scene",
+         {{"--kernels", names(packet_isa_names)}}},
+        {"view", "the interactive viewer", viewer::view_usage(), "scene",
+         {{"--view", names(viewer::view_mode_names)}, {"--error", names(viewer::error_metric_names)}}},
+        {"compare", "pass/fail check of a render against a reference, for CI", compare_usage(), "image", {}},
+        {"psnr", "PSNR (8-bit) or RMSE and relative MSE (HDR) of two images", psnr_usage(), "image", {}},
+        {"bench", "speed and convergence figures", std::string(bench_usage()) + "\n" + convergence_usage(), "scene",
+         {{"--kernels", names(packet_isa_names)}}},
+    };
+}
+
+// The hidden `keithray --help-man` and `keithray --completion bash`, which CMake runs at
+// build time.
+int print_docs(const std::string& command, int argc, char** argv) {
+    const std::vector<CommandHelp> commands = command_helps();
+    if (command == "--help-man") {
+        const std::string description =
+            std::string("keithray renders scenes of spheres described in JSON with a Whitted-style ray tracer ") +
+            "or a progressive path tracer, on all CPU cores, headless or in an interactive viewer.\n" +
+            kRenderIntro;
+        std::fputs(man_page(KEITHRAY_VERSION, kSynopsis, description.substr(0, description.find("\nOptions:")),
+                            commands).c_str(), stdout);
+        return 0;
+    }
+    if (argc != 3 || std::string(argv[2]) != "bash") {
+        std::fprintf(stderr, "error: --completion expects the shell: bash\n");
+        return 2;
+    }
+    std::fputs(bash_completion(commands, {"--help", "--version", "-V"}).c_str(), stdout);
+    return 0;
+}
 
 struct Options {
     std::vector<fs::path> scenes;
@@ -118,6 +198,7 @@ struct Options {
     PacketIsa kernels = PacketIsa::best;
     std::optional<fs::path> checkpoint, resume;
     double checkpoint_every = 60;
+    bool bundled = false;  // no scene given: the bundled scenes, written under ./output/
 };
 
 Options parse_options(int argc, char** argv) {
@@ -274,7 +355,12 @@ private:
         // The file's renderer and display blocks, then the command line over them.
         settings_ = apply_render_options(opt_.render, loaded_.scene);
         settings_.kernels = opt_.kernels;
-        output_ = opt_.output ? *opt_.output : loaded_.scene.output_path();
+        // The bundled scenes without a scene argument, and a scene whose output lies in the
+        // install tree, write into output/ under the current folder: the install tree is never
+        // written (scene/scene_list.h).
+        if (opt_.output) output_ = *opt_.output;
+        else if (opt_.bundled) output_ = output_in_current_folder(loaded_.scene);
+        else output_ = output_outside_install(loaded_.scene, data_dir()).value_or(loaded_.scene.output_path());
         return true;
     }
 
@@ -561,6 +647,14 @@ int run_view(int argc, char** argv) {
 int main(int argc, char** argv) {
     install_signal_cleanup();  // one handler for every write of the run (core/file_write.h)
     const std::string command = argc > 1 ? argv[1] : "";
+    if (command == "--version" || command == "-V") {
+        print_version();
+        return stdout_written() ? 0 : 1;
+    }
+    if (command == "--help-man" || command == "--completion") {
+        const int status = print_docs(command, argc, argv);
+        return stdout_written() ? status : 1;
+    }
     if (command == "-h" || command == "--help" || command == "help") {
         std::fputs(usage().c_str(), stdout);
         return stdout_written() ? 0 : 1;
@@ -623,9 +717,15 @@ int main(int argc, char** argv) {
         for (size_t at = 0, end; (end = names.find('\0', at)) != std::string::npos; at = end + 1)
             opt.scenes.emplace_back(names.substr(at, end - at));
         if (opt.scenes.empty()) {
-            if (cluster.leader()) std::fprintf(stderr, "error: no scene given and no res/scenes/*.json found\n");
+            if (cluster.leader())
+                std::fprintf(stderr, "error: no scene given and no bundled scenes found (looked in %s); give a "
+                                     "SCENE.json to render\n", data_dir_places().c_str());
             return 2;
         }
+        opt.bundled = true;
+        if (cluster.leader())
+            std::fprintf(stderr, "keithray: no scene given: rendering the %zu bundled scenes of %s into output/\n",
+                         opt.scenes.size(), shown(opt.scenes.front().parent_path()).c_str());
     }
     bool ok = true;
     for (const fs::path& scene : opt.scenes) {

@@ -217,6 +217,12 @@ bool float_lanes_fit(const RenderScene& scene) {
     return scene.float_gaps_resolved;
 }
 
+PacketKernels cpu_kernels(PacketIsa isa) {
+    RenderSettings settings;
+    settings.kernels = isa;
+    return isa_kernels(settings);
+}
+
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
     if (!packets_apply(scene, settings)) return PacketKernels::one_path;
     const PacketKernels kernels = isa_kernels(settings);

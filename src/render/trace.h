@@ -67,6 +67,9 @@ enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_
 inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
+// The kernels this CPU runs for `isa` before a scene has a say (a scene whose sizes keep
+// the float lanes out gets the double ones): what `keithray --version` reports.
+PacketKernels cpu_kernels(PacketIsa isa);
 
 // Whether these kernels (packet_kernels' answer) make camera rays and trace paths in lanes
 // straight from Sobol samples given as keys and indices (trace_sobol_camera_samples): the

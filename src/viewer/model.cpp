@@ -8,6 +8,7 @@
 #include "core/limits.h"
 #include "scene/load.h"
 #include "scene/save.h"
+#include "scene/scene_list.h"
 #include "viewer/navigation.h"
 #include "viewer/scene_edit.h"
 
@@ -81,6 +82,10 @@ void ViewerModel::load(const std::filesystem::path& file) {
         throw SceneError(file.string(), "", "not a regular file (a FIFO, a device or a folder); the viewer reads "
                                             "and watches a regular scene file");
     LoadedScene loaded = load_scene_file(file);
+    // A bundled scene of the install tree renders and saves its image into output/ under the
+    // current folder (as `keithray render` writes it), never into the install tree.
+    if (const auto output = output_outside_install(loaded.scene, data_dir()))
+        loaded.scene.renderer.output = std::filesystem::absolute(*output, ec).lexically_normal().string();
     set_scene(std::move(loaded.scene), std::move(loaded.warnings));
 }
 

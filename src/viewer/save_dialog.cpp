@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include "core/file_write.h"
 #include "core/text.h"
 #include "render/outputs.h"
@@ -55,7 +57,13 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
 
 }  // namespace
 
-SavePaths SavePaths::for_scene(const Scene& scene) {
+bool scene_file_read_only(const fs::path& file, const std::optional<DataDir>& data) {
+    if (data && data->installed && path_inside(file, data->path)) return true;
+    std::error_code ec;
+    return fs::exists(file, ec) && ::access(file.c_str(), W_OK) != 0;
+}
+
+SavePaths SavePaths::for_scene(const Scene& scene, bool read_only) {
     SavePaths paths;
     fs::path image = scene.output_path();
     if (image.empty()) image = "keithray.ppm";
@@ -64,7 +72,8 @@ SavePaths SavePaths::for_scene(const Scene& scene) {
     paths.hdr = image_save_path(SaveKind::exr, image).string();
     paths.convergence = (image.parent_path() / (image.stem().string() + "-convergence.csv")).string();
     const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
-    paths.scene = (source.parent_path() / (source.stem().string() + "-edited.json")).string();
+    paths.scene = read_only ? source.filename().string()
+                            : (source.parent_path() / (source.stem().string() + "-edited.json")).string();
     return paths;
 }
 

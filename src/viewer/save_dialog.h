@@ -5,9 +5,11 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/data_dir.h"
 #include "core/image_formats.h"
 #include "scene/scene.h"
 #include "viewer/model.h"
@@ -25,8 +27,13 @@ struct SavePaths {
     // The defaults for `scene`: its "output" (else keithray.ppm) as .ppm, .png and .exr, and
     // the scene itself beside its file as NAME-edited.json, the convergence log as
     // OUTPUT-convergence.csv.
-    static SavePaths for_scene(const Scene& scene);
+    // A `read_only` scene's (scene_file_read_only) is saved as NAME.json in the current folder.
+    static SavePaths for_scene(const Scene& scene, bool read_only = false);
 };
+
+// Whether the viewer must not save over `file`: a scene of the install tree's bundled files
+// (`data`, core/data_dir.h), or a file this process cannot write.
+bool scene_file_read_only(const std::filesystem::path& file, const std::optional<DataDir>& data);
 
 // The image kind an output named `path` is (its format, core/image_formats.h).
 SaveKind image_save_kind(const std::filesystem::path& path);

@@ -68,7 +68,11 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
             !problem.empty())
             throw std::runtime_error(problem + "; nothing opened or written");
     ui_.files.watch.watch(options_.scene);
-    if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene());
+    // A bundled scene of the install tree is never saved over: Save asks where (ui_panel_save.cpp).
+    ui_.save.read_only = scene_file_read_only(options_.scene, data_dir());
+    if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene(), ui_.save.read_only);
+    if (model_.has_scene() && ui_.save.read_only)
+        messages_.show_status("the scene's file is read-only (a bundled scene): Save asks where to save a copy");
     CompareTool& tool = ui_.compare;
     tool.comparison.settings = options_.compare;
     tool.locked_probe = options_.probe;
@@ -350,10 +354,10 @@ void ViewerApp::draw_panels() {
 // The questions (modal popups) are begun after every other window of the frame. ImGui 1.86
 // asserts when a window appears after a modal in the modal's first frame (Esc then F1
 // reaching one frame on a busy machine opened the quit question, then the help: an abort).
-void ViewerApp::draw_questions(bool cancel) {
+void ViewerApp::draw_questions(bool cancel, bool confirm) {
     if (quit_popup(quit_asked_, cancel)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
     discard_popup(ctx_, cancel);
-    overwrite_popup(ctx_, cancel);
+    overwrite_popup(ctx_, cancel, confirm);
 }
 
 bool ViewerApp::draw_frame() {
@@ -402,7 +406,7 @@ bool ViewerApp::draw_frame() {
     // the panels are drawn over anything.
     const auto read = [this](const PixelRect& r) { return read_image_region(r); };
     const bool done = options_.scripted() && script_.step(ctx_, rect, read, [this] { sync_worker(); });
-    draw_questions(requests.cancel_question);
+    draw_questions(requests.cancel_question, requests.confirm_question);
     ImGui::Render();
     ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (done) script_.window_shot(read, fb_w, fb_h);

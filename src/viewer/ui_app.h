@@ -47,7 +47,7 @@ private:
     void sync_worker();
     bool fetch_frame();
     void draw_panels();
-    void draw_questions(bool cancel);  // the modal questions, last in the frame (cancel: Esc)
+    void draw_questions(bool cancel, bool confirm);  // the modal questions, last in the frame (cancel: Esc, confirm: Return)
     void update_title();
     void write_status_file(const RunStatus& status);
     bool animating() const;  // something moves without input: redraw at the frame rate

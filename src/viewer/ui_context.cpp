@@ -105,7 +105,10 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
         ctx.ui.selected.reset();
         if (file != files.watch.file()) {
             files.watch.watch(file);
-            ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene());
+            ctx.ui.save.read_only = scene_file_read_only(file, data_dir());
+            ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene(), ctx.ui.save.read_only);
+            if (ctx.ui.save.read_only)
+                ctx.messages.show_status("the scene's file is read-only (a bundled scene): Save asks where to save a copy");
             // The brief's reference follows the scene; one the user chose stays.
             CompareTool& tool = ctx.ui.compare;
             if (tool.reference_automatic || !tool.comparison.reference()) {

@@ -105,12 +105,15 @@ struct SceneFiles {
 inline constexpr const char* kQuitQuestion = "Quit?";
 inline constexpr const char* kDiscardQuestion = "Unsaved edits";
 inline constexpr const char* kOverwriteQuestion = "Overwrite?";
+inline constexpr const char* kSaveWhereQuestion = "Save the scene as";
 
 // The Save panel's paths (edited by the user) and the save awaiting the overwrite question.
 struct SaveTool {
     SavePaths paths;
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
     bool ask_overwrite = false;  // open that question this frame
+    bool ask_where = false;      // Save of a read-only scene (a bundled one): ask where, this frame
+    bool read_only = false;      // the scene's file is not to be written (scene_file_read_only)
 };
 
 // The panel's width in window points: the default (labels uncut at the default font), the
@@ -182,6 +185,7 @@ void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path&
 // Save: the scene over its own file, without asking (Ctrl+S).
 void save_scene_in_place(PanelContext& ctx);
 // The overwrite question (request_save asks for it), drawn every frame after the other windows.
-void overwrite_popup(PanelContext& ctx, bool cancel);
+// `confirm`: Return was pressed (the save-where question saves).
+void overwrite_popup(PanelContext& ctx, bool cancel, bool confirm = false);
 
 }  // namespace kr::viewer

@@ -281,6 +281,9 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     for (const int key : in.key_presses) {
         if (key == GLFW_KEY_F11) requests.toggle_fullscreen = !requests.toggle_fullscreen;
         else if (key == GLFW_KEY_F1) ui.help_visible = !ui.help_visible;
+        // Return answers an open question, typed into or not (a tap between frames included).
+        else if ((key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) && ImGui::GetTopMostPopupModal())
+            requests.confirm_question = true;
         else if (typing) continue;
         else if (key == GLFW_KEY_ESCAPE) {
             // Esc closes what is open first: the help, the selection, a drop-down or a question

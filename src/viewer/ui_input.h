@@ -65,6 +65,7 @@ struct WindowRequests {
     bool toggle_fullscreen = false;  // F11 (pressed an odd number of times)
     bool quit = false;               // Esc
     bool cancel_question = false;    // Esc while a question is open: its safe answer
+    bool confirm_question = false;   // Return while a question is open (the save-where question: Save)
 };
 
 WindowRequests handle_input(PanelContext& ctx, InputState& input);

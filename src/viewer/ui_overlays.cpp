@@ -37,7 +37,7 @@ constexpr const char* kHelpRows[][2] = {
     {"Ctrl+1..9 / Shift+1..9", "store the view as bookmark N (saved with the cameras) / go to it"},
     {"B, then a left drag / Shift+B", "render region: only its pixels refine / the whole image"},
     {"Ctrl+D / Delete", "duplicate / delete the selection"},
-    {"Ctrl+S", "save the scene over its file"},
+    {"Ctrl+S", "save the scene over its file (a read-only one: asks where)"},
     {"[ / ]", "halve / double the target spp (keeps the samples taken)"},
     {"Space", "pause / resume"},
     {"Ctrl+Z", "undo"},
@@ -208,6 +208,7 @@ const char* open_question() {
     if (ImGui::IsPopupOpen(kQuitQuestion)) return "quit";
     if (ImGui::IsPopupOpen(kDiscardQuestion)) return "discard";
     if (ImGui::IsPopupOpen(kOverwriteQuestion)) return "overwrite";
+    if (ImGui::IsPopupOpen(kSaveWhereQuestion)) return "save-where";
     return "none";
 }
 

@@ -52,7 +52,10 @@ void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
         std::error_code ec;
         FileWatch& watch = ctx.ui.files.watch;
         if (kind == SaveKind::scene_copy && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
-        if (kind == SaveKind::scene) watch.watch(path);
+        if (kind == SaveKind::scene) {
+            watch.watch(path);
+            ctx.ui.save.read_only = false;
+        }
     } catch (const std::exception& e) {
         ctx.messages.show_error(std::string("save failed: ") + e.what());
     }
@@ -61,7 +64,14 @@ void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
 }  // namespace
 
 void save_scene_in_place(PanelContext& ctx) {
-    if (ctx.model.has_scene()) save_now(ctx, SaveKind::scene, ctx.ui.files.watch.file());
+    if (!ctx.model.has_scene()) return;
+    // A bundled scene of the install tree (or a file that cannot be written) is never saved
+    // over: Save asks where, and the file named there becomes the scene's.
+    if (ctx.ui.save.read_only) {
+        ctx.ui.save.ask_where = true;
+        return;
+    }
+    save_now(ctx, SaveKind::scene, ctx.ui.files.watch.file());
 }
 
 void request_save(PanelContext& ctx, SaveKind kind, const fs::path& path) {
@@ -76,7 +86,31 @@ void request_save(PanelContext& ctx, SaveKind kind, const fs::path& path) {
     save_now(ctx, kind, path);
 }
 
-void overwrite_popup(PanelContext& ctx, bool cancel) {
+void overwrite_popup(PanelContext& ctx, bool cancel, bool confirm) {
+    // Save of a read-only scene: where to (the Save panel's scene path, the current folder's
+    // NAME.json by default); an existing file is then asked about as any other.
+    if (ctx.ui.save.ask_where) {
+        ImGui::OpenPopup(kSaveWhereQuestion);
+        ctx.ui.save.ask_where = false;
+    }
+    if (ImGui::BeginPopupModal(kSaveWhereQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+        ImGui::Text("%s is read-only. Save the scene as:", ctx.ui.files.watch.file().filename().string().c_str());
+        // The name is typed at once; Return saves as the button does.
+        if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+        const bool entered =
+            ImGui::InputText("##where", &ctx.ui.save.paths.scene, ImGuiInputTextFlags_EnterReturnsTrue);
+        if (ImGui::Button("Save") || entered || confirm) {
+            ImGui::CloseCurrentPopup();
+            request_save(ctx, SaveKind::scene, ctx.ui.save.paths.scene);
+        }
+        ImGui::SameLine();
+        if (ImGui::Button("Cancel") || cancel) {
+            ctx.messages.show_status("not saved");
+            ImGui::CloseCurrentPopup();
+        }
+        ImGui::EndPopup();
+        return;
+    }
     auto& pending = ctx.ui.save.pending;
     if (ctx.ui.save.ask_overwrite) {
         ImGui::OpenPopup(kOverwriteQuestion);

@@ -8,6 +8,7 @@
 #include "core/file_write.h"
 #include "core/image_formats.h"
 #include "core/limits.h"
+#include "scene/scene_list.h"
 #include "viewer/image_view.h"
 
 namespace kr::viewer {
@@ -19,8 +20,9 @@ constexpr const char* kViewUsageHead = R"(keithray view: the interactive viewer
 Usage:
   keithray view [SCENE.json] [options]
 
-Opens SCENE.json (default: res/scenes/assignment_03.json) in a window that refines the
-image pass by pass. The panels on the right edit camera, lens, lights, materials, tone
+Opens SCENE.json (default: the bundled assignment_03.json; a bundled scene of an installed
+keithray is read-only: Save asks where to save it, and its image goes to output/ under the
+current folder) in a window that refines the image pass by pass. The panels on the right edit camera, lens, lights, materials, tone
 map and renderer; any edit that changes the image restarts at once from a
 low-resolution preview. The status bar shows the state, spp, progress and noise. The
 scene file is watched and reloaded when it changes (asking first if there are unsaved
@@ -136,13 +138,13 @@ ViewOptions parse_view_options(int argc, char** argv) {
     // A drag of the selection needs one: without --select it would move nothing.
     if (o.move_selection && !o.select)
         throw UsageError{"--move-selection drags the selection: give --select X,Y too (the sphere to drag)"};
-    if (!have_scene) {
-        o.scene = "res/scenes/assignment_03.json";
-#ifdef KEITHRAY_SCENES_DIR
-        std::error_code ec;
-        if (!std::filesystem::exists(o.scene, ec))
-            o.scene = std::filesystem::path(KEITHRAY_SCENES_DIR) / "assignment_03.json";
-#endif
+    if (!have_scene && !o.help) {
+        // The bundled scene (scene/scene_list.h), read-only where it is installed: the viewer's
+        // Save asks where to save it.
+        o.scene = default_view_scene();
+        if (o.scene.empty())
+            throw UsageError{"no scene given and no bundled scenes found (looked in " + data_dir_places() +
+                             "); give a SCENE.json to open"};
     }
     return o;
 }
