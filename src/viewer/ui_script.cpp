@@ -115,7 +115,7 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
         }
     } catch (const std::exception& e) {
         if (is_out_of_memory(e) && writing)
-            std::fprintf(stderr, "error: %s: not enough memory to make it\n", show_user_text(writing->string()).c_str());
+            std::fprintf(stderr, "error: %s: not enough memory to write it\n", show_user_text(writing->string()).c_str());
         else
             std::fprintf(stderr, "error: %s\n", e.what());
         status_ = 1;
@@ -130,7 +130,7 @@ void ScriptRun::window_shot(const ReadBack& read, int fb_w, int fb_h) {
         write_image(*options_.window_shot, read({0, 0, double(fb_w), double(fb_h)}));
     } catch (const std::exception& e) {
         if (is_out_of_memory(e))
-            std::fprintf(stderr, "error: %s: not enough memory to make it\n",
+            std::fprintf(stderr, "error: %s: not enough memory to write it\n",
                          show_user_text(options_.window_shot->string()).c_str());
         else
             std::fprintf(stderr, "error: %s\n", e.what());
