@@ -168,3 +168,15 @@ TEST_F(RobustMemory, PsnrAndCompareOfLargeImagesAtEveryLimit) {
     sweep("compare a.exr b.pfm --max-rmse 1 --diff d.png", {"d.png"}, {"a.exr", "b.pfm", "d.png"},
           [&](const std::string& name) { EXPECT_EQ(read_image_file(dir / name).width(), 1024); }, 5);
 }
+
+// A render resumed from its checkpoint (a 200x200 image: 4 MB of state): reading and decoding
+// the checkpoint, the state, the image. The message names the scene or the checkpoint.
+TEST_F(RobustMemory, ResumeFromACheckpointAtEveryLimit) {
+    std::string scene = many_spheres_json(200);
+    scene.replace(scene.find("[40, 40]"), 8, "[200, 200]");
+    std::ofstream(dir / "scene.json") << scene;
+    ASSERT_EQ(under(8192 * 1024, "render scene.json -q --spp 2 --checkpoint c.ckpt --every 0 -o first.png").status, 0);
+    fs::remove(dir / "first.png");
+    sweep("render scene.json -q --spp 2 --resume c.ckpt -o out.png", {"out.png"}, {"scene.json", "c.ckpt"},
+          [&](const std::string& name) { EXPECT_EQ(read_image_file(dir / name).width(), 200); }, 6);
+}

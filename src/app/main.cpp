@@ -361,7 +361,7 @@ private:
     // rank receives its rows of it.
     bool resume() {
         if (opt_.resume) {
-            stage_ = "the checkpoint of a " + image_;
+            stage_ = "the checkpoint " + shown(*opt_.resume) + " of a " + image_;
             std::string error;
             if (leader_) try {
                     decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
