@@ -29,7 +29,7 @@ inline float fast_exp_neg(float x) {
 using Planes = DenoiseWorkspace;
 
 // At most this many pixels, evenly strided, give the image's scale.
-constexpr size_t kScaleSamples = 65536;
+constexpr size_t kScaleSamples = 16384;
 
 // The filters' unit of radiance: a robust scale of the image, the 93rd percentile of the
 // luminance of (a stride of) its pixels, or where that is black (a lamp alone in the dark)
