@@ -129,7 +129,7 @@ int cost(int rounds, const std::string& scene_file, int final_rounds) {
         const RenderState state = render(p, 4, 1);
         RenderEstimates est = render_estimates(state, kAllLayers);
         const SurfaceLayers features = averaged_surface_layers(p.rs, p.settings, w, h, kFeatureSamples);
-        std::vector<float> albedo, normal, variance = est.variance;
+        std::vector<float> albedo, normal;
         for (size_t i = 0; i < features.albedo.size(); ++i)
             for (int k = 0; k < 3; ++k) {
                 albedo.push_back(float(features.albedo[i][k]));
@@ -137,7 +137,7 @@ int cost(int rounds, const std::string& scene_file, int final_rounds) {
             }
         DenoiseInput in;
         in.radiance = &est.radiance;
-        in.variance = variance;
+        in.variance = est.variance;
         in.albedo = albedo;
         in.normal = normal;
         in.depth = est.depth;

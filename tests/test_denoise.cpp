@@ -24,12 +24,13 @@ namespace {
 struct Synthetic {
     int w, h;
     Image truth, noisy;
-    std::vector<float> variance, albedo, normal;
+    std::vector<Color> variance;  // of the mean, per channel
+    std::vector<float> albedo, normal;
     std::vector<double> depth;
 
     Synthetic(int w_, int h_) : w(w_), h(h_), truth(w_, h_), noisy(w_, h_) {
         const size_t n = size_t(w) * size_t(h);
-        variance.assign(3 * n, 0.f);
+        variance.assign(n, Color());
         albedo.assign(3 * n, 1.f);
         normal.assign(3 * n, 0.f);
         for (size_t i = 0; i < n; ++i) normal[3 * i + 2] = -1;
@@ -50,7 +51,7 @@ struct Synthetic {
         std::normal_distribution<double> g(0, sigma);
         for (size_t i = 0; i < truth.pixels.size(); ++i) {
             noisy.pixels[i] = truth.pixels[i] + Color(g(rng), g(rng), g(rng));
-            for (int k = 0; k < 3; ++k) variance[3 * i + size_t(k)] = float(sigma * sigma);
+            variance[i] = Color(float(sigma * sigma));
         }
     }
     // Noise of standard deviation sigma on the mean as the average of two independent halves
@@ -66,7 +67,7 @@ struct Synthetic {
         }
         for (size_t i = 0; i < n; ++i) {
             noisy.pixels[i] = (half[0].pixels[i] + half[1].pixels[i]) * 0.5;
-            for (int k = 0; k < 3; ++k) variance[3 * i + size_t(k)] = float(sigma * sigma);
+            variance[i] = Color(float(sigma * sigma));
         }
     }
     Image half[2];
@@ -248,7 +249,7 @@ TEST(Denoise, AtrousDoesNotDependOnTheThreadCount) {
             }
         s.add_noise(0.2);
         for (size_t i = 0; i < s.truth.pixels.size(); i += 13)
-            for (int k = 0; k < 3; ++k) s.variance[3 * i + size_t(k)] = INFINITY;  // one sample there
+            s.variance[i] = Color(INFINITY);  // one sample there
         DenoiseWorkspace reused;
         {
             Synthetic big(70, 50);
@@ -318,7 +319,7 @@ TEST(Denoise, FinalFilterRemovesAFireflyAndKeepsAHighlight) {
     const size_t fly = s.at(20, 20);
     s.half[0].pixels[fly] = Color(100.0);
     s.noisy.pixels[fly] = (s.half[0].pixels[fly] + s.half[1].pixels[fly]) * 0.5;
-    for (int k = 0; k < 3; ++k) s.variance[3 * fly + size_t(k)] = 50.f * 50.f / 8;  // as its samples would say
+    s.variance[fly] = Color(50.f * 50.f / 8);  // as its samples would say
     const Image out = s.denoise_final();
     for (int y = 18; y <= 22; ++y)
         for (int x = 18; x <= 22; ++x) EXPECT_NEAR(out.at(x, y).y, 0.5, 0.1) << x << "," << y;
@@ -347,7 +348,7 @@ TEST(Denoise, FinalFilterKeepsDarkPixelsBesideNoisyHighlightsDark) {
         const double mean = s.truth.pixels[i].y, sigma_half = bright(int(i % size_t(s.w))) ? 2.0 : 1e-4;
         for (int h = 0; h < 2; ++h) s.half[h].pixels[i] = Color(std::max(0.0, mean + sigma_half * g(rng)));
         s.noisy.pixels[i] = (s.half[0].pixels[i] + s.half[1].pixels[i]) * 0.5;
-        for (int k = 0; k < 3; ++k) s.variance[3 * i + size_t(k)] = float(sigma_half * sigma_half / 2);
+        s.variance[i] = Color(float(sigma_half * sigma_half / 2));
     }
     const Image out = s.denoise_final();
     // The dark columns' error, relative as relMSE weighs it ((x - 0.01)^2 / (0.01^2 + 0.01)),
@@ -571,6 +572,59 @@ TEST(Denoise, ExrKeepsTheRawRadianceAndTheFeatureBuffers) {
     // Without the denoiser nothing changes: no raw layer.
     const Developed plain = develop(rs, render_estimates(state, kAllLayers), DevelopOptions{}, kAllLayers);
     EXPECT_TRUE(hdr_from_developed(plain).raw.empty());
+}
+
+// A filter whose result depended on the unit of power would be wrong: both filters work in a
+// unit of the image's own scale (docs/denoising.md), so scene 3 rendered with its lights at
+// 1e-30, 1e-20 and 1e30 times their power develops into that factor times the image at
+// power 1, to float rounding, and the filter changes as many pixels at every power. (Before,
+// at 1e-30 the variance, then floats, was zero and nothing was filtered; at 1e30 infinite.)
+// The paths are traced in double lanes with a uniform allocation, so that the renders
+// themselves are proportional.
+TEST(Denoise, BothFiltersAreProportionalToTheLightsPower) {
+    const Scene base = test::brief_scene(3, 32);
+    struct Result {
+        Image denoised, raw;
+    };
+    auto develop_at = [&](double power, bool interactive) {
+        Scene scene = base;
+        for (Light& light : scene.lights) light.power = light.power * power;
+        const RenderScene rs = prepare_scene(scene);
+        RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+        settings.kernels = PacketIsa::double_lanes;
+        settings.allocation = Allocation::uniform;
+        RenderState state(32, 32);
+        state.track_halves();
+        StopRule rule;
+        rule.max_passes = 6;
+        render_until(rs, settings, state, rule);
+        DevelopOptions options;
+        options.denoise = Denoise::on;
+        options.interactive = interactive;
+        options.sampling = settings;
+        Developed d = develop(rs, render_estimates(state, kLayerRadiance | develop_reads(options)), options, kLayerRadiance);
+        return Result{std::move(d.radiance), std::move(d.raw)};
+    };
+    for (const bool interactive : {false, true}) {
+        const Result unit = develop_at(1, interactive);
+        int changed_at_one = 0;
+        for (size_t i = 0; i < unit.raw.pixels.size(); ++i) changed_at_one += unit.denoised.pixels[i] != unit.raw.pixels[i];
+        EXPECT_GT(changed_at_one, 400) << interactive;  // of 1024: the filter does filter
+        for (const double power : {1e-30, 1e-20, 1e30}) {
+            const Result scaled = develop_at(power, interactive);
+            int changed = 0;
+            double worst = 0;
+            for (size_t i = 0; i < unit.raw.pixels.size(); ++i) {
+                changed += scaled.denoised.pixels[i] != scaled.raw.pixels[i];
+                for (int k = 0; k < 3; ++k) {
+                    const double expected = unit.denoised.pixels[i][k] * power, got = scaled.denoised.pixels[i][k];
+                    worst = std::max(worst, std::fabs(got - expected) / (std::fabs(expected) + 1e-300));
+                }
+            }
+            EXPECT_EQ(changed, changed_at_one) << interactive << " at power " << power;
+            EXPECT_LT(worst, 1e-5) << interactive << " at power " << power;  // float planes' rounding
+        }
+    }
 }
 
 TEST(Denoise, ViewerShowsRawDenoisedOrSplit) {

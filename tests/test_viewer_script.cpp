@@ -224,7 +224,7 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     full.radiance = Image(4, 3);
     full.depth.assign(12, 1.0);
     full.sample_count.assign(12, 1);
-    full.variance.assign(36, 0.0f);
+    full.variance.assign(12, Color());
     EXPECT_EQ(save_output(SaveKind::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
     EXPECT_EQ(read_image(dir / "a.ppm").width, 4);
     EXPECT_EQ(read_image(dir / "a-depth.ppm").width, 4);

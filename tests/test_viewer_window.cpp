@@ -28,6 +28,7 @@
 #include "viewer/navigation.h"
 #include "viewer/scene_edit.h"
 #include "render/render_scene.h"
+#include "render/render_state.h"
 #include "scene/load.h"
 #include "test_util.h"
 
@@ -735,6 +736,32 @@ TEST_F(ViewerWindow, RenderTooLargeForMemoryIsAnErrorNotAnAbort) {
     EXPECT_EQ(v.status, 1) << v.err;
     EXPECT_NE(v.err.find("not enough memory for the render of a 32768x32768 image"), std::string::npos) << v.err;
     EXPECT_FALSE(fs::exists(dir / "x.ppm"));
+}
+
+// A scripted run whose render does not fit the address space is refused before the window
+// opens, by the render thread's estimate: one line naming the scene, exit 1, nothing written.
+// (Mesa's llvmpipe, the window's GL, ends the process with SIGSEGV where its own allocations
+// fail while it compiles the display's shaders: 1024x1024 under ulimit -v 600000 did.)
+TEST_F(ViewerWindow, ScriptedRunThatCannotFitIsRefusedBeforeTheWindow) {
+#ifdef KR_TEST_SANITIZED
+    GTEST_SKIP() << "the sanitizers' runtimes reserve address space beyond any ulimit -v";
+#endif
+    std::string text = kr::test::read_file(scene(3));
+    const size_t at = text.find("\"dimensions\"");
+    ASSERT_NE(at, std::string::npos);
+    text.replace(at, text.find(']', at) + 1 - at, "\"dimensions\": [1024, 1024]");
+    std::ofstream(dir / "big.json") << text;
+    // 16 MiB less than the render needs: room to start, load and estimate.
+    const uint64_t kib = (kr::render_memory_bytes(1024, 1024, false, true) >> 10) - 16 * 1024;
+    const ViewRun v = kr::test::run_command(
+        xvfb_run() + "sh -c \"ulimit -v " + std::to_string(kib) + "; exec '" + KEITHRAY_EXE + "' view '" +
+            (dir / "big.json").string() + "' --spp 1 --save-image '" + (dir / "out.exr").string() + "' --timeout 120\"",
+        dir);
+    EXPECT_EQ(v.status, 1) << v.err;
+    EXPECT_EQ(v.err.find("window GL"), std::string::npos) << v.err;  // no window was opened
+    EXPECT_NE(v.err.find("big.json: not enough memory for the render of a 1024x1024 image"), std::string::npos) << v.err;
+    EXPECT_EQ(std::count(v.err.begin(), v.err.end(), '\n'), 1) << v.err;
+    EXPECT_FALSE(fs::exists(dir / "out.exr"));
 }
 
 // A status file that cannot be written fails the scripted run (a folder: refused before the

@@ -16,8 +16,11 @@
 
 #include "core/args.h"
 #include "core/file_write.h"
+#include "core/memory.h"
+#include "core/text.h"
 #include "render/progressive.h"
 #include "render/trace.h"
+#include "scene/json_reader.h"
 #include "scene/load.h"
 #include "scene/scene_list.h"
 
@@ -97,9 +100,12 @@ Timing time_render(const RenderScene& scene, const RenderSettings& settings, int
 
 // N random spheres of a few diffuse colours in a cube of side 20, on a floor, under one
 // sphere light: a scene whose cost is all in ray casting.
-nlohmann::json stress_scene_json(int n, uint64_t seed) {
+// Its JSON text, dumped with `indent` (-1: on one line). The DOMs are freed without allocating
+// however the function is left (scene/json_reader.h: nlohmann's destructor allocates).
+std::string stress_scene_json(int n, uint64_t seed, int indent = -1) {
     using nlohmann::json;
     json j;
+    const ReleasedOnExit<json> freed{j};
     j["cameras"] = json::array({{{"id", "camera"}, {"type", "pinhole"}, {"fov", 45}, {"aspect", 1.0},
                                  {"distance", 5.0}, {"position", {0, 4, -45}}, {"target", {0, 0, 0}}}});
     j["materials"] = json::array({{{"id", "red"}, {"type", "diffuse"}, {"rho", {0.8, 0.3, 0.3}}},
@@ -107,6 +113,7 @@ nlohmann::json stress_scene_json(int n, uint64_t seed) {
                                   {{"id", "blue"}, {"type", "diffuse"}, {"rho", {0.3, 0.3, 0.8}}},
                                   {{"id", "grey"}, {"type", "diffuse"}, {"rho", {0.7, 0.7, 0.7}}}});
     json shapes = json::array(), primitives = json::array();
+    const ReleasedOnExit<json> freed_shapes{shapes}, freed_primitives{primitives};
     Rng rng(seed, 17);
     // Radii so the spheres fill about a tenth of the cube whatever N is.
     const double mean_radius = 20.0 * std::cbrt(0.1 * 3.0 / (4.0 * kPi * n));
@@ -125,14 +132,14 @@ nlohmann::json stress_scene_json(int n, uint64_t seed) {
     primitives.push_back({{"id", "floor"}, {"type", "geometric"}, {"shape", "floor"}, {"material", "grey"}});
     primitives.push_back({{"id", "lamp"}, {"type", "emissive"}, {"shape", "lamp"}, {"material", "grey"},
                           {"light", "lamp"}});
-    j["shapes"] = shapes;
+    j["shapes"] = std::move(shapes);
     j["lights"] = json::array({{{"id", "lamp"}, {"type", "area"}, {"shape", "lamp"}, {"power", {8, 8, 8}}}});
     j["scene"] = {{"camera", "camera"},
                   {"lights", {"lamp"}},
-                  {"primitives", primitives},
+                  {"primitives", std::move(primitives)},
                   {"renderer", {{"type", "PT"}, {"dimensions", {512, 512}}, {"samples", 64}, {"depth", 4},
                                 {"output", "stress_" + std::to_string(n) + ".ppm"}}}};
-    return j;
+    return j.dump(indent);
 }
 
 struct BenchOptions {
@@ -255,7 +262,7 @@ int bench_stress(const BenchOptions& o) {
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int n : o.stress) {
         const double prepare_start = now_seconds();
-        const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1).dump(), "stress.json").scene);
+        const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1), "stress.json").scene);
         const double prepare_ms = (now_seconds() - prepare_start) * 1e3;
         // One copy of the scene per BVH, timed in turn within each run, so that the ratios
         // come from the same moments of a shared machine.
@@ -314,9 +321,13 @@ int run_bench(int argc, char** argv) {
             return 1;
         }
         try {
-            write_file_atomic(o.write_path, stress_scene_json(o.write_stress, 1).dump(1) + "\n");
+            write_file_atomic(o.write_path, stress_scene_json(o.write_stress, 1, 1) + "\n");
         } catch (const std::exception& e) {
-            std::fprintf(stderr, "error: %s\n", e.what());
+            if (is_out_of_memory(e))
+                std::fprintf(stderr, "error: %s: not enough memory for a scene of %d spheres\n",
+                             show_user_text(o.write_path.string()).c_str(), o.write_stress);
+            else
+                std::fprintf(stderr, "error: %s\n", e.what());
             return 1;
         }
         std::printf("wrote %s (%d spheres)\n", o.write_path.string().c_str(), o.write_stress);

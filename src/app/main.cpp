@@ -233,10 +233,17 @@ Options parse_options(int argc, char** argv) {
 // characters, bytes that are not UTF-8 or too many of them (core/text.h).
 std::string shown(const fs::path& path) { return show_user_text(path.string()); }
 
-// Whether an allocation failed: new's bad_alloc, or a container asked for more elements than
-// it can hold (length_error, e.g. vector::_M_default_append).
-bool out_of_memory(const std::exception& e) {
-    return dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e);
+// Whether an allocation failed (core/memory.h).
+bool out_of_memory(const std::exception& e) { return is_out_of_memory(e); }
+
+// The OpenMP team started before anything else (core/memory.h start_thread_team): false,
+// after one line naming `file`, where the threads' stacks do not fit the address space.
+bool team_started(const std::string& file) {
+    const int wanted = omp_get_max_threads(), started = start_thread_team();
+    if (started == wanted) return true;
+    std::fprintf(stderr, "error: %s: not enough memory for the stacks of %d threads, only of %d (--threads %d, or OMP_NUM_THREADS=%d)\n",
+                 file.c_str(), wanted, started, started, started);
+    return false;
 }
 
 // Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
@@ -432,6 +439,7 @@ private:
         rule_ = render_stop_rule(opt_.render, settings_);
         open_ended_ = rule_.open_ended();
         capped_ = open_ended_ && !opt_.render.spp;
+        stage_ = "the render's fingerprint (the scene's JSON text)";
         key_ = checkpoint_key(loaded_.scene, scene_, settings_, rule_);
     }
 
@@ -439,7 +447,7 @@ private:
     // rank receives its rows of it.
     bool resume() {
         if (opt_.resume) {
-            stage_ = "the checkpoint of a " + image_;
+            stage_ = "the checkpoint " + shown(*opt_.resume) + " of a " + image_;
             std::string error;
             if (leader_) try {
                     decode_checkpoint(read_checkpoint_file(*opt_.resume, key_), *opt_.resume, key_, state_);
@@ -660,6 +668,7 @@ int main(int argc, char** argv) {
         return stdout_written() ? 0 : 1;
     }
     if (command == "bench") {
+        if (!team_started("bench")) return 1;
         try {
             const int status = run_bench(argc, argv);
             return stdout_written() ? status : 1;
@@ -670,6 +679,7 @@ int main(int argc, char** argv) {
         }
     }
     if (command == "psnr" || command == "compare") {
+        if (!team_started(argc > 2 ? shown(argv[2]) : command)) return 1;
         try {
             const int status = command == "psnr" ? run_psnr(argc, argv) : run_compare(argc, argv);
             return stdout_written() ? status : 1;
@@ -708,6 +718,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
+    if (cluster.any_flags(!team_started(opt.scenes.empty() ? std::string("render") : shown(opt.scenes.front())))) return 1;
     if (opt.scenes.empty()) {
         // Rank 0's list of the bundled scenes, in every rank.
         std::string names;

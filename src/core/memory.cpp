@@ -3,8 +3,15 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <new>
+#include <stdexcept>
 #include <string>
+#include <system_error>
+#include <vector>
 
+#include <malloc.h>
+#include <omp.h>
+#include <pthread.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -71,6 +78,36 @@ std::string memory_shortfall(uint64_t needed, const std::string& what) {
     if (needed <= limit.bytes) return "";
     return "not enough memory for " + what + ": it needs about " + format_bytes(needed) + ", above " + limit.what +
            " (" + format_bytes(limit.bytes) + ")";
+}
+
+bool is_out_of_memory(const std::exception& e) {
+    if (dynamic_cast<const std::bad_alloc*>(&e) || dynamic_cast<const std::length_error*>(&e)) return true;
+    const auto* system = dynamic_cast<const std::system_error*>(&e);
+    return system && system->code() == std::errc::resource_unavailable_try_again;
+}
+
+int start_thread_team() {
+    // Under an address-space limit (ulimit -v) every thread shares malloc's one arena: glibc
+    // gives each thread that allocates an arena of its own, reserving 64 MiB of address space
+    // apiece, which a team started early would take before the work it is for.
+    rlimit address_space{};
+    if (::getrlimit(RLIMIT_AS, &address_space) == 0 && address_space.rlim_cur != RLIM_INFINITY)
+        ::mallopt(M_ARENA_MAX, 1);
+    const int wanted = omp_get_max_threads();
+    std::vector<pthread_t> started;
+    started.reserve(size_t(std::max(wanted - 1, 0)));
+    for (int i = 1; i < wanted; ++i) {
+        pthread_t thread{};
+        if (::pthread_create(&thread, nullptr, [](void*) -> void* { return nullptr; }, nullptr) != 0) break;
+        started.push_back(thread);
+    }
+    // Joined: their stacks are unmapped (or kept in glibc's cache for the team to take).
+    for (const pthread_t thread : started) ::pthread_join(thread, nullptr);
+    if (int(started.size()) + 1 < wanted) return int(started.size()) + 1;
+#pragma omp parallel
+    {
+    }
+    return wanted;
 }
 
 std::string format_bytes(uint64_t bytes) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -39,8 +40,12 @@ namespace {
 RTCDevice device() {
     static RTCDevice d = [] {
         RTCDevice made = rtcNewDevice("threads=1");
-        if (!made) throw std::runtime_error("Embree: cannot create a device (error " +
-                                            std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
+        if (!made) {
+            const RTCError error = rtcGetDeviceError(nullptr);
+            // Out of memory is said as such by the caller (core/memory.h is_out_of_memory).
+            if (error == RTC_ERROR_OUT_OF_MEMORY) throw std::bad_alloc();
+            throw std::runtime_error("Embree: cannot create a device (error " + std::to_string(int(error)) + ")");
+        }
         return made;
     }();
     return d;
@@ -163,7 +168,13 @@ std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<Sphe
     rtcAttachGeometry(a->scene, geometry);
     rtcReleaseGeometry(geometry);
     rtcCommitScene(a->scene);
-    if (const RTCError error = rtcGetDeviceError(device()); error != RTC_ERROR_NONE)
+    const RTCError error = rtcGetDeviceError(device());
+    // A scene whose commit failed is left to the process, not released: Embree's destructor
+    // of it ends the process (std::terminate in its build's task group), which the error
+    // said here would never reach. Memory ran out: the process is ending or drops the scene.
+    if (error != RTC_ERROR_NONE) a->scene = nullptr;
+    if (error == RTC_ERROR_OUT_OF_MEMORY) throw std::bad_alloc();
+    if (error != RTC_ERROR_NONE)
         throw std::runtime_error("Embree: building the BVH of " + std::to_string(spheres.size()) +
                                  " spheres failed (error " + std::to_string(int(error)) + ")");
     return a;

@@ -28,6 +28,42 @@ inline float fast_exp_neg(float x) {
 
 using Planes = DenoiseWorkspace;
 
+// At most this many pixels, evenly strided, give the image's scale.
+constexpr size_t kScaleSamples = 16384;
+
+// The filters' unit of radiance: a robust scale of the image, the 93rd percentile of the
+// luminance of (a stride of) its pixels, or where that is black (a lamp alone in the dark)
+// their mean. Both filters work on the radiance over this unit and multiply it back, so their
+// result is proportional to the light's power (a render at power s times the lights is s
+// times the image at power 1) over the loader's whole range: a value of 1e30 or 1e-30 never
+// meets float's range (its square overflows or underflows), and the few absolute constants
+// (the luminance floor of the selection's relative risks, the guards against dividing by
+// zero) are fractions of the image's own brightness. The percentile is the one, of the 80th
+// to the 97th and the mean with the brightest 1 % clipped, that changed the final filter's
+// figures least (docs/denoising.md, "Units"): the scenes it was tuned on have units of 0.18
+// (scene 4, dark) to 2.5 (scene 5), 1 in their geometric mean. The luminances are taken over
+// the largest one in `scratch` (floats in [0, 1]). An image without a positive finite
+// luminance has the unit 1.
+double radiance_unit(const Image& radiance, std::vector<float>& scratch) {
+    const size_t n = radiance.pixels.size(), stride = std::max<size_t>(1, n / kScaleSamples);
+    double largest = 0;
+    for (size_t i = 0; i < n; i += stride) {
+        const double l = luminance(radiance.pixels[i]);
+        if (std::isfinite(l)) largest = std::max(largest, l);
+    }
+    if (!(largest > 0)) return 1;
+    scratch.clear();
+    double sum = 0;
+    for (size_t i = 0; i < n; i += stride) {
+        const double l = luminance(radiance.pixels[i]);
+        scratch.push_back(std::isfinite(l) ? float(std::max(0.0, l / largest)) : 0.f);
+        sum += scratch.back();
+    }
+    const auto at = scratch.begin() + ptrdiff_t((scratch.size() - 1) * 93 / 100);
+    std::nth_element(scratch.begin(), at, scratch.end());
+    return largest * (*at > 0 ? double(*at) : sum / double(scratch.size()));
+}
+
 
 // Where a pixel's variance is unknown (one sample): the luminance's variance over its 3x3
 // neighbourhood, the variance of one sample where the neighbours are alike.
@@ -111,8 +147,10 @@ void blur3(int w, int h, const std::vector<float>& v, std::vector<float>& out) {
 KR_VECTOR_CLONES
 void prepare_pixels(const DenoiseInput& in, Planes& p, size_t i0, size_t i1) {
     const Color* __restrict rad = in.radiance->pixels.data();
-    const float *__restrict variance = in.variance.data(), *__restrict albedo = in.albedo.data(),
-                *__restrict normal = in.normal.data();
+    const Color* __restrict variance = in.variance.data();
+    const float *__restrict albedo = in.albedo.data(), *__restrict normal = in.normal.data();
+    // In the filter's unit (radiance_unit): the radiance over it, the variance over its square.
+    const double inv_unit = 1 / p.unit, var_scale = p.var_scale;
     const double* __restrict depth = in.depth.data();
     float *__restrict d0 = p.demod[0].data(), *__restrict d1 = p.demod[1].data(), *__restrict d2 = p.demod[2].data();
     float *__restrict c0 = p.c[0].data(), *__restrict c1 = p.c[1].data(), *__restrict c2 = p.c[2].data();
@@ -122,14 +160,14 @@ void prepare_pixels(const DenoiseInput& in, Planes& p, size_t i0, size_t i1) {
           *__restrict raw_lum = p.lum_raw.data(), *__restrict z = p.z.data();
 KR_INDEPENDENT_ITERATIONS
     for (size_t i = i0; i < i1; ++i) {
-        const float r[3] = {float(rad[i].x), float(rad[i].y), float(rad[i].z)};
+        const float r[3] = {float(rad[i].x * inv_unit), float(rad[i].y * inv_unit), float(rad[i].z * inv_unit)};
         float d[3], c[3];
         float var = 0, raw_var = 0, l = 0, raw_l = 0;
         for (int k = 0; k < 3; ++k) {
             // Demodulation: the illumination is the radiance over the albedo.
             d[k] = std::max(0.f, albedo[3 * i + size_t(k)]) + kAlbedoFloor;
             c[k] = r[k] / d[k];
-            const float v = variance[3 * i + size_t(k)];
+            const float v = float(variance[i][k] * var_scale);
             var += kLum[k] * kLum[k] * v / (d[k] * d[k]);
             raw_var += kLum[k] * kLum[k] * v;
             l += kLum[k] * c[k];  // as the a-trous passes take it from p.c
@@ -192,8 +230,11 @@ void prepare(const DenoiseInput& in, Planes& p) {
     p.w = rad.width;
     p.h = rad.height;
     const size_t n = rad.pixels.size();
-    if (in.variance.size() != 3 * n || in.albedo.size() != 3 * n || in.normal.size() != 3 * n || in.depth.size() != n)
+    if (in.variance.size() != n || in.albedo.size() != 3 * n || in.normal.size() != 3 * n || in.depth.size() != n)
         throw std::invalid_argument("denoise: a feature buffer's size is not the image's");
+    p.unit = radiance_unit(rad, p.var_blur);
+    // Divided twice: the square of a unit of 1e200 would overflow.
+    p.var_scale = 1 / p.unit / p.unit;
     for (int k = 0; k < 3; ++k) {
         p.c[k].resize(n);
         p.demod[k].resize(n);
@@ -330,6 +371,7 @@ void atrous_row(const AtrousPass& a, int y) {
 KR_VECTOR_CLONES
 void remodulate_and_fade_pixels(const Image& raw, const Planes& p, const float* raw_var, float t2, Image& out,
                                 size_t i0, size_t i1) {
+    const double unit = p.unit;
     const float *__restrict c0 = p.c[0].data(), *__restrict c1 = p.c[1].data(), *__restrict c2 = p.c[2].data();
     const float *__restrict d0 = p.demod[0].data(), *__restrict d1 = p.demod[1].data(), *__restrict d2 = p.demod[2].data();
     const Color* __restrict in = raw.pixels.data();
@@ -337,8 +379,10 @@ void remodulate_and_fade_pixels(const Image& raw, const Planes& p, const float* 
     // Selects rather than branches, so that the loop vectorises.
 KR_INDEPENDENT_ITERATIONS
     for (size_t i = i0; i < i1; ++i) {
-        const Color filtered{double(c0[i] * d0[i]), double(c1[i] * d1[i]), double(c2[i] * d2[i])};
-        const double l = std::max(luminance(filtered), 0.0), v = raw_var[i];
+        // In the filter's unit (the fade's relative error), then in the radiance's.
+        const Color f{double(c0[i] * d0[i]), double(c1[i] * d1[i]), double(c2[i] * d2[i])};
+        const double l = std::max(luminance(f), 0.0), v = raw_var[i];
+        const Color filtered{f.x * unit, f.y * unit, f.z * unit};
         const double r2 = l > 0 ? v / (l * l) : (v > 0 ? INFINITY : 0.0);
         const double blend = t2 > 0 && std::isfinite(r2) ? r2 / (r2 + t2) : 1.0;
         const bool keep = std::isnan(c0[i]);
@@ -445,6 +489,7 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
         }
     const bool halves = in.half[0] && in.half[1] && in.half[0]->pixels.size() == n && in.half[1]->pixels.size() == n &&
                         in.half_count[0].size() == n && in.half_count[1].size() == n;
+    const double inv_unit = 1 / p.unit;
     const long count = long(n);
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < count; ++li) {
@@ -457,8 +502,8 @@ void prepare_halves(const DenoiseInput& in, Planes& p) {
             for (int k = 0; k < 3; ++k) {
                 const float d = p.demod[k][i];
                 const double r = split ? in.half[g]->pixels[i][k] : in.radiance->pixels[i][k];
-                const float v = float(in.variance[3 * i + size_t(k)] * share) / (d * d);
-                p.u[g][k][i] = float(r) / d;
+                const float v = float(in.variance[i][k] * p.var_scale * share) / (d * d);
+                p.u[g][k][i] = float(r * inv_unit) / d;  // as prepare_pixels takes it
                 p.v[g][k][i] = std::isfinite(v) ? v : INFINITY;
             }
         }
@@ -752,7 +797,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
             for (int k = 0; k < 3; ++k) {
                 lum_f += kLum[k] * p.cand[c][k][i] * p.demod[k][i];
                 lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.demod[k][i];
-                var += kLum[k] * kLum[k] * input.variance[3 * i + size_t(k)];
+                var += kLum[k] * kLum[k] * float(input.variance[i][k] * p.var_scale);
             }
             if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = 2;
         }

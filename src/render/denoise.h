@@ -22,7 +22,10 @@ inline constexpr EnumNames<Denoise, 2> denoise_names{{"off", "on"}};
 // What a denoiser reads, all width x height, row-major.
 struct DenoiseInput {
     const Image* radiance = nullptr;  // the mean radiance
-    std::span<const float> variance;  // 3 per pixel: the variance of the mean (infinite: unknown)
+    // Per pixel and channel the variance of the mean (infinite: unknown), in double: a render
+    // at a light power of 1e30 has variances of about 1e60, at 1e-30 about 1e-60, infinite or
+    // zero as floats; the filters take it over their unit's square (DenoiseWorkspace::unit).
+    std::span<const Color> variance;
     std::span<const float> albedo;    // 3 per pixel: first-surface albedo, averaged
     std::span<const float> normal;    // 3 per pixel: first-surface normal, averaged (shorter at silhouettes)
     std::span<const double> depth;    // the mean primary hit distance
@@ -54,6 +57,10 @@ struct AtrousParams {
 // one between calls: fresh memory's page faults cost about as much as the filter.
 struct DenoiseWorkspace {
     int w = 0, h = 0;
+    // The unit of radiance the planes hold (a robust scale of the image, so that the result
+    // is proportional to the light's power) and the factor from the input's variance to the
+    // planes' (one over the unit's square).
+    double unit = 1, var_scale = 1;
     std::vector<float> c[3], c2[3];  // demodulated radiance (and the next pass's)
     std::vector<float> var, var2;    // variance of its luminance (of the mean)
     std::vector<float> demod[3];     // albedo + floor
@@ -100,6 +107,8 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, D
 
 // Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
 // The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
-inline constexpr uint64_t kDenoiseBytesPerPixel = (39 + 38) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
+// The estimates' variance is in double while the filter runs (3 floats more than its layer).
+inline constexpr uint64_t kDenoiseBytesPerPixel =
+    (39 + 38 + 3) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
 
 }  // namespace kr

@@ -41,7 +41,7 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
     if (layers & kLayerDepth) out.depth = state.mean_depth();
     if (layers & kLayerSamples) out.samples = state.sample_count();
     if (layers & kLayerVariance) {
-        out.variance = floats(state.variance_of_mean());
+        out.variance = state.variance_of_mean();
         if (state.tracks_halves()) out.halves = state.halves();
     }
     return out;
@@ -98,7 +98,7 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
     if (layers & kLayerDepth) out.depth = std::move(estimates.depth);
     if (layers & kLayerSamples) out.samples = std::move(estimates.samples);
     // The variance belongs to the mean, not to its blurred picture.
-    if ((layers & kLayerVariance) && options.blur == 0) out.variance = std::move(estimates.variance);
+    if ((layers & kLayerVariance) && options.blur == 0) out.variance = floats(estimates.variance);
     if ((layers & (kLayerAlbedo | kLayerNormal)) && options.denoise == Denoise::off) {
         const SurfaceLayers surface = first_surface_layers(scene, width, height);
         if (layers & kLayerAlbedo) out.albedo = floats(surface.albedo);

@@ -27,7 +27,7 @@ struct RenderEstimates {
     Image radiance;                 // the mean radiance (compensated sums)
     std::vector<double> depth;      // the mean primary hit distance
     std::vector<uint32_t> samples;  // samples per pixel
-    std::vector<float> variance;    // 3 per pixel: the variance of the mean radiance
+    std::vector<Color> variance;    // the variance of the mean radiance (the layer's floats in develop)
     // The denoiser's feature buffers (render/aov.h averaged_surface_layers), where the caller
     // keeps them (the viewer's render thread makes them once per edit); develop makes them
     // when it denoises and they are empty.

@@ -52,9 +52,26 @@ void check_nesting(std::string_view text, const std::string& file) {
 // callback keeps parsing linear (the callback parser rescans the parent array at every
 // object end), and lets us refuse duplicate keys and know the JSON pointer of the value
 // being parsed, where nlohmann itself only knows a byte offset.
+//
+// An object's members are gathered in a vector of (key, value) pairs and moved into its
+// ordered_map when it closes, with one allocation of the exact size. The ordered_map is a
+// std::vector of pair<const string, Json>, whose const key makes the pair's move constructor
+// one that may throw, so a growing ordered_map copies its elements: appending the fourth key
+// of a scene's top level deep-copied its "shapes" array (100,000 objects), and a bad_alloc
+// in that copy destroyed the partial copy, whose nlohmann destructor allocates (its heap
+// stack), threw again out of a noexcept destructor, and aborted the process.
 class DomBuilder : public nlohmann::json_sax<Json> {
 public:
     Json root;
+    // Whatever is left of the DOM (a partial one when parsing stopped, and the members of
+    // the objects still open) is freed without allocating: this may run while memory is
+    // exhausted.
+    ~DomBuilder() override { free(); }
+    void free() noexcept {
+        for (Level& level : levels_)
+            for (auto& member : level.members) release(member.second);
+        release(root);
+    }
     // Set when parsing stopped on our own finding rather than a syntax error.
     std::optional<std::string> duplicate_key;
     std::string error_pointer;                 // where parsing stopped
@@ -97,6 +114,7 @@ private:
         std::string key;   // objects: the key whose value is being parsed
         size_t count = 0;  // arrays: elements completed so far = index of the current one
         std::unordered_set<std::string> keys;
+        std::vector<std::pair<std::string, Json>> members;  // objects: their members so far (movable)
     };
 
     // Pointer of the value being parsed now.
@@ -108,7 +126,8 @@ private:
     }
 
     // Stores a value in the innermost container and returns where it now lives. Only that
-    // container grows while it is open, so the pointers held in levels_ stay valid.
+    // container grows while it is open, so the pointers held in levels_ stay valid. Arrays
+    // grow by moving their elements (basic_json's move constructor is noexcept).
     Json* place(Json&& value) {
         if (levels_.empty()) {
             root = std::move(value);
@@ -120,10 +139,8 @@ private:
             array.push_back(std::move(value));
             return &array.back();
         }
-        // Keys are known unique (key() checked), so skip ordered_map's linear lookup.
-        auto& object = top.value->get_ref<Json::object_t&>();
-        object.Container::emplace_back(top.key, std::move(value));
-        return &object.back().second;
+        top.members.emplace_back(top.key, std::move(value));
+        return &top.members.back().second;
     }
 
     bool add(Json&& value) {
@@ -133,10 +150,18 @@ private:
     }
     bool open(Json&& container) {
         Json* where = place(std::move(container));
-        levels_.push_back({where, {}, 0, {}});
+        levels_.push_back({where, {}, 0, {}, {}});
         return true;
     }
     bool close() {
+        Level& top = levels_.back();
+        if (top.value->is_object()) {
+            // Keys are known unique (key() checked), so skip ordered_map's linear lookup; the
+            // exact reserve means no reallocation, so every value is moved, none copied.
+            auto& object = top.value->get_ref<Json::object_t&>();
+            object.reserve(top.members.size());
+            for (auto& [key, value] : top.members) object.Container::emplace_back(std::move(key), std::move(value));
+        }
         levels_.pop_back();
         element_done();
         return true;
@@ -195,26 +220,6 @@ std::string describe(const Json& j) {
     }
 }
 
-// Frees a DOM without allocating. nlohmann's destructor first moves a container's children
-// onto a heap stack (to avoid recursion); when memory ran out building a huge DOM that
-// allocation fails too, inside a destructor, and the process aborts. Popping children from
-// the back allocates nothing, and check_nesting bounds this recursion to 64 levels.
-void release(Json& j) {
-    if (j.is_array()) {
-        auto& array = j.get_ref<Json::array_t&>();
-        while (!array.empty()) {
-            release(array.back());
-            array.pop_back();
-        }
-    } else if (j.is_object()) {
-        auto& object = j.get_ref<Json::object_t&>();
-        while (!object.empty()) {
-            release(object.back().second);
-            object.pop_back();
-        }
-    }
-}
-
 SceneError out_of_memory(const std::string& file, std::string_view text) {
     return SceneError(file, "", "not enough memory for the scene (" + format_bytes(text.size()) + " of JSON)");
 }
@@ -225,7 +230,10 @@ Json parse_json(std::string_view text, const std::string& file) {
     try {
         if (Json::sax_parse(text.begin(), text.end(), &builder)) return std::move(builder.root);
     } catch (const std::bad_alloc&) {
-        release(builder.root);
+        builder.free();  // before the message's strings are allocated
+        throw out_of_memory(file, text);
+    } catch (const std::length_error&) {
+        builder.free();
         throw out_of_memory(file, text);
     }
 

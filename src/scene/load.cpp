@@ -599,15 +599,16 @@ LoadedScene Loader::load(const Json& root) {
 LoadedScene parse_scene(std::string_view json_text, const std::filesystem::path& file) {
     const std::string name = file.string();
     Json root = parse_json(json_text, name);
+    // Freed without allocating on every way out, the loaded scene's return included: by then
+    // the scene and the DOM together may hold most of the memory there is.
+    const ReleasedOnExit<Json> freed{root};
     try {
         LoadedScene loaded = Loader(name).load(root);
         loaded.scene.source_file = file;
         return loaded;
-    } catch (const std::bad_alloc&) {
-        release(root);
-        throw out_of_memory(name, json_text);
-    } catch (const std::length_error&) {
-        release(root);
+    } catch (const std::exception& e) {
+        if (!is_out_of_memory(e)) throw;
+        release(root);  // before the message's strings are allocated
         throw out_of_memory(name, json_text);
     }
 }

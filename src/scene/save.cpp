@@ -3,13 +3,14 @@
 #include <nlohmann/json.hpp>
 
 #include "core/file_write.h"
+#include "scene/json_reader.h"
 
 namespace kr {
 
 namespace {
 
-// Keys in the order the brief's files use, so a saved file diffs well against its source.
-using Json = nlohmann::ordered_json;
+// Keys in the order the brief's files use, so a saved file diffs well against its source
+// (Json is nlohmann::ordered_json, scene/json_reader.h).
 
 Json vec3(const Vec3& v) { return Json::array({v.x, v.y, v.z}); }
 
@@ -50,7 +51,14 @@ std::string scene_to_json(const Scene& scene) {
                                      " out of range");
         return items[size_t(index)].id;
     };
-    Json root;
+    // Every DOM here is freed without allocating however the function is left (json_reader.h):
+    // a scene of 100,000 spheres can run out of memory while its DOM is being built. The two
+    // objects holding the long arrays get their five keys' room first: a growing ordered_map
+    // copies its members (their const keys make the pairs' moves ones that may throw), the
+    // arrays' whole contents with them.
+    Json root = Json::object();
+    const ReleasedOnExit<Json> freed_root{root};
+    root.get_ref<Json::object_t&>().reserve(5);
     root["cameras"] = Json::array();
     for (const Camera& c : scene.cameras) root["cameras"].push_back(camera_json(c));
     root["materials"] = Json::array();
@@ -58,35 +66,40 @@ std::string scene_to_json(const Scene& scene) {
     root["shapes"] = Json::array();
     for (const Shape& s : scene.shapes) {
         Json j;
+        const ReleasedOnExit<Json> freed{j};
         j["id"] = s.id;
         j["type"] = shape_type_names.name(s.type);
         j["centre"] = vec3(s.centre);
         j["radius"] = s.radius;
-        root["shapes"].push_back(j);
+        root["shapes"].push_back(std::move(j));
     }
     root["lights"] = Json::array();
     for (const Light& l : scene.lights) {
         Json j;
+        const ReleasedOnExit<Json> freed{j};
         j["id"] = l.id;
         j["type"] = light_type_names.name(l.type);
         if (l.type == LightType::point) j["position"] = vec3(l.position);
         else j["shape"] = id_of(scene.shapes, l.shape, "light shape");
         j["power"] = vec3(l.power);
-        root["lights"].push_back(j);
+        root["lights"].push_back(std::move(j));
     }
-    Json block;
+    Json block = Json::object();
+    const ReleasedOnExit<Json> freed_block{block};
+    block.get_ref<Json::object_t&>().reserve(5);
     block["camera"] = id_of(scene.cameras, scene.camera, "camera");
     block["lights"] = Json::array();
     for (int l : scene.active_lights) block["lights"].push_back(id_of(scene.lights, l, "active light"));
     block["primitives"] = Json::array();
     for (const Primitive& p : scene.primitives) {
         Json j;
+        const ReleasedOnExit<Json> freed{j};
         j["id"] = p.id;
         j["type"] = primitive_type_names.name(p.type);
         j["shape"] = id_of(scene.shapes, p.shape, "primitive shape");
         if (p.type == PrimitiveType::emissive) j["light"] = id_of(scene.lights, p.light, "primitive light");
         j["material"] = id_of(scene.materials, p.material, "primitive material");
-        block["primitives"].push_back(j);
+        block["primitives"].push_back(std::move(j));
     }
     const RendererSettings& r = scene.renderer;
     Json renderer;
@@ -100,7 +113,7 @@ std::string scene_to_json(const Scene& scene) {
     display["tonemap"] = tonemap_names.name(scene.display.tonemap);
     display["exposure"] = scene.display.exposure;
     block["display"] = display;
-    root["scene"] = block;
+    root["scene"] = std::move(block);
     // nlohmann prints doubles in their shortest round-trip form, so values load back equal.
     return root.dump(2) + "\n";
 }

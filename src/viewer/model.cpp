@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "core/limits.h"
+#include "core/memory.h"
 #include "scene/load.h"
 #include "scene/save.h"
 #include "scene/scene_list.h"
@@ -25,6 +26,9 @@ std::shared_ptr<const RenderScene> prepare(const Scene& scene, std::vector<std::
         return std::make_shared<const RenderScene>(prepare_scene(scene, warnings, previous));
     } catch (const std::invalid_argument& e) {
         throw SceneError(scene.source_file.string(), "", e.what());
+    } catch (const std::exception& e) {
+        if (!is_out_of_memory(e)) throw;
+        throw SceneError(scene.source_file.string(), "", "not enough memory for the prepared scene and its BVH");
     }
 }
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include <omp.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -181,6 +182,13 @@ void RenderWorker::run() {
     // window. Linux nice values are per thread, and the team's threads, created by this
     // thread at its first parallel region, inherit it.
     setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), 10);
+    // This thread's OpenMP team, started before a pass would start it and libgomp end the
+    // viewer where a thread's stack does not fit the address space (core/memory.h): with as
+    // many threads as fit, the image being the same at any count.
+    if (const int fit = start_thread_team(); fit < omp_get_max_threads()) {
+        omp_set_num_threads(fit);
+        start_thread_team();
+    }
     constexpr double kPreviewBudget = 0.010;  // seconds for the first preview pass
     RenderJob job;
     RenderState state;  // the estimate of `job`, at full resolution

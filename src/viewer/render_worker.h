@@ -127,9 +127,9 @@ struct Snapshot {
     std::vector<uint32_t> sample_count;
     std::vector<float> standard_error;
     // And what Save develops with the radiance and the counts (render/outputs.h): the mean
-    // depth and, 3 per pixel, the variance of the mean radiance.
+    // depth and, per pixel, the variance of the mean radiance (in double, as render_estimates gives it).
     std::vector<double> depth;
-    std::vector<float> variance;
+    std::vector<Color> variance;
     // While a feature view is on (RenderWorker::set_features), previews included, at the
     // frame's resolution: the albedo and normal, and per pixel the mean primary hit distance
     // where every sample hit (infinite where one missed; viewer/inspect.h hit_depths).

@@ -40,7 +40,7 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
     if (shown->generation != model.generation() || !model.prepared())
         throw std::runtime_error("the image shown is not of the current scene yet");
     const size_t n = shown->radiance.pixels.size();
-    if (shown->depth.size() != n || shown->sample_count.size() != n || shown->variance.size() != 3 * n)
+    if (shown->depth.size() != n || shown->sample_count.size() != n || shown->variance.size() != n)
         throw std::runtime_error("no full-resolution image yet");
     if (image_save_kind(path) != kind)
         throw std::invalid_argument(quoted_path(path) + ": a " + format_info(image_format(kind)).name +

@@ -12,6 +12,9 @@
 #include <backends/imgui_impl_opengl3.h>
 
 #include "core/file_write.h"
+#include "core/memory.h"
+#include "core/text.h"
+#include "render/render_state.h"
 #include "scene/load.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
@@ -81,6 +84,18 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
     if (options_.reference) load_reference(ctx_, *options_.reference, false);
     else if (const auto brief = brief_reference_for(options_.scene)) load_reference(ctx_, *brief, true);
 
+    // A scripted run whose render cannot fit is refused before the window opens, with the
+    // estimate the render thread applies to every job (render_worker.cpp): the GL driver
+    // (Mesa's llvmpipe) ends the process with SIGSEGV where its own allocations fail
+    // (compiling the display's shaders under ulimit -v), which no message could report.
+    if (model_.has_scene() && options_.writes_after_render()) {
+        const int rw = model_.scene().renderer.width, rh = model_.scene().renderer.height;
+        if (const std::string shortfall = memory_shortfall(render_memory_bytes(rw, rh, false, true),
+                                                           "the render of a " + std::to_string(rw) + "x" +
+                                                               std::to_string(rh) + " image");
+            !shortfall.empty())
+            throw std::runtime_error(show_user_text(options_.scene.string()) + ": " + shortfall);
+    }
     if (!glfwInit()) throw std::runtime_error("cannot initialise GLFW (is there a display? try render --gl)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);

@@ -3,6 +3,8 @@
 #include <exception>
 #include <string>
 
+#include "core/memory.h"
+#include "core/text.h"
 #include "viewer/ui_app.h"
 #include "viewer/view_options.h"
 #include "viewer/viewer.h"
@@ -25,11 +27,15 @@ int run_viewer(int argc, char** argv, SharedPasses* ranks) {
         std::fprintf(stderr, "error: %s; nothing opened or written\n", problem.c_str());
         return 1;
     }
+    const std::filesystem::path scene = options.scene;
     try {
         ViewerApp app(std::move(options), ranks);
         return app.run();
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        if (is_out_of_memory(e))
+            std::fprintf(stderr, "error: %s: not enough memory for the viewer's images\n", show_user_text(scene.string()).c_str());
+        else
+            std::fprintf(stderr, "error: %s\n", e.what());
         return 1;
     }
 }

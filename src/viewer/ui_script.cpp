@@ -6,6 +6,8 @@
 
 #include "core/file_write.h"
 #include "core/image_io.h"
+#include "core/memory.h"
+#include "core/text.h"
 #include "scene/save.h"
 #include "viewer/save_dialog.h"
 #include "viewer/navigation.h"
@@ -79,8 +81,10 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int needed = script_passes_needed(options_, model.settings());
     if (!(current && current->scale == 1 && current->spp >= needed)) return false;
+    const std::filesystem::path* writing = nullptr;  // the output being made, for its error
     try {
         if (options_.screenshot) {
+            writing = &*options_.screenshot;
             // What is on screen of the image: all of it unless zoomed in.
             const PixelRect area = ctx.view_area();
             const double x0 = std::max(rect.x, area.x), y0 = std::max(rect.y, area.y);
@@ -95,21 +99,27 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
                         (y0 - rect.y) / scale, scale, x0, y0);
         }
         if (options_.stats_json) {
+            writing = &*options_.stats_json;
             write_file_atomic(*options_.stats_json, stats_json(stats_figures(ctx)));
             std::printf("stats: %s\n", options_.stats_json->string().c_str());
         }
         if (options_.save_image) {
             // The Save panel's code, without its overwrite question.
             const std::filesystem::path& out = *options_.save_image;
+            writing = &out;
             save_output(image_save_kind(out), out, ctx.model, current);
             std::printf("image: %s (%d spp)\n", out.string().c_str(), current->spp);
         }
         if (options_.save_scene) {
+            writing = &*options_.save_scene;
             save_scene_json(model.scene_for_saving(), *options_.save_scene);
             std::printf("scene: %s\n", options_.save_scene->string().c_str());
         }
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        if (is_out_of_memory(e) && writing)
+            std::fprintf(stderr, "error: %s: not enough memory to write it\n", show_user_text(writing->string()).c_str());
+        else
+            std::fprintf(stderr, "error: %s\n", e.what());
         status_ = 1;
     }
     std::fflush(stdout);
@@ -121,7 +131,11 @@ void ScriptRun::window_shot(const ReadBack& read, int fb_w, int fb_h) {
     try {
         write_image(*options_.window_shot, read({0, 0, double(fb_w), double(fb_h)}));
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "error: %s\n", e.what());
+        if (is_out_of_memory(e))
+            std::fprintf(stderr, "error: %s: not enough memory to write it\n",
+                         show_user_text(options_.window_shot->string()).c_str());
+        else
+            std::fprintf(stderr, "error: %s\n", e.what());
         status_ = 1;
     }
 }
