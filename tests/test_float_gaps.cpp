@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -202,8 +203,11 @@ TEST(FloatGaps, EveryKernelRendersHostileScenesAsOnePath) {
     std::vector<std::pair<RenderScene, std::string>> scenes;
     for (Hostile hostile : kAllHostile) {
         const double t = threshold(hostile);
-        for (double gap : {2 * t, t / 2, 1e-5 * t})
-            scenes.emplace_back(hostile_scene(hostile, gap), std::string(name(hostile)) + " at gap " + std::to_string(gap));
+        for (double gap : {2 * t, t / 2, 1e-5 * t}) {
+            char what[96];
+            std::snprintf(what, sizeof what, "%s at gap %.3g", name(hostile), gap);
+            scenes.emplace_back(hostile_scene(hostile, gap), what);
+        }
     }
     for (Hostile hostile : {Hostile::lamp_in_glass, Hostile::glass_in_glass})
         scenes.emplace_back(hostile_scene(hostile, 0, offset_for_fraction(hostile, kFloatNearFraction / 2)),

@@ -129,7 +129,7 @@ int print_version() {
                                                                         : "not built for this CPU");
     else
         std::printf("SIMD kernels on this CPU: %s (%s paths at a time in single precision; x86-64-v3 lanes, "
-                    "four in double, where a scene's sizes need it)\n",
+                    "four in double, where a scene's sizes or gaps need it)\n",
                     name.c_str(), kernels == PacketKernels::x86_64_v4_float ? "sixteen" : "eight");
 #ifdef KEITHRAY_HAVE_EMBREE
     std::printf("Embree: yes (%s): scenes of more than 32 spheres\n", KEITHRAY_EMBREE_VERSION);
