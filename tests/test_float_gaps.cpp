@@ -78,6 +78,22 @@ TEST(FloatGaps, BriefAndExampleScenesKeepTheFloatLanes) {
     for (int n = 1; n <= 8; ++n) EXPECT_TRUE(float_lanes_fit(prepare_scene(load_scene_file(files[size_t(n - 1)]).scene))) << n;
 }
 
+// Spheres whose grid cells no integer counts (a ball 1e30 away beside unit ones) are paired
+// with every other: a shell there is still found, and spheres far apart still pass.
+TEST(FloatGaps, FarSpheresAreStillPaired) {
+    for (double far : {1e20, 1e30, -1e300}) {
+        test::SceneBuilder b;
+        const int grey = b.material(MaterialType::diffuse, Color(0.8));
+        b.sphere({0, 0, 0}, 1, grey);
+        b.sphere({0, 2, 0}, 0.5, grey);
+        b.sphere({far, 0, 0}, 1, grey);
+        RenderScene scene = b.build();
+        EXPECT_TRUE(float_resolves_gaps(scene)) << far;
+        scene.spheres.push_back({{far, 0, 0}, 1 + 1e-9 * std::abs(far)});  // a shell around it
+        EXPECT_FALSE(float_resolves_gaps(scene)) << far;
+    }
+}
+
 // The hostile configurations, in a closed room lit by a lamp, around a unit sphere at c.
 enum class Hostile { point_inside_ball, point_outside_ball, lamp_in_shell, lamp_in_glass, glass_in_glass, ball_in_glass };
 const char* name(Hostile h) {
@@ -180,6 +196,29 @@ TEST(FloatGaps, TheFloatLanesTakeHostileScenesOnlyBeyondEachThreshold) {
         EXPECT_FALSE(float_lanes_fit(hostile_scene(hostile, 0, offset_for_fraction(hostile, kFloatNearFraction * 2))))
             << name(hostile);
     }
+}
+
+// The viewer prepares a scene again after each edit, keeping the gap check where the spheres
+// and lights stayed: each edit's answer is a fresh preparation's.
+TEST(FloatGaps, AnEditsPreparedSceneChecksTheGapsAsAFreshOne) {
+    test::SceneBuilder b = room();
+    const int grey = b.material(MaterialType::diffuse, Color(0.8));
+    b.sphere(kCentre, 1, grey);
+    b.point_light(kCentre + Vec3(2, 0, 0), Color(50));
+    const RenderScene before = b.build();
+    ASSERT_TRUE(before.float_gaps_resolved);
+    Light& light = b.scene.lights.back();
+    const auto check = [&](const char* edit) {
+        const RenderScene edited = prepare_scene(b.scene, nullptr, &before);
+        EXPECT_EQ(edited.float_gaps_resolved, b.build().float_gaps_resolved) << edit;
+        return edited.float_gaps_resolved;
+    };
+    b.scene.cameras[0].position = {1, 0, -14};
+    EXPECT_TRUE(check("camera moved"));
+    light.position = kCentre + Vec3(1 - threshold(Hostile::point_inside_ball) / 2, 0, 0);
+    EXPECT_FALSE(check("point light moved just inside the ball"));
+    light.power = Color(0);
+    EXPECT_TRUE(check("that light made black"));
 }
 
 // A render's radiance with its variance layer, and its count of non-finite samples.

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 #include <vector>
 
@@ -92,6 +92,12 @@ bool float_resolves_gaps(const RenderScene& scene) {
     std::nth_element(radii.begin(), radii.begin() + ptrdiff_t(radii.size() / 2), radii.end());
     const double cell = 2 * radii[radii.size() / 2] + margin;
     const auto cell_of = [&](double x) { return int64_t(std::floor(x / cell)); };
+    // Cell indices a double counts exactly (and an int64_t holds): beyond them a sphere is
+    // paired with all, as a large one is.
+    const auto countable = [&](const Vec3& v) {
+        constexpr double kLargest = 0x1.0p52;
+        return std::abs(v.x / cell) < kLargest && std::abs(v.y / cell) < kLargest && std::abs(v.z / cell) < kLargest;
+    };
     struct Key {
         int64_t x, y, z;
         bool operator==(const Key&) const = default;
@@ -108,9 +114,13 @@ bool float_resolves_gaps(const RenderScene& scene) {
     const auto upper = [&](const SphereGeom& s) { return s.centre + Vec3(s.radius + margin / 2); };
     for (size_t i = 0; i < spheres.size(); ++i) {
         const Vec3 lo = lower(spheres[i]), hi = upper(spheres[i]);
+        if (!countable(lo) || !countable(hi)) {
+            large.push_back(i);
+            continue;
+        }
         const int64_t x0 = cell_of(lo.x), y0 = cell_of(lo.y), z0 = cell_of(lo.z);
         const int64_t x1 = cell_of(hi.x), y1 = cell_of(hi.y), z1 = cell_of(hi.z);
-        if (!(x1 - x0 < 4 && y1 - y0 < 4 && z1 - z0 < 4)) {  // also where the cells overflow
+        if (!(x1 - x0 < 4 && y1 - y0 < 4 && z1 - z0 < 4)) {
             large.push_back(i);
             continue;
         }
