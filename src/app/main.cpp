@@ -233,9 +233,6 @@ Options parse_options(int argc, char** argv) {
 // characters, bytes that are not UTF-8 or too many of them (core/text.h).
 std::string shown(const fs::path& path) { return show_user_text(path.string()); }
 
-// Whether an allocation failed (core/memory.h).
-bool out_of_memory(const std::exception& e) { return is_out_of_memory(e); }
-
 // The OpenMP team started before anything else (core/memory.h start_thread_team): false,
 // after one line naming `file`, where the threads' stacks do not fit the address space.
 bool team_started(const std::string& file) {
@@ -566,7 +563,7 @@ private:
                 };
             write_files_atomic(output_files(scene_, state_, request));
         } catch (const std::exception& e) {
-            if (out_of_memory(e)) throw;
+            if (is_out_of_memory(e)) throw;
             std::fprintf(stderr, "error: %s: %s\n", file_.c_str(), e.what());
             return false;
         }
@@ -673,7 +670,7 @@ int main(int argc, char** argv) {
             const int status = run_bench(argc, argv);
             return stdout_written() ? status : 1;
         } catch (const std::exception& e) {
-            if (!out_of_memory(e)) throw;
+            if (!is_out_of_memory(e)) throw;
             std::fprintf(stderr, "error: bench: not enough memory for the benchmark's scenes and images\n");
             return 1;
         }
@@ -684,7 +681,7 @@ int main(int argc, char** argv) {
             const int status = command == "psnr" ? run_psnr(argc, argv) : run_compare(argc, argv);
             return stdout_written() ? status : 1;
         } catch (const std::exception& e) {
-            if (!out_of_memory(e)) throw;
+            if (!is_out_of_memory(e)) throw;
             std::fprintf(stderr, "error: %s: not enough memory for the images %s and %s\n", command.c_str(),
                          argc > 2 ? shown(argv[2]).c_str() : "", argc > 3 ? shown(argv[3]).c_str() : "");
             return 1;
@@ -744,7 +741,7 @@ int main(int argc, char** argv) {
         try {
             ok = render_scene_file(scene, opt, stage, cluster) && ok;
         } catch (const std::exception& e) {
-            if (out_of_memory(e))
+            if (is_out_of_memory(e))
                 std::fprintf(stderr, "error: %s: not enough memory for %s\n", shown(scene).c_str(), stage.c_str());
             else
                 std::fprintf(stderr, "error: %s: %s\n", shown(scene).c_str(), e.what());
