@@ -19,6 +19,21 @@ TEST(StopRule, ProgressTowardsThePasses) {
     EXPECT_EQ(*p.nearest, StopReason::passes);
 }
 
+TEST(StopRule, EtasAreInWallTimeAtItsMeasuredRate) {
+    StopRule rule;
+    rule.max_passes = 64;
+    rule.seconds = 20;
+    // 16 passes took 8 s of the engine's time and 24 s of wall time (the viewer's frames and
+    // window beside them): 48 passes left at 1.5 s of wall time each, and the time rule's
+    // 12 s left are 36 s of wall time; the time rule comes first.
+    const StopProgress p = stop_progress(rule, 16, 8.0, 0.04, 24.0);
+    EXPECT_DOUBLE_EQ(p.eta, 36.0);
+    rule.seconds = 0;
+    EXPECT_DOUBLE_EQ(stop_progress(rule, 16, 8.0, 0.04, 24.0).eta, 72.0);
+    // Wall time shorter than the clock (rounding) is taken as the clock's.
+    EXPECT_DOUBLE_EQ(stop_progress(rule, 16, 8.0, 0.04, 7.0).eta, 24.0);
+}
+
 TEST(StopRule, TheRuleNearestToEndingWins) {
     StopRule rule;
     rule.max_passes = 64;

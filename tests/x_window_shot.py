@@ -68,9 +68,8 @@ def grab(x11, display, window):
     return w, h, bytes(out)
 
 
-def main():
-    if len(sys.argv) != 3:
-        sys.exit("usage: x_window_shot.py WINDOW_ID OUT.ppm")
+def open_x11():
+    """libX11 with the prototypes grab() needs, and the display ($DISPLAY)."""
     x11 = ctypes.CDLL(ctypes.util.find_library("X11") or "libX11.so.6")
     x11.XOpenDisplay.restype = ctypes.c_void_p
     x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
@@ -86,6 +85,13 @@ def main():
     display = x11.XOpenDisplay(None)
     if not display:
         sys.exit("x_window_shot: cannot open the display")
+    return x11, display
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit("usage: x_window_shot.py WINDOW_ID OUT.ppm")
+    x11, display = open_x11()
     window = int(sys.argv[1])
     last = None
     for _ in range(50):
@@ -99,4 +105,5 @@ def main():
     sys.exit("x_window_shot: the window kept changing")
 
 
-main()
+if __name__ == "__main__":
+    main()

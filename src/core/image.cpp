@@ -111,6 +111,37 @@ void blur_line(const double* in, double* out, int n, int radius) {
 
 }  // namespace
 
+Image upscale_linear(const Image& src, int width, int height) {
+    Image out(width, height);
+    if (src.width <= 0 || src.height <= 0) return out;
+    // Source coordinates of each destination pixel centre: the lower sample and the weight of
+    // the upper one, clamped to the edge.
+    struct Tap {
+        int lo, hi;
+        double t;
+    };
+    auto taps = [](int n, int source) {
+        std::vector<Tap> out(size_t(std::max(0, n)));
+        for (int i = 0; i < n; ++i) {
+            const double u = std::clamp((i + 0.5) * source / n - 0.5, 0.0, double(source - 1));
+            const int lo = std::min(int(u), source - 1);
+            out[size_t(i)] = {lo, std::min(lo + 1, source - 1), u - lo};
+        }
+        return out;
+    };
+    const std::vector<Tap> xs = taps(width, src.width), ys = taps(height, src.height);
+    for (int y = 0; y < height; ++y) {
+        const Tap ty = ys[size_t(y)];
+        for (int x = 0; x < width; ++x) {
+            const Tap tx = xs[size_t(x)];
+            const Color top = src.at(tx.lo, ty.lo) * (1 - tx.t) + src.at(tx.hi, ty.lo) * tx.t;
+            const Color bottom = src.at(tx.lo, ty.hi) * (1 - tx.t) + src.at(tx.hi, ty.hi) * tx.t;
+            out.at(x, y) = top * (1 - ty.t) + bottom * ty.t;
+        }
+    }
+    return out;
+}
+
 Image box_blur(const Image& src, int radius) {
     if (radius <= 0 || src.pixels.empty()) return src;
     // Two 1-D passes (rows, then columns), each a running sum over a line copied into a

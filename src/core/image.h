@@ -64,6 +64,11 @@ uint8_t quantize_unit(double v);  // clamp to [0,1], x255, round
 // per line). radius 0 returns the input.
 Image box_blur(const Image& src, int radius);
 
+// `src` stretched over a width x height image, bilinear between pixel centres (as a GPU's
+// linear filter of a texture drawn over that many pixels, clamped at the edges): a preview
+// rendered at a fraction of the resolution, shown smooth.
+Image upscale_linear(const Image& src, int width, int height);
+
 // The brief's depth map: each pixel shows 1 - d/(1+d) as grey.
 Rgb8Image depth_to_rgb8(const std::vector<double>& depth, int width, int height);
 

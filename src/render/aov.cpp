@@ -72,11 +72,27 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
 
 SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                                       int samples) {
-    SurfaceLayers out;
-    const size_t n = size_t(width) * size_t(height);
-    out.albedo.assign(n, Color());
-    out.normal.assign(n, Color());
     samples = std::clamp(samples, 1, kSampleBatch);
+    SurfaceLayers out;
+    add_surface_samples(scene, settings, width, height, 0, samples, out);
+    const double inverse = 1.0 / double(samples);
+    for (size_t i = 0; i < out.albedo.size(); ++i) {
+        out.albedo[i] = out.albedo[i] * inverse;
+        out.normal[i] = out.normal[i] * inverse;
+    }
+    return out;
+}
+
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
+                         int count, SurfaceLayers& sums) {
+    const size_t n = size_t(width) * size_t(height);
+    if (sums.albedo.size() != n || sums.normal.size() != n) {
+        sums.albedo.assign(n, Color());
+        sums.normal.assign(n, Color());
+    }
+    first = std::max(0, first);
+    count = std::clamp(count, 0, kSampleBatch);
+    if (count == 0) return;
 #pragma omp parallel for schedule(dynamic, 4)
     for (int y = 0; y < height; ++y) {
         std::optional<Sampler> samplers[kSampleBatch];
@@ -85,27 +101,27 @@ SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSett
         Ray rays[kSampleBatch];
         for (int x = 0; x < width; ++x) {
             const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-            // The pixel's first camera samples, made as render_pass makes them.
-            for (int k = 0; k < samples; ++k) {
+            // The pixel's camera samples first..first+count-1, made as render_pass makes them.
+            for (int k = 0; k < count; ++k) {
+                const uint32_t index = uint32_t(first + k);
                 pointers[k] = settings.estimator == Estimator::sobol
-                                  ? &samplers[k].emplace(Sampler::pixel_key(settings.seed, pixel), uint32_t(k))
-                                  : &samplers[k].emplace(settings.estimator, settings.seed, pixel, uint32_t(k),
+                                  ? &samplers[k].emplace(Sampler::pixel_key(settings.seed, pixel), index)
+                                  : &samplers[k].emplace(settings.estimator, settings.seed, pixel, index,
                                                          settings.target_spp);
                 xs[k] = x;
                 ys[k] = y;
             }
-            camera_rays(scene, settings, width, height, xs, ys, pointers, samples, rays);
-            Color albedo, normal;
-            for (int k = 0; k < samples; ++k) {
+            camera_rays(scene, settings, width, height, xs, ys, pointers, count, rays);
+            Color albedo = sums.albedo[pixel], normal = sums.normal[pixel];
+            for (int k = 0; k < count; ++k) {
                 const FirstSurface s = first_surface(scene, rays[k]);
                 albedo += s.albedo;
                 normal += s.normal;
             }
-            out.albedo[pixel] = albedo / double(samples);
-            out.normal[pixel] = normal / double(samples);
+            sums.albedo[pixel] = albedo;
+            sums.normal[pixel] = normal;
         }
     }
-    return out;
 }
 
 }  // namespace kr

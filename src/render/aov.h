@@ -38,4 +38,11 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
 SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                                       int samples);
 
+// The same layers made a few samples at a time (the viewer's display refines them frame by
+// frame): adds the first-surface albedo and normal of the pixels' camera samples
+// [first, first + count) to `sums`, sized here on the first call. Sums over samples 0..n-1 in
+// any number of calls, divided by n, are averaged_surface_layers(n) bit for bit.
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
+                         int count, SurfaceLayers& sums);
+
 }  // namespace kr

@@ -1,5 +1,6 @@
 #include "render/outputs.h"
 
+#include <algorithm>
 #include <limits>
 #include <stdexcept>
 #include <utility>
@@ -49,9 +50,23 @@ RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
 
 void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, int width, int height,
                      std::vector<float>& albedo, std::vector<float>& normal) {
-    const SurfaceLayers features = averaged_surface_layers(scene, sampling, width, height, kFeatureSamples);
-    albedo = floats(features.albedo);
-    normal = floats(features.normal);
+    SurfaceLayers sums;
+    add_surface_samples(scene, sampling, width, height, 0, kFeatureSamples, sums);
+    feature_buffers_from_sums(sums, kFeatureSamples, albedo, normal);
+}
+
+void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vector<float>& albedo,
+                               std::vector<float>& normal) {
+    // As averaged_surface_layers divides: times the reciprocal.
+    const double inverse = 1.0 / double(std::max(1, samples));
+    const size_t n = sums.albedo.size();
+    albedo.resize(3 * n);
+    normal.resize(3 * n);
+    for (size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            albedo[3 * i + size_t(k)] = stored_float(sums.albedo[i][k] * inverse);
+            normal[3 * i + size_t(k)] = stored_float(sums.normal[i][k] * inverse);
+        }
 }
 
 unsigned develop_reads(const DevelopOptions& options) {

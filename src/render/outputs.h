@@ -13,6 +13,7 @@
 #include "core/file_write.h"
 #include "core/image.h"
 #include "core/image_formats.h"
+#include "render/aov.h"
 #include "render/denoise.h"
 #include "render/progressive.h"
 #include "render/render_scene.h"
@@ -64,6 +65,10 @@ inline constexpr double kWhittedRawSpp = 4;
 // albedo and normal views show them).
 void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, int width, int height,
                      std::vector<float>& albedo, std::vector<float>& normal);
+// The feature buffers of the sums of `samples` camera samples a pixel (render/aov.h
+// add_surface_samples): of kFeatureSamples, what feature_buffers makes, bit for bit.
+void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vector<float>& albedo,
+                               std::vector<float>& normal);
 // The layers develop reads for `options` besides those of its output.
 unsigned develop_reads(const DevelopOptions& options);
 

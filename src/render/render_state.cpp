@@ -60,6 +60,7 @@ RenderState::Halves RenderState::halves() const {
         out.count[h].assign(px_.sample_count.size(), 0);
     }
     if (!tracks_halves()) return out;
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < px_.sample_count.size(); ++i) {
         const uint32_t odd = std::min(px_.half_count[i], px_.sample_count[i]), even = px_.sample_count[i] - odd;
         const Color total = px_.radiance_sum[i] + px_.radiance_compensation[i];
@@ -80,6 +81,7 @@ uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised)
 
 Image RenderState::radiance() const {
     Image img(width, height);
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < img.pixels.size(); ++i)
         img.pixels[i] = px_.sample_count[i]
                             ? (px_.radiance_sum[i] + px_.radiance_compensation[i]) / double(px_.sample_count[i])
@@ -89,6 +91,7 @@ Image RenderState::radiance() const {
 
 std::vector<double> RenderState::mean_depth() const {
     std::vector<double> d(px_.depth_sum.size(), kMissDepth);
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < d.size(); ++i)
         if (px_.sample_count[i]) d[i] = px_.depth_sum[i] / double(px_.sample_count[i]);
     return d;
@@ -96,6 +99,7 @@ std::vector<double> RenderState::mean_depth() const {
 
 std::vector<Color> RenderState::variance_of_mean() const {
     std::vector<Color> v(px_.radiance_sum.size(), Color(kInfinity));
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < v.size(); ++i) {
         const double n = px_.sample_count[i];
         if (n < 2 || !is_finite(px_.radiance_sq_sum[i])) continue;  // unknown, as sample_variance

@@ -52,7 +52,9 @@ struct StopProgress {
 
 // After `passes` passes taking `seconds` (the time rule's clock), with the image's estimated
 // relative error `noise` (<= 0: not known yet). The noise rule's ETA assumes the error falls
-// as 1/sqrt(passes).
-StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise);
+// as 1/sqrt(passes). `wall_seconds` (> 0) is the wall time the passes took with everything
+// done beside them (the viewer's previews, frames and window): the ETAs are in it, at the
+// rate it measures.
+StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise, double wall_seconds = 0);
 
 }  // namespace kr

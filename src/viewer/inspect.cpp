@@ -11,14 +11,18 @@
 namespace kr::viewer {
 
 void record_pixel_statistics(const RenderState& totals, Snapshot& frame) {
+    record_pixel_statistics(totals, render_estimates(totals, kLayerDepth | kLayerSamples | kLayerVariance), frame);
+}
+
+void record_pixel_statistics(const RenderState& totals, RenderEstimates estimates, Snapshot& frame) {
     const size_t n = totals.sample_count().size();
-    frame.sample_count = totals.sample_count();
     frame.standard_error.resize(n);
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; ++i) frame.standard_error[i] = float(totals.pixel_standard_error(i));
-    RenderEstimates layers = render_estimates(totals, kLayerDepth | kLayerVariance);
-    frame.depth = std::move(layers.depth);
-    frame.variance = std::move(layers.variance);
-    frame.halves = std::move(layers.halves);
+    frame.sample_count = std::move(estimates.samples);
+    frame.depth = std::move(estimates.depth);
+    frame.variance = std::move(estimates.variance);
+    frame.halves = std::move(estimates.halves);
 }
 
 std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int height, int x, int y,

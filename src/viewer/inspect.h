@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/outputs.h"
 #include "render/progressive.h"
 #include "viewer/compare_view.h"
 #include "viewer/edit.h"
@@ -21,6 +22,9 @@ namespace kr::viewer {
 // variance layers, viewer/save_dialog.h) read from the running totals into a
 // full-resolution snapshot.
 void record_pixel_statistics(const RenderState& totals, Snapshot& frame);
+// The same with the totals' estimates already taken (render/outputs.h render_estimates with
+// the depth, samples and variance layers), which it moves into the frame.
+void record_pixel_statistics(const RenderState& totals, RenderEstimates estimates, Snapshot& frame);
 
 // One pixel as the inspector shows it.
 struct PixelProbe {

@@ -106,7 +106,7 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     prepared_ = std::move(prepared);
     settings_ = settings;
     warnings_ = std::move(warnings);
-    ++generation_;
+    view_base_generation_ = ++generation_;
     undo_.clear();
     redo_.clear();
     open_group_.clear();
@@ -159,7 +159,10 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
     if (resets) {
         prepared_ = std::move(prepared);
         warnings_ = std::move(warnings);
+        // A camera edit keeps the base of the camera edits before it; any other starts anew.
+        const bool navigating = kind == Edit::camera && view_base_generation_ != 0;
         ++generation_;
+        if (!navigating) view_base_generation_ = generation_;
     }
     return true;
 }
@@ -172,7 +175,7 @@ void ViewerModel::restore(State& state, std::vector<State>& push_to) {
         // Every state on the stacks was prepared once, so this succeeds.
         prepared_ = prepare(state.scene, &warnings, prepared_.get());
         warnings_ = std::move(warnings);
-        ++generation_;
+        view_base_generation_ = ++generation_;
     }
     const bool paused = settings_.paused;
     scene_ = std::move(state.scene);

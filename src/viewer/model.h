@@ -73,6 +73,11 @@ public:
     const ViewerSettings& settings() const { return settings_; }
     const std::vector<std::string>& warnings() const { return warnings_; }
     uint64_t generation() const { return generation_; }
+    // The generation before the camera edits that led to this one (the generation itself when
+    // the last resetting edit was not a camera edit): frames of the generations from it on
+    // show this scene and settings from an earlier view, which the window shows while the
+    // user navigates until the current view's frame comes.
+    uint64_t view_base_generation() const { return view_base_generation_; }
 
     // Applies `change` to the authored scene and settings. An edit that changes the image
     // rebuilds the render scene and advances the generation; if the result cannot be
@@ -160,6 +165,7 @@ private:
     ViewerSettings settings_;
     std::vector<std::string> warnings_;
     uint64_t generation_ = 0;
+    uint64_t view_base_generation_ = 0;
     RenderOptions overrides_;
 
     std::vector<State> undo_, redo_;

@@ -44,6 +44,16 @@ std::vector<int> preview_scales(int width, int height, double seconds_per_pixel,
     return scales;
 }
 
+bool FrameSchedule::due(double age, double since_last, double cost) const {
+    const double by_age = std::clamp(age_fraction * age, min_interval, max_interval);
+    return since_last >= std::max(by_age, cost / cost_share);
+}
+
+bool frame_spp(int spp, bool after_previews) {
+    if (spp < (after_previews ? kFirstFrameSpp : 1)) return false;
+    return spp <= 8 ? (spp & (spp - 1)) == 0 : spp % 8 == 0;
+}
+
 RenderWorker::RenderWorker(std::function<void()> on_publish, SharedPasses* ranks)
     : on_publish_(std::move(on_publish)), ranks_(ranks), thread_([this] { run(); }) {}
 
@@ -62,6 +72,7 @@ void RenderWorker::submit(RenderJob job) {
         std::lock_guard lock(mutex_);
         rule_ = job.stop;
         rule_.max_passes = std::max(1, rule_.max_passes);
+        if (job.edited == Clock::time_point{}) job.edited = Clock::now();
         pending_ = std::move(job);
         stop_.store(true);  // the pass in flight ends at its next row
     }
@@ -71,6 +82,8 @@ void RenderWorker::submit(RenderJob job) {
 void RenderWorker::set_paused(bool paused) {
     {
         std::lock_guard lock(mutex_);
+        if (paused && !paused_) pause_start_ = Clock::now();
+        if (!paused && paused_ && pause_start_ >= job_start_) paused_seconds_ += seconds_since(pause_start_);
         paused_ = paused;
     }
     changed_.notify_all();
@@ -116,6 +129,11 @@ void RenderWorker::set_features(bool on) {
     changed_.notify_all();
 }
 
+void RenderWorker::set_schedule(const FrameSchedule& schedule) {
+    std::lock_guard lock(mutex_);
+    schedule_ = schedule;
+}
+
 void RenderWorker::set_stop_rule(const StopRule& rule) {
     {
         std::lock_guard lock(mutex_);
@@ -156,26 +174,86 @@ void RenderWorker::publish_error(uint64_t generation, std::string error) {
 
 namespace {
 
-// The denoised radiance of `state` for the display, developed by render/outputs.h with the
-// interactive filter (Save and `render --denoise` develop with the final one). `albedo` and `normal` keep the feature buffers of a full-resolution
-// state between passes (empty: made here).
-Image denoised_radiance(const RenderJob& job, const RenderState& state, std::vector<float>& albedo,
-                        std::vector<float>& normal, DenoiseWorkspace& workspace) {
+// The denoised radiance of `estimates` (the radiance, depth, variance and, for a Whitted
+// render, the counts) for the display, developed by render/outputs.h with the interactive
+// filter (Save and `render --denoise` develop with the final one), guided by `features` of
+// their resolution.
+Image denoised_radiance(const RenderJob& job, const RenderEstimates& estimates, const DisplayFeatures& features,
+                        DenoiseWorkspace& workspace) {
     DevelopOptions options;
     options.workspace = &workspace;
     options.denoise = Denoise::on;
     options.interactive = true;  // the live display: the a-trous filter (Save: the final one)
     options.sampling = job.settings;
-    RenderEstimates estimates = render_estimates(state, kLayerRadiance | develop_reads(options));
-    estimates.albedo = std::move(albedo);
-    estimates.normal = std::move(normal);
-    Developed developed = develop(*job.scene, std::move(estimates), options, kLayerRadiance | kLayerAlbedo | kLayerNormal);
-    albedo = std::move(developed.albedo);
-    normal = std::move(developed.normal);
-    return std::move(developed.radiance);
+    RenderEstimates input;
+    input.radiance = estimates.radiance;
+    input.depth = estimates.depth;
+    input.variance = estimates.variance;
+    if (develop_reads(options) & kLayerSamples) input.samples = estimates.samples;
+    input.albedo = features.albedo;
+    input.normal = features.normal;
+    return std::move(develop(*job.scene, std::move(input), options, kLayerRadiance).radiance);
 }
 
 }  // namespace
+
+void DisplayFeatures::reset(int w, int h) {
+    width = w, height = h, samples = 0;
+    sums = {};
+    albedo.clear();
+    normal.clear();
+}
+
+void DisplayFeatures::refine_to(const RenderJob& job, int total) {
+    const int count = std::min(total, kFeatureSamples) - samples;
+    if (count <= 0) return;
+    add_surface_samples(*job.scene, job.settings, width, height, samples, count, sums);
+    samples += count;
+    feature_buffers_from_sums(sums, samples, albedo, normal);
+}
+
+int next_display_feature_samples(const DisplayFeatures& features) {
+    return std::min(kDisplayFeatureSamples, features.samples + 1);
+}
+
+void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
+                        Snapshot& frame) {
+    const int w = job.scene->renderer.width, h = job.scene->renderer.height;
+    RenderState preview(scaled(w, scale), scaled(h, scale));
+    kr::render_pass(*job.scene, job.settings, preview);
+    frame.scale = scale;
+    frame.radiance = preview.radiance();
+    DisplayFeatures preview_features;
+    if (denoise || features) {
+        preview_features.reset(preview.width, preview.height);
+        preview_features.refine_to(job, kPreviewFeatureSamples);
+    }
+    if (denoise) {
+        DevelopOptions reads;
+        reads.denoise = Denoise::on;
+        reads.interactive = true;
+        reads.sampling = job.settings;
+        const RenderEstimates estimates = render_estimates(preview, develop_reads(reads) | kLayerRadiance);
+        frame.denoised = denoised_radiance(job, estimates, preview_features, workspace);
+    }
+    if (features) {
+        auto f = std::make_shared<FeatureBuffers>();
+        f->width = preview.width;
+        f->height = preview.height;
+        f->albedo = std::move(preview_features.albedo);
+        f->normal = std::move(preview_features.normal);
+        frame.features = std::move(f);
+        frame.hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
+    }
+}
+
+void make_full_frame(const RenderJob& job, const RenderState& state, const DisplayFeatures* features,
+                     DenoiseWorkspace& workspace, Snapshot& frame) {
+    RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
+    if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
+    frame.radiance = std::move(estimates.radiance);
+    record_pixel_statistics(state, std::move(estimates), frame);
+}
 
 void RenderWorker::run() {
     // Below the UI thread: on a 2-core machine the OpenMP team would otherwise starve the
@@ -205,22 +283,33 @@ void RenderWorker::run() {
     std::optional<ProgressiveDriver> driver;
     std::vector<int> previews;
     size_t next_preview = 0;
-    double seconds = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
-    std::vector<float> albedo, normal;  // the full-resolution feature buffers of `job`
-    std::shared_ptr<const FeatureBuffers> features;  // the same for the feature views, made once
+    DisplayFeatures display_features;  // of `job` at full resolution, for the display's filter
+    std::shared_ptr<const FeatureBuffers> features;  // the feature views' (complete), made once
     DenoiseWorkspace denoise_planes;    // kept between frames
-    // The feature views' buffers of `job` at full resolution: the denoiser's when it made them.
+    // The full-resolution passes of `job` not yet in a frame, when the last frame was made and
+    // what making it cost (seconds, smoothed).
+    bool unpublished = false;
+    bool full_frame_made = false;
+    Clock::time_point last_frame{};
+    double frame_cost = 0;
+    // The feature views' buffers of `job` at full resolution: the display's, completed.
     auto full_features = [&] {
         if (!features) {
+            display_features.refine_to(job, kFeatureSamples);
             auto f = std::make_shared<FeatureBuffers>();
-            f->width = job.scene->renderer.width;
-            f->height = job.scene->renderer.height;
-            if (!albedo.empty() && !normal.empty()) f->albedo = albedo, f->normal = normal;
-            else feature_buffers(*job.scene, job.settings, f->width, f->height, f->albedo, f->normal);
+            f->width = display_features.width;
+            f->height = display_features.height;
+            f->albedo = display_features.albedo;
+            f->normal = display_features.normal;
             features = std::move(f);
         }
         return features;
+    };
+    // Wall seconds of `job` so far, less its pauses (under the lock).
+    auto job_seconds = [&] {
+        const double paused = paused_seconds_ + (paused_ && pause_start_ >= job_start_ ? seconds_since(pause_start_) : 0);
+        return std::max(0.0, seconds_since(job_start_) - paused);
     };
 
     for (;;) {
@@ -238,17 +327,25 @@ void RenderWorker::run() {
                    latest_->scale == 1 && latest_->error.empty() && !latest_->features;
         };
         std::shared_ptr<const Snapshot> republish;
+        bool publish_estimate = false;  // a frame of passes already taken (paused, stopped)
         {
             std::unique_lock lock(mutex_);
             changed_.wait(lock, [&] {
-                return quit_ || pending_ || (driver && !paused_ && !stop_reason()) || features_due();
+                return quit_ || pending_ || (driver && !paused_ && !stop_reason()) || features_due() ||
+                       (driver && unpublished);
             });
             if (quit_) return;
-            if (!pending_ && !(driver && !paused_ && !stop_reason())) republish = latest_;
+            if (!pending_ && !(driver && !paused_ && !stop_reason())) {
+                if (unpublished) publish_estimate = true;
+                else republish = latest_;
+            }
             if (pending_) {
                 job = std::move(*pending_);
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
+                job_start_ = job.edited;
+                paused_seconds_ = 0;
+                if (paused_) pause_start_ = job_start_;
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
                 // The estimate render applies, before allocating (render_state.h).
                 const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
@@ -268,15 +365,15 @@ void RenderWorker::run() {
                     publish_error(job.generation, "not enough memory for the render state of a " + image);
                     continue;
                 }
-                albedo.clear();
-                normal.clear();
+                display_features.reset(w, h);
                 features.reset();
+                unpublished = false;
+                full_frame_made = false;
                 driver.emplace(*job.scene, job.settings, state, rule_, hooks);
                 job_unsent = ranks_ != nullptr;  // sent outside the lock: the ranks may be busy
                 job_rays = job_nonfinite = 0;
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
-                seconds = 0;
                 if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
             rule = rule_;
@@ -298,34 +395,22 @@ void RenderWorker::run() {
             }
             continue;
         }
-        const auto start = Clock::now();
         auto frame = std::make_shared<Snapshot>();
         bool shared_pass = false;  // inside a pass shared with the other ranks
         // An allocation that fails here (a preview, a pass's buffers, the frame's copies) is
         // the window's error, not an abort of the viewer; the job is dropped.
         try {
-        if (next_preview < previews.size()) {
+        if (publish_estimate) {
+            // The passes since the last frame, now that no pass follows them (paused, or a
+            // stop rule met): made below.
+        } else if (next_preview < previews.size()) {
             const int scale = previews[next_preview];
-            RenderState preview(scaled(w, scale), scaled(h, scale));
-            if (!kr::render_pass(*job.scene, job.settings, preview, &stop_)) continue;
-            seconds += seconds_since(start);
             ++next_preview;
-            frame->scale = scale;
-            frame->radiance = preview.radiance();
-            std::vector<float> preview_albedo, preview_normal;
-            if (denoise_.load())
-                frame->denoised = denoised_radiance(job, preview, preview_albedo, preview_normal, denoise_planes);
-            if (features_.load()) {
-                auto f = std::make_shared<FeatureBuffers>();
-                f->width = preview.width;
-                f->height = preview.height;
-                if (preview_albedo.empty() || preview_normal.empty())
-                    feature_buffers(*job.scene, job.settings, f->width, f->height, f->albedo, f->normal);
-                else f->albedo = std::move(preview_albedo), f->normal = std::move(preview_normal);
-                frame->features = std::move(f);
-                frame->hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
-            }
+            // Not stopped by an edit: a preview is short by design (preview_scales), and during a
+            // drag, edits coming faster than previews would otherwise leave the window none.
+            make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame);
         } else {
+            const auto start = Clock::now();
             if (ranks_) {
                 // Every rank runs the pass to its end: they exchange rows after it.
                 if (std::string error = ranks_->begin_pass(rule, region.region); !error.empty()) {
@@ -340,30 +425,45 @@ void RenderWorker::run() {
             }
             // A pass stopped early is always an edit's: the next turn starts the new job.
             else if (!driver->pass(rule, &stop_)) continue;
-            const double dt = seconds_since(start);
-            seconds += dt;
             // Only full passes: tiny previews are dominated by per-pass overheads.
-            seconds_per_pixel = dt / (double(w) * h);
-            frame->radiance = state.radiance();
-            if (denoise_.load()) {
-                if ((albedo.empty() || normal.empty()) && features) albedo = features->albedo, normal = features->normal;
-                frame->denoised = denoised_radiance(job, state, albedo, normal, denoise_planes);
+            seconds_per_pixel = seconds_since(start) / (double(w) * h);
+            unpublished = true;
+            // The frame schedule: is this pass's image worth making and drawing now?
+            bool due = false;
+            {
+                std::lock_guard lock(mutex_);
+                const bool by_schedule = frame_spp(state.passes, !previews.empty()) &&
+                    (!full_frame_made ||
+                     schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load()));
+                due = by_schedule || paused_ || stop_reason() || (features_.load() && !(latest_ && latest_->features));
             }
+            if (!due) continue;
         }
-        frame->generation = job.generation;
-        frame->spp = state.passes;
-        frame->seconds = seconds;
-        frame->full_seconds = driver->seconds();
-        frame->rays = ranks_ ? job_rays : state.rays;
-        frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
-        frame->nonfinite_samples = ranks_ ? job_nonfinite : state.nonfinite_samples;
         if (frame->scale == 1) {
-            record_pixel_statistics(state, *frame);
+            // A full-resolution frame of the estimate: its radiance, the display's denoised
+            // image (guided by feature buffers refined one more step each frame) and the
+            // pixel statistics.
+            // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
+            if (denoise_.load()) display_features.refine_to(job, next_display_feature_samples(display_features));
+            const auto start = Clock::now();
+            make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame);
             if (features_.load()) {
                 frame->features = full_features();
                 frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
             }
+            const double cost = seconds_since(start);
+            if (std::getenv("KR_DEBUG_FRAMES")) std::fprintf(stderr, "frame cost %.1f ms (display %.1f)\n", 1e3 * cost, 1e3 * display_cost_.load());
+            frame_cost = full_frame_made ? 0.5 * (frame_cost + cost) : cost;
+            full_frame_made = true;
+            unpublished = false;
+            last_frame = Clock::now();
         }
+        frame->generation = job.generation;
+        frame->spp = state.passes;
+        frame->full_seconds = driver->seconds();
+        frame->rays = ranks_ ? job_rays : state.rays;
+        frame->relative_error = frame->spp >= 2 ? state.relative_error() : INFINITY;
+        frame->nonfinite_samples = ranks_ ? job_nonfinite : state.nonfinite_samples;
         } catch (const std::bad_alloc&) {
             if (shared_pass) {
                 // The other ranks wait for this one's rows: only the end of the job frees them.
@@ -378,6 +478,7 @@ void RenderWorker::run() {
         }
         {
             std::lock_guard lock(mutex_);
+            frame->seconds = job_seconds();
             frame->max_passes = rule_.max_passes;
             frame->stopped_by = stop_reason();
             frame->finished = frame->stopped_by.has_value();

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "core/image.h"
+#include "render/aov.h"
+#include "render/denoise.h"
 #include "render/progressive.h"
 
 namespace kr::viewer {
@@ -30,6 +32,9 @@ struct RenderJob {
     // The scene `scene` was prepared from: what the other ranks prepare (SharedPasses; only
     // needed with them).
     std::shared_ptr<const Scene> source;
+    // When the edit was made (RenderWorker::submit stamps a job that has none): frames count
+    // their wall time from it.
+    std::chrono::steady_clock::time_point edited{};
 };
 
 // A render region: the image pixels [x0, x1) x [y0, y1) that full passes refine.
@@ -118,8 +123,8 @@ struct Snapshot {
     Image denoised;          // the radiance developed with the denoiser (render/outputs.h); empty when off
     int spp = 0;             // full-resolution passes accumulated (0 for a preview)
     int max_passes = 1;      // the stop rule's pass limit (kUnlimitedPasses: none)
-    double seconds = 0;      // render time of this generation so far (pauses excluded)
-    double full_seconds = 0; // of which full-resolution passes
+    double seconds = 0;      // wall time from the edit to this frame (pauses excluded)
+    double full_seconds = 0; // the engine's time in full-resolution passes (the time rule's clock)
     uint64_t rays = 0;       // rays of the full-resolution passes
     double relative_error = 0;  // RenderState::relative_error() of the accumulation
     // Full-resolution frames only (viewer/inspect.h): per pixel, the samples accumulated
@@ -143,6 +148,62 @@ struct Snapshot {
     // has no image and the worker waits for the next job.
     std::string error;
 };
+
+// When the render thread develops a full-resolution frame of its estimate (the radiance, the
+// display's denoised image, the pixel statistics) between passes. The first full pass of an
+// edit, the last one (a stop rule met) and the pass before a pause always make one; between
+// them a frame is due once `since_last` seconds have passed since the previous one, where the
+// interval grows with the image's age (seconds since the edit: the image changes fast at
+// first, slowly later) up to `max_interval`, and is never so short that the frames (`cost`:
+// the render thread's time to make one plus the window's to draw it) take more than
+// `cost_share` of the time. Frames nobody could see in time are not made.
+struct FrameSchedule {
+    double age_fraction = 0.5;   // interval: half the image's age (frames at ages 1, 1.5, 2.25, ...)
+    double min_interval = 1.0 / 60;
+    double max_interval = 1.0;
+    double cost_share = 0.2;
+    bool due(double age, double since_last, double cost) const;
+};
+
+// The display's feature buffers of one image (albedo and normal, render/outputs.h): refined a
+// few camera samples at a time (render/aov.h add_surface_samples), so that the first frame of
+// an edit costs one sample a pixel; at kFeatureSamples they are feature_buffers', bit for bit.
+struct DisplayFeatures {
+    int width = 0, height = 0;
+    SurfaceLayers sums;
+    int samples = 0;
+    std::vector<float> albedo, normal;  // of the sums
+
+    void reset(int w, int h);
+    // Refined to `total` camera samples a pixel (at most kFeatureSamples).
+    void refine_to(const RenderJob& job, int total);
+};
+// The camera samples a pixel of the display's feature buffers at the next frame: the first full
+// frame of an edit traces one, the next one more (a sample costs about 1/8 of a pass;
+// kFeatureSamples, which Save and the feature views use, would hold up the first frames).
+inline constexpr int kDisplayFeatureSamples = 2;
+int next_display_feature_samples(const DisplayFeatures& features);
+// A preview's feature buffers: its image is coarse anyway.
+inline constexpr int kPreviewFeatureSamples = 2;
+
+// The frames the render thread publishes, as it makes them (the tests make the same):
+// a preview of `job` at 1/scale resolution (one pass of its own), with the display's denoised
+// radiance and the feature layers where asked;
+void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
+                        Snapshot& frame);
+// and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
+// `features` (null: not denoised) and the pixel statistics.
+void make_full_frame(const RenderJob& job, const RenderState& state, const DisplayFeatures* features,
+                     DenoiseWorkspace& workspace, Snapshot& frame);
+
+// The sample counts at which the render thread makes a full-resolution frame by its schedule
+// (a stop rule met or a pause makes one at any count): after previews, from kFirstFrameSpp on
+// (fewer samples, denoised, can look worse than the last preview: the a-trous filter at 1 spp
+// speckles, and a lens's blur is noisy); and only where the samples are balanced: powers of
+// two up to 8, then multiples of 8 (a Sobol or stratified estimate between them is less even:
+// a Whitted render lost about 1 dB from 8 spp to 9).
+inline constexpr int kFirstFrameSpp = 4;
+bool frame_spp(int spp, bool after_previews);
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
 // to full resolution. first_scale is the smallest power of two (up to 16) whose pass is
@@ -178,6 +239,9 @@ public:
     void set_region(std::optional<PixelBox> region);
     // Whether frames carry the denoised radiance (Snapshot::denoised), from the next frame on.
     void set_denoise(bool on) { denoise_.store(on); }
+    // The window's time to draw a new frame (seconds; the frame schedule counts it).
+    void set_display_cost(double seconds) { display_cost_.store(seconds); }
+    void set_schedule(const FrameSchedule& schedule);
     // Whether frames carry the feature layers (Snapshot::features, hit_depth): from the next
     // frame on, and a finished or paused render's newest frame is published again with them.
     void set_features(bool on);
@@ -206,6 +270,12 @@ private:
     std::atomic<bool> stop_{false};
     std::atomic<bool> denoise_{true};
     std::atomic<bool> features_{false};
+    std::atomic<double> display_cost_{0};
+    FrameSchedule schedule_;  // under the mutex
+    // The wall time of the job so far less its pauses (under the mutex): the job's start (its
+    // edit), the pauses' total and when the current pause began.
+    std::chrono::steady_clock::time_point job_start_{}, pause_start_{};
+    double paused_seconds_ = 0;
     std::thread thread_;  // last: starts after every member above exists
 };
 

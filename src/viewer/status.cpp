@@ -21,7 +21,9 @@ RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool
     st.noise = frame->spp >= 2 && std::isfinite(frame->relative_error) ? frame->relative_error : -1;
 
     // Progress towards each stop rule that is on; the first to be met ends the render.
-    const StopProgress progress = stop_progress(settings.stop_rule(), frame->spp, frame->full_seconds, st.noise);
+    // ETAs at the rate measured in wall time (previews, frames and the window included).
+    const StopProgress progress =
+        stop_progress(settings.stop_rule(), frame->spp, frame->full_seconds, st.noise, frame->seconds);
     st.progress = progress.fraction;
     st.eta = progress.eta;
     if (progress.nearest) st.rule = stop_reason_names.name(*progress.nearest);
@@ -90,14 +92,23 @@ std::optional<std::vector<double>> TypedFields::take(unsigned id) {
     return values;
 }
 
-Image shown_radiance(const Snapshot& frame, DenoiseView view) {
+Image shown_radiance(const Snapshot& frame, DenoiseView view, int width, int height) {
     const Image& denoised = frame.denoised;
-    if (view == DenoiseView::off || denoised.pixels.size() != frame.radiance.pixels.size()) return frame.radiance;
-    if (view == DenoiseView::on) return denoised;
-    Image out = frame.radiance;
-    for (int y = 0; y < out.height; ++y)
-        for (int x = out.width / 2; x < out.width; ++x) out.at(x, y) = denoised.at(x, y);
+    Image out;
+    if (view == DenoiseView::off || denoised.pixels.size() != frame.radiance.pixels.size()) out = frame.radiance;
+    else if (view == DenoiseView::on) out = denoised;
+    else {
+        out = frame.radiance;
+        for (int y = 0; y < out.height; ++y)
+            for (int x = out.width / 2; x < out.width; ++x) out.at(x, y) = denoised.at(x, y);
+    }
+    if (frame.scale > 1 && width > 0 && height > 0) out = upscale_linear(out, width, height);
     return out;
+}
+
+Rgb8Image displayed_picture(const Snapshot& frame, DenoiseView view, int width, int height,
+                            const DisplaySettings& display) {
+    return tonemap(shown_radiance(frame, view, width, height), display.tonemap, display.exposure_scale());
 }
 
 std::string_view shown_word(const Snapshot& frame, DenoiseView view) {

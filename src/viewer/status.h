@@ -54,7 +54,12 @@ std::string window_title(std::string_view scene_name, const RunStatus& status, b
 
 // The image the display shows of `frame` under `view`: its radiance, its denoised radiance
 // (where the worker made one), or the raw left half beside the denoised right half.
-Image shown_radiance(const Snapshot& frame, DenoiseView view);
+// A preview, given the image's full `width` and `height`, is upscaled to it smoothly
+// (core/image.h upscale_linear): a coarse image, not blocks.
+Image shown_radiance(const Snapshot& frame, DenoiseView view, int width = 0, int height = 0);
+// The 8-bit picture the window shows of `frame` at 1:1 with the display's tone map.
+Rgb8Image displayed_picture(const Snapshot& frame, DenoiseView view, int width, int height,
+                            const DisplaySettings& display);
 // The status bar's word for it: "raw", "denoised" or "split".
 std::string_view shown_word(const Snapshot& frame, DenoiseView view);
 

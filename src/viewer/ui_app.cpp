@@ -182,8 +182,18 @@ bool ViewerApp::fetch_frame() {
     const DenoiseView view = model_.settings().denoise;
     if (!frame || (frame->serial == ui_.shown_serial && view == shown_view_)) return false;
     ui_.shown_serial = frame->serial;
-    // A frame of an older generation shows an image the user already changed.
-    if (frame->generation != model_.generation()) return false;
+    // A frame of an older generation shows an image the user already changed, except while
+    // the user navigates: one of an earlier view of the same scene and settings (of the
+    // image's size) keeps the picture following the hand until the current view's comes.
+    if (frame->generation != model_.generation()) {
+        const RendererSettings& image = model_.scene().renderer;
+        const bool earlier_view = frame->generation >= model_.view_base_generation() &&
+                                  frame->generation < model_.generation() && frame->error.empty() &&
+                                  (frame->scale > 1 || (frame->radiance.width == image.width &&
+                                                        frame->radiance.height == image.height)) &&
+                                  (!ui_.shown || ui_.shown->generation <= frame->generation);
+        if (!earlier_view) return false;
+    }
     if (!frame->error.empty()) {  // the render could not go on (memory): the window says so
         messages_.show_error(frame->error);
         if (options_.scripted()) {  // its passes will never come
@@ -193,7 +203,8 @@ bool ViewerApp::fetch_frame() {
         }
         return false;
     }
-    display_->upload(shown_radiance(*frame, shown_view_ = view));
+    const RendererSettings& image = model_.scene().renderer;
+    display_->upload(shown_radiance(*frame, shown_view_ = view, image.width, image.height));
     ui_.shown = std::move(frame);
     return true;
 }
@@ -308,13 +319,18 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // feature: the feature view's readout of the pixel under the pointer, spaces as '_' ("none").
     std::string feature = tool.hover_feature.empty() ? "none" : tool.hover_feature.substr(0, 80);
     std::replace(feature.begin(), feature.end(), ' ', '_');
-    char line[800];
+    // shown: the frame on screen, as generation,scale,spp,serial ("none" before the first).
+    char shown[96] = "none";
+    if (ui_.shown)
+        std::snprintf(shown, sizeof shown, "%llu,%d,%d,%llu", static_cast<unsigned long long>(ui_.shown->generation),
+                      ui_.shown->scale, ui_.shown->spp, static_cast<unsigned long long>(ui_.shown->serial));
+    char line[900];
     std::snprintf(line, sizeof line,
-                  "state=%s spp=%d target=%d generation=%llu dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
+                  "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
                   "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
                   "feature=%s draft=%s question=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
-                  static_cast<unsigned long long>(model_.generation()), int(model_.dirty()), int(ui_.help_visible),
+                  static_cast<unsigned long long>(model_.generation()), shown, int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
@@ -464,6 +480,7 @@ int ViewerApp::run() {
         const auto now = UiClock::now();
         const double work = seconds(now - frame_start);
         ui_.ui_work = ui_.ui_work > 0 ? 0.9 * ui_.ui_work + 0.1 * work : work;
+        worker_->set_display_cost(ui_.ui_work);  // the frame schedule counts the window's drawing
         const double interval = seconds(now - last_frame_);
         last_frame_ = now;
         ui_.ui_fps = 0.9 * ui_.ui_fps + 0.1 * (interval > 0 ? 1.0 / interval : 0.0);

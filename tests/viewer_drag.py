@@ -1,0 +1,206 @@
+#!/usr/bin/env python3
+"""An orbit drag in a real `keithray view` window with real X input (xdotool), watched through
+the X server's copy of the window (x_window_shot.py). Run inside xvfb-run. Prints key=value lines.
+
+  viewer_drag.py test  KEITHRAY SCENE WORKDIR
+      For tests/test_viewer_window.cpp; never waits for time, only for conditions (bounded by a
+      generous limit): the button goes down, then each of STEPS moves of the pointer is
+      followed by a wait until the window shows a frame of the camera that move made, with
+      the button still held; each such frame must differ from the one before. Then the button
+      goes up. Prints steps=, shown_during_drag= (moves whose frame came before the next move),
+      changed_during_drag=, still_pressed= and the final generation.
+
+  viewer_drag.py bench KEITHRAY SCENE WORKDIR [--steps 24] [--step-px 5] [--interval 0.05]
+      For scripts/bench_viewer.sh (prints figures, asserts nothing): a drag of STEPS moves at
+      INTERVAL seconds, the window grabbed every 50 ms meanwhile (how many grabs changed), then
+      after the release the grabs at 0.25, 0.5, 1, 2, 3 and 10 s against the settled image
+      (a grab after --settle seconds): PSNR, and the time from the release to the first change.
+"""
+import argparse
+import math
+import os
+import subprocess
+import sys
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from x_window_shot import grab, open_x11  # noqa: E402
+
+LIMIT = float(os.environ.get("VIEWER_INPUT_LIMIT", "240"))  # seconds for any one condition
+
+
+def xdotool(*args):
+    subprocess.run(["xdotool", *[str(a) for a in args]], check=True, stdout=subprocess.DEVNULL)
+
+
+class Viewer:
+    def __init__(self, keithray, scene, workdir, extra):
+        self.status_path = os.path.join(workdir, "status.txt")
+        self.err = open(os.path.join(workdir, "view.err"), "w")
+        self.proc = subprocess.Popen([keithray, "view", scene, "--status-file", self.status_path, *extra],
+                                     stdout=subprocess.DEVNULL, stderr=self.err)
+        self.window = int(subprocess.run(["xdotool", "search", "--sync", "--name", "^keithray"], check=True,
+                                         capture_output=True, text=True).stdout.split()[0])
+        self.x11, self.display = open_x11()
+
+    def status(self):
+        try:
+            with open(self.status_path) as f:
+                line = f.read()
+        except OSError:
+            return {}
+        return dict(kv.split("=", 1) for kv in line.split() if "=" in kv)
+
+    def wait(self, condition, what):
+        end = time.monotonic() + LIMIT
+        while time.monotonic() < end:
+            if self.proc.poll() is not None:
+                sys.exit("error=viewer exited (status %d) waiting for %s" % (self.proc.returncode, what))
+            s = self.status()
+            if s and condition(s):
+                return s
+            time.sleep(0.005)
+        sys.exit("error=timed out waiting for %s (status: %s)" % (what, self.status()))
+
+    def image(self, s):
+        """The image area of a grab of the window (the status line's image=x,y,fitS)."""
+        x, y, fit = s["image"].split(",")
+        scale = float(fit.replace("fit", ""))
+        x, y = int(float(x)), int(float(y))
+        w, h, pixels = grab(self.x11, self.display, self.window)
+        size = self.size
+        iw, ih = int(size[0] * scale), int(size[1] * scale)
+        rows = [pixels[3 * ((y + r) * w + x):3 * ((y + r) * w + x + iw)] for r in range(min(ih, h - y))]
+        return b"".join(rows)
+
+    def close(self):
+        self.proc.terminate()
+        try:
+            self.proc.wait(10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+
+
+def shown(s):
+    """The shown frame's (generation, scale, spp)."""
+    if s.get("shown", "none") == "none":
+        return None
+    g, scale, spp, _ = s["shown"].split(",")
+    return int(g), int(scale), int(spp)
+
+
+def psnr(a, b):
+    mse = sum((x - y) ** 2 for x, y in zip(a, b)) / max(1, len(a))
+    return 99.0 if mse == 0 else 10 * math.log10(255 * 255 / mse)
+
+
+def start(args, extra):
+    v = Viewer(args.keithray, args.scene, args.workdir, extra)
+    s = v.wait(lambda s: s.get("state") in ("rendering", "done") and shown(s) and shown(s)[1] == 1, "a full frame")
+    # The image's size: the scene's, from the first full frame's area (image=x,y,fitS and the
+    # scene's renderer size are what the test scenes use: 512x512 unless --size says).
+    v.size = tuple(int(n) for n in args.size.split("x"))
+    xdotool("windowfocus", "--sync", v.window)
+    x, y, _ = s["image"].split(",")
+    # The pointer in the image's middle band, over the image.
+    xdotool("mousemove", "--window", v.window, int(float(x)) + 150, int(float(y)) + 200)
+    return v, s
+
+
+def run_test(args):
+    v, s = start(args, ["--spp", "64"])
+    before = v.image(s)
+    xdotool("mousedown", 1)
+    v.wait(lambda s: s.get("press") not in (None, "0"), "the press")
+    shown_during, changed = 0, 0
+    for step in range(args.steps):
+        generation = int(v.status()["generation"])
+        xdotool("mousemove_relative", "--", args.step_px, 0)
+        s = v.wait(lambda s, g=generation: int(s["generation"]) > g, "the move's edit")
+        g = int(s["generation"])
+        s = v.wait(lambda s, g=g: shown(s) and shown(s)[0] >= g, "a frame of the moved camera")
+        if s.get("press") not in (None, "0"):
+            shown_during += 1
+        now = v.image(s)
+        changed += now != before
+        before = now
+    pressed = v.status().get("press")
+    xdotool("mouseup", 1)
+    s = v.wait(lambda s: s.get("press") == "0", "the release")
+    print("steps=%d" % args.steps)
+    print("shown_during_drag=%d" % shown_during)
+    print("changed_during_drag=%d" % changed)
+    print("still_pressed=%d" % (pressed not in (None, "0")))
+    print("generation=%s" % s["generation"])
+    v.close()
+
+
+def run_bench(args):
+    v, s = start(args, ["--unlimited"])
+    time.sleep(1.0)
+    grabs, stop = [], threading.Event()
+
+    def watch():
+        last = None
+        while not stop.is_set():
+            t = time.monotonic()
+            img = v.image(v.status())
+            grabs.append((t, img != last))
+            last = img
+            time.sleep(max(0.0, 0.05 - (time.monotonic() - t)))
+
+    xdotool("mousedown", 1)
+    thread = threading.Thread(target=watch)
+    thread.start()
+    for _ in range(args.steps):
+        t = time.monotonic()
+        xdotool("mousemove_relative", "--", args.step_px, 0)
+        time.sleep(max(0.0, args.interval - (time.monotonic() - t)))
+    stop.set()
+    thread.join()
+    xdotool("mouseup", 1)
+    released = time.monotonic()
+    during = grabs[1:]
+    print("drag: %d moves in %.2f s; %d of %d grabs (every 50 ms) changed" %
+          (args.steps, args.steps * args.interval, sum(c for _, c in during), len(during)))
+    # After the release: the first change, and the image at each checkpoint.
+    s = v.status()
+    shots, first_change, last = [], None, v.image(s)
+    checkpoints = [0.25, 0.5, 1.0, 2.0, 3.0, 10.0]
+    while time.monotonic() - released < checkpoints[-1]:
+        t = time.monotonic() - released
+        img = v.image(s)
+        if first_change is None and img != last:
+            first_change = t
+        for c in checkpoints:
+            if t >= c and all(c != k for k, _, _ in shots):
+                shots.append((c, img, shown(v.status())))
+        time.sleep(0.01)
+    time.sleep(max(0.0, args.settle - checkpoints[-1]))
+    settled = v.image(s)
+    print("release to the first change: %s" % ("%.0f ms" % (1e3 * first_change) if first_change is not None else "none"))
+    print("PSNR against the settled image (%g s): %s" % (args.settle, "  ".join(
+        "%g s: %.1f dB (%s)" % (c, psnr(img, settled), "%d spp%s" % (f[2], "" if f[1] == 1 else ", preview") if f else "-")
+        for c, img, f in shots)))
+    v.close()
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("mode", choices=["test", "bench"])
+    p.add_argument("keithray")
+    p.add_argument("scene")
+    p.add_argument("workdir")
+    p.add_argument("--steps", type=int, default=None)
+    p.add_argument("--step-px", type=int, default=5)
+    p.add_argument("--interval", type=float, default=0.05)
+    p.add_argument("--settle", type=float, default=30)
+    p.add_argument("--size", default="512x512")
+    args = p.parse_args()
+    if args.steps is None:
+        args.steps = 6 if args.mode == "test" else 24
+    (run_test if args.mode == "test" else run_bench)(args)
+
+
+main()
