@@ -24,6 +24,7 @@
 #include "viewer/model.h"
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
+#include "viewer/status.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -79,6 +80,25 @@ TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
 
 // Rebuilding the BVH after every edit made it most of an edit's latency in a large scene: an
 // edit that moves no sphere keeps it, one that moves a sphere builds it again.
+// While the user navigates, frames of the earlier views of the same scene may be shown (the
+// picture follows the hand): the view base is the generation before a run of camera edits;
+// any other resetting edit, a load or an undo starts a new base.
+TEST(ResetRule, CameraEditsKeepTheViewBaseOthersMoveIt) {
+    ViewerModel m = test::brief_model(3);
+    const uint64_t base = m.generation();
+    EXPECT_EQ(m.view_base_generation(), base);
+    for (int i = 0; i < 3; ++i)
+        ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].position.x += 0.1; }));
+    EXPECT_EQ(m.generation(), base + 3);
+    EXPECT_EQ(m.view_base_generation(), base);
+    ASSERT_TRUE(m.edit(Edit::material, [](Scene& s, ViewerSettings&) { s.materials[0].rho = Color(0.3); }));
+    EXPECT_EQ(m.view_base_generation(), m.generation());
+    ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].position.x += 0.1; }));
+    EXPECT_EQ(m.view_base_generation(), m.generation() - 1);
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.view_base_generation(), m.generation());
+}
+
 TEST(ResetRule, EditsThatMoveNoSphereKeepTheBvh) {
     test::SceneBuilder b;
     const int m = b.material(MaterialType::diffuse);
@@ -414,6 +434,79 @@ TEST(RenderThread, RegionRefinesOnlyItsPixels) {
     ASSERT_TRUE(f && f->spp == 6);
     EXPECT_EQ(f->sample_count[0], 3u);
     EXPECT_EQ(f->sample_count[size_t(box.y0) * 40 + size_t(box.x0)], 6u);
+}
+
+// Past the warm-up (adaptive passes), a region's pass plans only its pixels: the samples of
+// a pass are as many as its pixels (not the whole image's, heaped on them), so the region
+// reaches its target as its pixels' share of the work.
+TEST(RenderThread, ARegionsPassesCostWhatItsPixelsCost) {
+    const auto scene = small_scene(3, 48, 40);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;  // 8 uniform passes, then 8 planned ones
+    const PixelBox box{10, 8, 22, 20};
+    RenderWorker worker;
+    worker.set_region(box);
+    worker.submit({1, scene, settings, StopRule{settings.target_spp}});
+    std::shared_ptr<const Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->finished);
+    ASSERT_EQ(f->spp, 16);
+    uint64_t inside = 0, outside = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 48; ++x) {
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            (in ? inside : outside) += f->sample_count[size_t(y) * 48 + size_t(x)];
+        }
+    EXPECT_EQ(outside, 0u);
+    // 16 samples a pixel on average, give or take the planned passes' carried fractions.
+    const double mean = double(inside) / (12.0 * 12.0);
+    EXPECT_GE(mean, 15.0);
+    EXPECT_LE(mean, 17.0);
+}
+
+// The frame schedule: the first frame, then intervals of half the image's age (at least a
+// display refresh, at most a second), never shorter than the frames' cost over their share.
+TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
+    const FrameSchedule s;
+    EXPECT_FALSE(s.due(1.0, 0.4, 0.001));  // half of 1 s: 0.5 s
+    EXPECT_TRUE(s.due(1.0, 0.5, 0.001));
+    EXPECT_TRUE(s.due(0.01, 1.0 / 60, 0.001));  // a young image: one refresh
+    EXPECT_FALSE(s.due(0.01, 0.01, 0.001));
+    EXPECT_TRUE(s.due(100, 1.0, 0.001));        // an old one: a second
+    EXPECT_FALSE(s.due(100, 0.9, 0.001));
+    // Frames costing 0.1 s (making and drawing) come at most every 0.5 s (a fifth of the time).
+    EXPECT_FALSE(s.due(0.2, 0.4, 0.1));
+    EXPECT_TRUE(s.due(0.2, 0.5, 0.1));
+    // The counts frames are made at: balanced ones, and after previews none below 4 spp.
+    for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp, false)) << spp;
+    for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp, false)) << spp;
+    EXPECT_FALSE(frame_spp(1, true));
+    EXPECT_FALSE(frame_spp(2, true));
+    EXPECT_TRUE(frame_spp(4, true));
+}
+
+// The status bar's elapsed time is the wall time since the edit, not the passes' time alone:
+// a job stamped as edited 2 s ago says at least 2 s in its first frame.
+TEST(RenderThread, FramesCountWallTimeFromTheEdit) {
+    const auto scene = small_scene(3, 24, 20);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    RenderWorker worker;
+    RenderJob job{1, scene, settings, StopRule{1}};
+    job.edited = std::chrono::steady_clock::now() - std::chrono::seconds(2);
+    worker.submit(job);
+    std::shared_ptr<const Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    ASSERT_TRUE(f && f->finished);
+    EXPECT_GE(f->seconds, 2.0);
+    EXPECT_LT(f->full_seconds, f->seconds);  // the engine's own clock: its passes alone
+    // And the status bar says it.
+    ViewerSettings view;
+    view.render.target_spp = 1;
+    EXPECT_GE(run_status(f.get(), view, false).elapsed, 2.0);
 }
 
 TEST(RenderThread, PauseKeepsSamplesAndUnlimitedContinues) {

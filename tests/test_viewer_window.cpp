@@ -368,6 +368,28 @@ TEST_F(ViewerWindow, ClickWithOnePixelJitterLeavesTheImage) {
     EXPECT_NE(r["generation_after"], r["generation_before"]);
 }
 
+// An orbit drag with the button held: after each move of the pointer the window shows a
+// frame of the camera that move made, before the button goes up, each different from the one
+// before (tests/viewer_drag.py waits for each, bounded; the rate is scripts/bench_viewer.sh's).
+TEST_F(ViewerWindow, FramesOfEachMovedCameraComeDuringADrag) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const std::string script = (fs::path(KEITHRAY_RES_DIR) / ".." / "tests" / "viewer_drag.py").string();
+    const kr::test::CommandResult r = kr::test::run_command(
+        xvfb_run() + "python3 '" + script + "' test '" + KEITHRAY_EXE + "' '" +
+            kr::test::brief_scene_file(3).string() + "' '" + dir.string() + "'",
+        dir);
+    std::map<std::string, std::string> out;
+    std::istringstream lines(r.out);
+    for (std::string line; std::getline(lines, line);)
+        if (const size_t eq = line.find('='); eq != std::string::npos) out[line.substr(0, eq)] = line.substr(eq + 1);
+    ASSERT_EQ(r.status, 0) << r.out << r.err;
+    ASSERT_EQ(out.count("error"), 0u) << out["error"];
+    EXPECT_EQ(out["steps"], "6");
+    EXPECT_EQ(out["shown_during_drag"], "6");
+    EXPECT_EQ(out["changed_during_drag"], "6");
+    EXPECT_EQ(out["still_pressed"], "1");
+}
+
 TEST_F(ViewerWindow, RaisingTheTargetKeepsTheSamplesAndTheTitleShowsSpp) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
     auto r = drive(dir, "raise_target", 3);

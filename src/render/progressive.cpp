@@ -21,6 +21,7 @@ bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* canc
     noise_checked_ = rule.noise;
     const auto start = std::chrono::steady_clock::now();
     const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
+    if (hooks_) hooks_->before_plan(state_);
     state_.plan_pass(settings_, share);
     if (hooks_) hooks_->before_pass(state_);
     state_.begin_half_pass();

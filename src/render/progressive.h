@@ -22,6 +22,9 @@ namespace kr {
 class PassHooks {
 public:
     virtual ~PassHooks() = default;
+    // Before plan_pass: narrows the pixels the pass plans for (a render region), so that its
+    // samples, as many as those pixels, go to them alone. after_pass undoes it too.
+    virtual void before_plan(RenderState&) {}
     // After plan_pass, before render_pass: narrows the pass to this process's pixels.
     virtual void before_pass(RenderState& state) = 0;
     // After render_pass: undoes before_pass; when `statistics`, the next step reads the

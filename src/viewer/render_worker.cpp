@@ -89,7 +89,7 @@ void RenderWorker::set_paused(bool paused) {
     changed_.notify_all();
 }
 
-void RegionHooks::before_pass(RenderState& state) {
+void RegionHooks::before_plan(RenderState& state) {
     applied_ = false;
     if (!region) return;
     const int w = state.width, h = state.height;
@@ -452,7 +452,6 @@ void RenderWorker::run() {
                 frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
             }
             const double cost = seconds_since(start);
-            if (std::getenv("KR_DEBUG_FRAMES")) std::fprintf(stderr, "frame cost %.1f ms (display %.1f)\n", 1e3 * cost, 1e3 * display_cost_.load());
             frame_cost = full_frame_made ? 0.5 * (frame_cost + cost) : cost;
             full_frame_made = true;
             unpublished = false;

@@ -45,12 +45,15 @@ struct PixelBox {
 };
 
 // Narrows each full pass to a region's pixels (AND the noise rule's mask), through the
-// driver's pass hooks: render_pass skips the pixels whose active entry is 0, so the others
-// keep their samples and their image. No region: the pass is untouched.
+// driver's pass hooks, before the pass is planned: the plan gives the region's pixels as many
+// samples as they are (a pass costs what its pixels cost) and render_pass skips the pixels
+// whose active entry is 0, so the others keep their samples and their image. No region: the
+// pass is untouched.
 class RegionHooks : public PassHooks {
 public:
     std::optional<PixelBox> region;
-    void before_pass(RenderState& state) override;
+    void before_plan(RenderState& state) override;
+    void before_pass(RenderState&) override {}
     void after_pass(RenderState& state, bool statistics) override;
     bool any(bool stop) override { return stop; }
 
@@ -64,10 +67,11 @@ private:
 class RegionOverShare final : public PassHooks {
 public:
     RegionOverShare(RegionHooks& region, PassHooks& share) : region_(region), share_(share) {}
-    void before_pass(RenderState& state) override {
-        share_.before_pass(state);
-        region_.before_pass(state);
+    void before_plan(RenderState& state) override {
+        share_.before_plan(state);
+        region_.before_plan(state);
     }
+    void before_pass(RenderState& state) override { share_.before_pass(state); }
     void after_pass(RenderState& state, bool statistics) override {
         region_.after_pass(state, statistics);
         share_.after_pass(state, statistics);
