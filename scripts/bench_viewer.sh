@@ -4,7 +4,9 @@
 # input), and the latency from an orbit edit to the first frame of the new image on screen
 # (median and 90th percentile over 30 edits). Runs a real window under Xvfb. Then the
 # per-frame cost of the inspect and compare tools (bench/compare_tools.cpp) and of the
-# feature views (bench/feature_views.cpp).
+# feature views (bench/feature_views.cpp). Then the render pipeline: the viewer's passes per second
+# against render's, a 1.2 s orbit drag with real input (frames during it, PSNR after it),
+# the render thread's frames after an orbit, a 4 % region, the first full frame at 1920x1080.
 # Usage: scripts/bench_viewer.sh [build/keithray]   (docs/viewer.md records its figures)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -23,3 +25,45 @@ cmake --build "$(dirname "$exe")" --target keithray_bench_compare >/dev/null
 echo "== feature views (albedo, normal, depth)"
 cmake --build "$(dirname "$exe")" --target keithray_bench_features >/dev/null
 "$(dirname "$exe")/keithray_bench_features" res/scenes/assignment_03.json
+
+# The viewer at the engine's speed (docs/viewer.md, "The render pipeline").
+echo "== passes: view --spp 64 --frames 64 against render --spp 64, scene 3, each less its 2-spp run (medians of 3, interleaved)"
+python3 - "$exe" <<'PY'
+import statistics, subprocess, sys, time
+exe, scene = sys.argv[1], "res/scenes/assignment_03.json"
+xvfb = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"]
+def timed(cmd):
+    start = time.monotonic()
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.monotonic() - start
+runs = {}
+for _ in range(3):
+    for spp in (64, 2):
+        runs.setdefault(("render", spp), []).append(timed([exe, "render", scene, "--spp", str(spp), "-q", "-o", "/tmp/keithray-bench-viewer.ppm"]))
+        for display in ("on", "off"):
+            runs.setdefault((display, spp), []).append(timed(xvfb + [exe, "view", scene, "--spp", str(spp), "--frames", str(spp), "--denoise", display]))
+m = {k: statistics.median(v) for k, v in runs.items()}
+render = m[("render", 64)] - m[("render", 2)]
+for display in ("on", "off"):
+    view = m[(display, 64)] - m[(display, 2)]
+    print("  render %.2f s, view (denoise %s) %.2f s: the viewer at %.2fx render's passes per second" % (render, display, view, render / view))
+subprocess.run(["rm", "-f", "/tmp/keithray-bench-viewer.ppm"])
+PY
+for scene in res/scenes/assignment_03.json res/scenes/assignment_08.json res/scenes/examples/many_spheres.json; do
+  echo "== a 1.2 s orbit drag with real input, then the frames after the release: $scene"
+  work=$(mktemp -d)
+  xvfb-run -a -s "-screen 0 1280x1024x24" python3 tests/viewer_drag.py bench "$exe" "$scene" "$work" --settle 30 || true
+  rm -rf "$work"
+done
+echo "== the render thread after a 120-pixel orbit (bench/viewer_frames.cpp): frames, PSNR, a 4 % region"
+cmake --build "$(dirname "$exe")" --target keithray_bench_frames >/dev/null
+for scene in res/scenes/assignment_03.json res/scenes/assignment_08.json res/scenes/examples/many_spheres.json; do
+  "$(dirname "$exe")/keithray_bench_frames" "$scene" --seconds 10 | grep -v "^ *[0-9.]* s  1/"
+done
+echo "== at 1920x1080: the first full-resolution frame after an edit, denoised display and raw"
+for scene in res/scenes/assignment_03.json res/scenes/assignment_08.json; do
+  for raw in "" --raw; do
+    "$(dirname "$exe")/keithray_bench_frames" "$scene" --size 1920x1080 --seconds 4 --settle-spp 16 --no-region $raw |
+      grep -E "^res|first full"
+  done
+done
