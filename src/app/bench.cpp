@@ -34,6 +34,7 @@ constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
                  [--kernels best|double|float8|any|off] [--lens R]
   keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
+  keithray bench --sweep FROM:TO [--accel LIST] [--runs N] [--threads N] [--size W]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
@@ -59,6 +60,10 @@ constexpr const char* kBenchUsage = R"(Usage:
               ns per ray and ns per ray / log2(N), and how paths were traced (the SIMD
               lanes cast rays down their own tree under own and auto, up to
               kLaneTreeMaxSpheres; embree traces one path at a time).
+--sweep       --stress at every count from FROM to TO, each about 10 % above the last,
+              then per BVH its steps (the largest rise of ns per ray between
+              neighbouring counts, and how many rise by more than 15 %) and its band
+              (the largest over the smallest ns per ray / log2 N above 64 spheres).
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
               own,embree where the build has Embree, else own). With --throughput, one
               of them (default auto).
@@ -145,6 +150,7 @@ std::string stress_scene_json(int n, uint64_t seed, int indent = -1) {
 struct BenchOptions {
     bool throughput = false, linear = false;
     std::vector<int> stress;
+    bool sweep = false;
     std::vector<AccelBackend> accel;
     int write_stress = 0;
     fs::path write_path;
@@ -171,6 +177,17 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--stress") {
             for (const std::string& item : split_list(value()))
                 o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
+        } else if (arg == "--sweep") {
+            const std::string range = value();
+            const size_t colon = range.find(':');
+            if (colon == std::string::npos)
+                throw UsageError{"--sweep: expected FROM:TO (sphere counts), got " + quote_user_text(range, 40)};
+            const int from = int(parse_number("--sweep", range.substr(0, colon), 1, 1e7));
+            const int to = int(parse_number("--sweep", range.substr(colon + 1), 1, 1e7));
+            if (to < from) throw UsageError{"--sweep: TO is below FROM in " + quote_user_text(range, 40)};
+            for (int n = from; n <= to; n = std::max(n + 1, int(std::lround(n * 1.1)))) o.stress.push_back(n);
+            if (o.stress.back() != to) o.stress.push_back(to);
+            o.sweep = true;
         } else if (arg == "--accel") {
             for (const std::string& item : split_list(value())) {
                 const AccelBackend backend = parse_name(arg, item, accel_backend_names);
@@ -186,7 +203,7 @@ BenchOptions parse(int argc, char** argv) {
         else o.scenes.emplace_back(arg);
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)
-        throw UsageError{"choose --throughput, --stress, --write-stress or --convergence"};
+        throw UsageError{"choose --throughput, --stress, --sweep, --write-stress or --convergence"};
     if (o.throughput && o.accel.size() > 1) throw UsageError{"--throughput takes one --accel"};
     if (o.accel.empty()) {
         if (o.throughput) o.accel = {AccelBackend::automatic};
@@ -257,7 +274,30 @@ int bench_throughput(const BenchOptions& o) {
     return 0;
 }
 
+// --sweep's summary of one BVH's ns per ray at the sweep's counts.
+void print_sweep_summary(const char* bvh, const std::vector<int>& counts, const std::vector<double>& ns) {
+    double largest = 0, band_lo = kInfinity, band_hi = 0;
+    size_t at = 0;
+    int steps = 0;
+    for (size_t i = 1; i < counts.size(); ++i) {
+        const double rise = ns[i] / ns[i - 1];
+        if (rise > 1.15) ++steps;
+        if (rise > largest) largest = rise, at = i;
+    }
+    for (size_t i = 0; i < counts.size(); ++i)
+        if (counts[i] > 64) {
+            const double per_log = ns[i] / std::log2(double(counts[i]) + 1);
+            band_lo = std::min(band_lo, per_log);
+            band_hi = std::max(band_hi, per_log);
+        }
+    std::printf("| %s | %+.0f %% | %d to %d | %d | ", bvh, 100 * (largest - 1), at ? counts[at - 1] : 0,
+                at ? counts[at] : 0, steps);
+    if (band_hi > 0) std::printf("%.2f to %.2f | %.2fx |\n", band_lo, band_hi, band_hi / band_lo);
+    else std::printf("- | - |\n");
+}
+
 int bench_stress(const BenchOptions& o) {
+    std::vector<std::vector<double>> sweep(o.accel.size());  // ns per ray, per BVH, per count
     std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N | paths |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int n : o.stress) {
@@ -290,14 +330,27 @@ int bench_stress(const BenchOptions& o) {
             const SphereBvh& bvh = scenes[k].bvh;
             const bool own = bvh.backend() == AccelBackend::own;
             const double ns_ray = median(ns[k]);
+            sweep[k].push_back(ns_ray);
+            // How the SIMD lanes cast rays: the clusters a scan tests, or their tree.
+            const char* lanes = bvh.one_leaf() ? "" : !bvh.lane_tree().clusters.empty() ? ", scan"
+                                                  : !bvh.lane_tree().nodes.empty()     ? ", tree"
+                                                                                       : "";
             std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f | %s |\n", n,
                         o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())).c_str(),
                         own ? std::to_string(bvh.node_count()).c_str() : "-",
                         own ? std::to_string(bvh.depth()).c_str() : "-", prepare_ms, build_ms[k], median(seconds[k]),
                         ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1),
-                        std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))).c_str());
+                        (std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))) + lanes).c_str());
         }
         std::fflush(stdout);
+    }
+    if (o.sweep) {
+        std::printf("\nSweep of %zu counts, %d to %d (%d threads, %d runs, %d x %d at 4 spp):\n\n", o.stress.size(),
+                    o.stress.front(), o.stress.back(), omp_get_max_threads(), o.runs, o.size, o.size);
+        std::printf("| --accel | largest step | between | steps over 15 %% | ns/ray / log2 N above 64 | band |\n");
+        std::printf("|---|---|---|---|---|---|\n");
+        for (size_t k = 0; k < o.accel.size(); ++k)
+            print_sweep_summary(std::string(accel_backend_names.name(o.accel[k])).c_str(), o.stress, sweep[k]);
     }
     return 0;
 }
@@ -314,6 +367,13 @@ int run_bench(int argc, char** argv) {
         return report_usage(e, kBenchUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
+    // Embree's module, asked for by name: loaded before anything is measured.
+    if (std::find(o.accel.begin(), o.accel.end(), AccelBackend::embree) != o.accel.end()) try {
+            embree_module();
+        } catch (const std::runtime_error& e) {
+            std::fprintf(stderr, "error: bench --accel embree: %s\n", e.what());
+            return 1;
+        }
     if (o.write_stress > 0) {
         std::error_code ec;
         if (fs::exists(o.write_path, ec)) {

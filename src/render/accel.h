@@ -18,6 +18,7 @@ namespace kr {
 struct Ray;
 struct SphereGeom;
 struct EmbreeSpheres;  // accel_embree.cpp
+struct EmbreeModule;
 
 // own:       our BVH. One leaf, without any box test, for up to 16 spheres: the faster one
 //            for small scenes (the brief's have 5 to 10 spheres).
@@ -132,12 +133,24 @@ private:
     int depth_ = 0;
     LaneTree lane_tree_;
     std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
+    const EmbreeModule* embree_functions_ = nullptr;  // the module's, with embree_
     uint64_t build_id_ = 0;                        // a number per build() in this process
 };
 
-// Embree's side (accel_embree.cpp, only in builds with Embree).
-std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<SphereGeom>& spheres);
-int embree_closest(const EmbreeSpheres& accel, const Ray& ray, double& t);
-bool embree_any(const EmbreeSpheres& accel, const Ray& ray);
+// Embree's side: the module keithray_embree.so (accel_embree.cpp, built where CMake found
+// libembree-dev), loaded with libembree3 and TBB the first time a scene is given to Embree
+// (core/module.h). The program passes it its sphere test; it returns its functions.
+struct EmbreeHost {
+    double (*accepted_root)(const SphereGeom& s, int index, const Ray& ray, bool shadow);
+};
+struct EmbreeModule {
+    std::shared_ptr<const EmbreeSpheres> (*build)(const std::vector<SphereGeom>& spheres);
+    int (*closest)(const EmbreeSpheres& accel, const Ray& ray, double& t);
+    bool (*any)(const EmbreeSpheres& accel, const Ray& ray);
+    const char* embree_version;
+};
+// Loads the module once; throws std::runtime_error (one line naming its file and what is
+// missing) where this build has no Embree or the module or libembree3 cannot be loaded.
+const EmbreeModule& embree_module();
 
 }  // namespace kr
