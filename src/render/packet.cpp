@@ -28,6 +28,7 @@
 #include "core/sampling.h"
 #include "render/lanes.h"
 #include "render/path.h"
+#include "render/precision.h"
 #include "render/trace.h"
 #include "render/vertex.h"
 
@@ -191,14 +192,14 @@ PacketKernels isa_kernels(const RenderSettings& settings) {
 }  // namespace
 
 bool float_lanes_fit(const RenderScene& scene) {
-    // Geometry: the largest distance is bounded by the camera's (its lens included) and the
-    // spheres' distances from the origin, as rays start at the camera or on a sphere.
+    // The largest distance is bounded by the camera's (its lens included) and the spheres'
+    // distances from the origin, as rays start at the camera or on a sphere.
     double largest = length(scene.camera.position) + std::max(scene.camera.lens_radius, 0.0), smallest_radius = kInf;
     for (const SphereGeom& s : scene.spheres) {
         largest = std::max(largest, length(s.centre) + s.radius);
         smallest_radius = std::min(smallest_radius, s.radius);
     }
-    if (!(std::isfinite(largest) && smallest_radius > 0 && largest <= 0x1.0p12 * smallest_radius)) return false;
+    if (!(std::isfinite(largest) && smallest_radius > 0)) return false;
     // Absolute range: the lanes square distances and radii, which must stay normal floats
     // (2^-126..2^128) with room for the products they enter; lengths of 2^-40..2^40 do.
     if (!(smallest_radius >= 0x1.0p-40 && largest <= 0x1.0p40)) return false;
@@ -214,7 +215,9 @@ bool float_lanes_fit(const RenderScene& scene) {
     for (const PointLight& light : scene.point_lights)
         if (!in_range(light.intensity)) return false;
     // Gaps: surfaces and lights no nearer each other than the lanes' rounding resolves.
-    return scene.float_gaps_resolved;
+    // Sizes (last, the dearest): each sphere's tests round to well under its radius
+    // (float_sizes_fit, precision.h), once per pass.
+    return scene.float_gaps_resolved && float_sizes_fit(scene);
 }
 
 PacketKernels cpu_kernels(PacketIsa isa) {

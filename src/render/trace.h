@@ -86,7 +86,9 @@ void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene,
                                 const uint32_t* index_reversed, int count, SampleResult* results);
 
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
-// distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
+// distance a sphere test meets, stays below 2^-12 of the sphere's radius (float_sizes_fit,
+// render/precision.h: at once where the whole scene is within 2^12 smallest radii, else
+// sphere by sphere over the points rays can reach), every length is
 // within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
 // inside their range (2^-60 to 2^60; a light of 1e30 is double's), and its rays resolve
 // the gaps between its surfaces and lights (scene.float_gaps_resolved, render/precision.h).
