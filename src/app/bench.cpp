@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -33,8 +34,8 @@ namespace {
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
                  [--kernels best|double|float8|any|off] [--lens R]
-  keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
-  keithray bench --sweep FROM:TO [--accel LIST] [--runs N] [--threads N] [--size W]
+  keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W] [--cpu-time]
+  keithray bench --sweep FROM:TO [--accel LIST] [--runs N] [--threads N] [--size W] [--cpu-time]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
@@ -57,9 +58,13 @@ constexpr const char* kBenchUsage = R"(Usage:
               The table's last column says which ran for each scene.
 --stress      generated scenes of N random spheres (and a floor and a lamp, two spheres
               more) under a sphere light, path traced at W x W (default 256) with 4 spp:
-              ns per ray and ns per ray / log2(N), and how paths were traced (the SIMD
-              lanes cast rays down their own tree under own and auto, up to
-              kLaneTreeMaxSpheres; embree traces one path at a time).
+              ns per ray and ns per ray / log2(N), and how paths were traced: in SIMD
+              lanes, which scan the spheres a cluster at a time up to 1,024 spheres
+              and walk their own tree above, or one path at a time. Under auto the
+              lanes take up to 1,024 spheres (eight float lanes 768, double lanes
+              128) and Embree one path at a time above; under own, up to 2,048
+              (eight float lanes 1,024, double lanes 320) and our own tree one path
+              at a time above; embree always traces one path at a time.
 --sweep       --stress at every count from FROM to TO, each about 10 % above the last,
               then per BVH its steps (the largest rise of ns per ray between
               neighbouring counts, and how many rise by more than 15 %) and its band
@@ -67,6 +72,9 @@ constexpr const char* kBenchUsage = R"(Usage:
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
               own,embree where the build has Embree, else own). With --throughput, one
               of them (default auto).
+--cpu-time    time --stress and --sweep by the process's CPU time rather than the
+              clock: on a machine other programs share, what the renders themselves
+              cost (with --threads 1, where no thread waits for work).
 --write-stress writes such a scene as a scene file (for the viewer).
 )";
 
@@ -78,6 +86,13 @@ namespace {
 
 double now_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The CPU time of all the process's threads.
+double cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 double median(std::vector<double> v) {
@@ -92,15 +107,17 @@ struct Timing {
 };
 
 // Renders `passes` passes into a fresh state, each planned as `keithray render` plans it
-// (adaptive allocation, by default); returns wall time and rays.
-Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes) {
+// (adaptive allocation, by default); returns wall time (or CPU time, `cpu`) and rays.
+Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes,
+                   bool cpu = false) {
+    const auto clock = cpu ? cpu_seconds : now_seconds;
     RenderState state(width, height);
-    const double start = now_seconds();
+    const double start = clock();
     for (int i = 0; i < passes; ++i) {
         state.plan_pass(settings);
         render_pass(scene, settings, state);
     }
-    return {now_seconds() - start, state.rays};
+    return {clock() - start, state.rays};
 }
 
 // N random spheres of a few diffuse colours in a cube of side 20, on a floor, under one
@@ -150,7 +167,7 @@ std::string stress_scene_json(int n, uint64_t seed, int indent = -1) {
 struct BenchOptions {
     bool throughput = false, linear = false;
     std::vector<int> stress;
-    bool sweep = false;
+    bool sweep = false, cpu_time = false;
     std::vector<AccelBackend> accel;
     int write_stress = 0;
     fs::path write_path;
@@ -168,6 +185,7 @@ BenchOptions parse(int argc, char** argv) {
         auto value = [&] { return args.value(); };
         if (arg == "--throughput") o.throughput = true;
         else if (arg == "--linear") o.linear = true;
+        else if (arg == "--cpu-time") o.cpu_time = true;
         else if (arg == "--fraction") o.fraction = parse_number(arg, value(), 1e-6, 1.0);
         else if (arg == "--runs") o.runs = int(parse_number(arg, value(), 1, 1000));
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
@@ -321,7 +339,7 @@ int bench_stress(const BenchOptions& o) {
         settings.kernels = o.kernels;
         for (int run = 0; run < o.runs; ++run)
             for (size_t k = 0; k < o.accel.size(); ++k) {
-                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4);
+                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4, o.cpu_time);
                 seconds[k].push_back(t.seconds);
                 // Per-ray cost on all threads together, as a user sees it.
                 ns[k].push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
@@ -345,8 +363,9 @@ int bench_stress(const BenchOptions& o) {
         std::fflush(stdout);
     }
     if (o.sweep) {
-        std::printf("\nSweep of %zu counts, %d to %d (%d threads, %d runs, %d x %d at 4 spp):\n\n", o.stress.size(),
-                    o.stress.front(), o.stress.back(), omp_get_max_threads(), o.runs, o.size, o.size);
+        std::printf("\nSweep of %zu counts, %d to %d (%d threads, %d runs, %d x %d at 4 spp, %s time):\n\n",
+                    o.stress.size(), o.stress.front(), o.stress.back(), omp_get_max_threads(), o.runs, o.size, o.size,
+                    o.cpu_time ? "CPU" : "wall");
         std::printf("| --accel | largest step | between | steps over 15 %% | ns/ray / log2 N above 64 | band |\n");
         std::printf("|---|---|---|---|---|---|\n");
         for (size_t k = 0; k < o.accel.size(); ++k)

@@ -490,7 +490,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     embree_functions_ = nullptr;
     lane_tree_ = {};
     if (backend != AccelBackend::embree && spheres.size() > size_t(kMaxLeafSpheres) &&
-        (backend == AccelBackend::own || spheres.size() <= kLaneTreeMaxSpheres))
+        spheres.size() <= (backend == AccelBackend::own ? kLaneOwnMaxSpheres : kLaneTreeMaxSpheres))
         lane_tree_ = build_lane_tree(spheres);
     if (backend == AccelBackend::embree) {
         const EmbreeModule& functions = embree_module();

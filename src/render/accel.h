@@ -40,9 +40,13 @@ bool embree_fits(const std::vector<SphereGeom>& spheres);
 
 // Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
 // well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
-// "Scenes of more than 16 spheres in the lanes": the single-precision lanes 1.7x Embree at
-// 128 spheres, the double lanes even at 256 and behind from 512).
-inline constexpr size_t kLaneTreeMaxSpheres = 256;
+// "Switch points": the single-precision lanes' scan meets Embree at about 1,100 spheres with
+// sixteen lanes and about 900 with eight; the double lanes stop earlier, packet.cpp).
+inline constexpr size_t kLaneTreeMaxSpheres = 1024;
+// Up to this many, AccelBackend::own builds it: above it one path down our own tree is the
+// faster (sixteen float lanes meet it at about 2,000 spheres; eight at about 1,200 and the
+// double lanes at about 350 stop earlier, packet.cpp).
+inline constexpr size_t kLaneOwnMaxSpheres = 2048;
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
@@ -67,8 +71,9 @@ struct LaneSphere {
     int32_t id;      // the sphere's index in the scene
 };
 // Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
-// walk the lane tree (docs/performance.md, "Sixteen single-precision lanes").
-inline constexpr size_t kLaneScanMaxSpheres = 128;
+// walk the lane tree (docs/performance.md, "Switch points": the scan is the cheaper up to
+// about 2,800 spheres with sixteen lanes and about 1,500 with eight).
+inline constexpr size_t kLaneScanMaxSpheres = 1024;
 // Spheres near each other that the scan tests after their box (boxed), or a sphere it tests
 // alone: scan_f[first, first + count).
 struct LaneCluster {
@@ -114,8 +119,8 @@ public:
     // Whether it is our one leaf, which the lanes test sphere by sphere without a box.
     bool one_leaf() const { return !embree_ && nodes_.size() == 1; }
     // The tree the lanes walk, built beside ours or Embree's for more than 16 spheres: up to
-    // kLaneTreeMaxSpheres under `automatic`, at any count under `own`, never under `embree`
-    // (which so measures one path through Embree's tree).
+    // kLaneTreeMaxSpheres under `automatic`, kLaneOwnMaxSpheres under `own`, never under
+    // `embree` (which so measures one path through Embree's tree).
     const LaneTree& lane_tree() const { return lane_tree_; }
 
     // Whether this and `other` are copies of one build (their trees are the same).

@@ -226,12 +226,37 @@ PacketKernels cpu_kernels(PacketIsa isa) {
     return isa_kernels(settings);
 }
 
+namespace {
+
+// The most spheres each kind of lanes takes under `best` (beyond one leaf) before one path at
+// a time is the faster: down Embree's tree where `automatic` built it beside the lanes' tree,
+// else down our own. Measured on the stress scenes, one thread, CPU time (`bench --stress N
+// --accel own,embree --kernels K --cpu-time --threads 1`; docs/performance.md, "Switch
+// points"). The sixteen float lanes' are the lane tree's own limits (accel.h).
+size_t lanes_max_spheres(PacketKernels kernels, bool beside_embree) {
+    switch (kernels) {
+    case PacketKernels::x86_64_v4_float: return beside_embree ? kLaneTreeMaxSpheres : kLaneOwnMaxSpheres;
+    case PacketKernels::x86_64_v3_float: return beside_embree ? 768 : 1024;
+    case PacketKernels::x86_64_v3:
+    case PacketKernels::x86_64: return beside_embree ? 128 : 320;
+    case PacketKernels::one_path: break;
+    }
+    return std::numeric_limits<size_t>::max();
+}
+
+}  // namespace
+
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
     if (!packets_apply(scene, settings)) return PacketKernels::one_path;
-    const PacketKernels kernels = isa_kernels(settings);
+    PacketKernels kernels = isa_kernels(settings);
     if ((kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float) &&
         !float_lanes_fit(scene))
-        return PacketKernels::x86_64_v3;
+        kernels = PacketKernels::x86_64_v3;
+    // Kernels asked for by name run wherever they can (to measure them); `best` only where
+    // they are the faster.
+    if (settings.kernels == PacketIsa::best && !scene.bvh.one_leaf() &&
+        scene.spheres.size() > lanes_max_spheres(kernels, scene.bvh.backend() == AccelBackend::embree))
+        return PacketKernels::one_path;
     return kernels;
 }
 

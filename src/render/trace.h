@@ -62,7 +62,8 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
 
 // What trace_samples runs for path tracing with these settings on this scene, as the
-// settings' kernels, the CPU and the scene decide.
+// settings' kernels, the CPU and the scene decide (under `best`, each kind of lanes only up
+// to the sphere count where one path at a time becomes the faster: packet.cpp).
 enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_v4_float };
 inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
