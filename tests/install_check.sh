@@ -5,7 +5,9 @@
 #       prefix removed; then, from another folder: --version, render without a scene (the
 #       bundled scenes into ./output/), render of an installed scene, compare against a
 #       bundled reference, the viewer under Xvfb (its default scene, the Open list's examples,
-#       Save of a read-only bundled scene), the man page, the bash completion, the desktop entry.
+#       Save of a read-only bundled scene), the man page, the bash completion, the desktop entry;
+#       the modules in lib/keithray/ (the program links none of their libraries; each missing
+#       one refused in one line).
 #   install_check.sh package BUILD_DIR
 #       `cpack -G DEB` into a temporary folder: the package's file list and dependencies
 #       (dpkg-deb -c, -I), and the program run from its files extracted into a folder.
@@ -30,6 +32,20 @@ check_program() {
   local root=$1 kr=$1/bin/keithray data=$1/share/keithray
   [ -x "$kr" ] || fail "no $kr"
   [ ! -e "$root/bin/keithray-res.path" ] || fail "the build's marker file was installed"
+  [ ! -e "$root/bin/keithray-modules.path" ] || fail "the build's module marker file was installed"
+  # The modules (core/module.h), and the program itself links none of their libraries.
+  local modules version
+  version=$("$kr" --version)
+  modules=$(grep -o 'module [^ ,)]*keithray_viewer.so' <<<"$version" | cut -d' ' -f2)
+  modules=$(dirname "$modules")
+  for m in viewer $(grep -q '^MPI: yes' <<<"$version" && echo mpi) $(grep -q '^Embree: yes' <<<"$version" && echo embree); do
+    [ -f "$modules/keithray_$m.so" ] || fail "no module $modules/keithray_$m.so: $version"
+    case $modules in "$root"/*) ;; *) fail "the module keithray_$m.so found outside the tree: $modules" ;; esac
+    if grep -aqF "$source_res" "$modules/keithray_$m.so"; then fail "keithray_$m.so holds the source tree's path"; fi
+  done
+  if ldd "$kr" | grep -E 'libembree|libtbb|libmpi|libOSMesa|libglfw|libGL'; then
+    fail "$kr links a module's library itself"
+  fi
   # Nothing compiled in leads back to the sources.
   if grep -aqF "$source_res" "$kr"; then fail "$kr holds the source tree's path $source_res"; fi
   for n in 1 2 3 4 5 6 7 8; do
@@ -45,6 +61,7 @@ check_program() {
   # --version and -V
   "$kr" --version >version.txt || fail "--version exit $?"
   grep -Eq '^keithray [0-9]+\.[0-9]+' version.txt || fail "--version: $(cat version.txt)"
+  if grep -q ', missing)' version.txt; then fail "--version says a module is missing: $(cat version.txt)"; fi
   grep -Fq "bundled scenes: $(cd "$data" && pwd -P) (installed)" version.txt ||
     grep -Fq "bundled scenes: $data (installed)" version.txt || fail "--version names no installed scenes: $(cat version.txt)"
   for word in "build: " "SIMD kernels on this CPU: " "Embree: " "MPI: " "viewer: yes"; do
@@ -159,6 +176,32 @@ tree)
   grep -q "no bundled scenes found (looked in .*/alone/share/keithray.*give a SCENE.json" err.txt ||
     fail "render without scene or share/ says: $(cat err.txt)"
   [ ! -e output ] || fail "render without scene or share/ wrote output/"
+  # Without its lib/keithray/: what needs a module says so in one line naming the file (exit 1);
+  # what does not runs.
+  status=0
+  ../bin/keithray view "$tmp/copy/share/keithray/scenes/assignment_03.json" >out.txt 2>err.txt || status=$?
+  [ "$status" = 1 ] || fail "view without its module: exit $status"
+  [ "$(wc -l <err.txt)" = 1 ] && grep -q "^error: the viewer: its module .*/alone/lib/keithray/keithray_viewer.so is missing" err.txt ||
+    fail "view without its module says: $(cat err.txt)"
+  status=0
+  ../bin/keithray render "$tmp/copy/share/keithray/scenes/assignment_03.json" --gl --spp 1 -q -o gl.png >out.txt 2>err.txt || status=$?
+  [ "$status" = 1 ] || fail "render --gl without its module: exit $status"
+  [ "$(wc -l <err.txt)" = 1 ] && grep -q "^error: --gl: the viewer: its module .*keithray_viewer.so is missing" err.txt ||
+    fail "render --gl without its module says: $(cat err.txt)"
+  [ ! -e gl.png ] || fail "render --gl without its module wrote gl.png"
+  ../bin/keithray render "$tmp/copy/share/keithray/scenes/assignment_03.json" --spp 1 -q -o plain.png >out.txt 2>err.txt ||
+    fail "render without the modules: $(cat err.txt)"
+  if grep -q '^Embree: yes' <("$tmp/copy/bin/keithray" --version); then
+    status=0
+    ../bin/keithray bench --stress 40 --accel embree --runs 1 --size 8 >out.txt 2>err.txt || status=$?
+    [ "$status" = 1 ] && [ "$(wc -l <err.txt)" = 1 ] &&
+      grep -q "^error: bench --accel embree: Embree: its module .*keithray_embree.so is missing" err.txt ||
+      fail "bench --accel embree without its module: exit $status: $(cat err.txt)"
+    # auto: our own BVH takes the scene.
+    ../bin/keithray bench --stress 40 --accel auto --runs 1 --size 8 >out.txt 2>err.txt ||
+      fail "bench --accel auto without Embree's module: $(cat err.txt)"
+    grep -q '| 40 | own |' out.txt || fail "bench --accel auto without Embree's module: $(cat out.txt)"
+  fi
   ;;
 package)
   command -v dpkg-deb >/dev/null || fail "dpkg-deb missing"
@@ -172,12 +215,13 @@ package)
     ./usr/share/applications/keithray.desktop ./usr/share/icons/hicolor/scalable/apps/keithray.svg; do
     grep -qx -- "$f" "$tmp/files.txt" || fail "the package lacks $f"
   done
-  if grep -q 'keithray-res.path\|/output/' "$tmp/files.txt"; then fail "the package holds build files: $(grep 'keithray-res.path\|/output/' "$tmp/files.txt")"; fi
+  grep -qx './usr/lib/keithray/keithray_viewer.so' "$tmp/files.txt" || fail "the package lacks the viewer module"
+  if grep -q 'keithray-res.path\|keithray-modules.path\|/output/' "$tmp/files.txt"; then fail "the package holds build files: $(grep 'keithray-res.path\|keithray-modules.path\|/output/' "$tmp/files.txt")"; fi
   dpkg-deb -I "$deb" >"$tmp/info.txt"
   grep -q '^ Package: keithray$' "$tmp/info.txt" || fail "package name: $(cat "$tmp/info.txt")"
   depends=$(grep '^ Depends:' "$tmp/info.txt") || fail "the package has no Depends: $(cat "$tmp/info.txt")"
-  # The libraries this build linked, as their Debian packages.
-  libs=$(ldd "$build/keithray")
+  # The libraries this build linked, the program's and its modules', as their Debian packages.
+  libs=$(ldd "$build/keithray" "$build"/modules/keithray_*.so)
   for pair in "libembree3:libembree3" "libOpenEXR:libopenexr" "libglfw:libglfw3" "libOSMesa:libosmesa6" \
     "libmpi:libopenmpi" "libgomp:libgomp1" "libstdc++:libstdc++6"; do
     lib=${pair%%:*} pkg=${pair#*:}
@@ -191,6 +235,7 @@ package)
   kr=$tmp/root/usr/bin/keithray
   mkdir "$tmp/work" && cd "$tmp/work"
   grep -q "(installed)" <<<"$("$kr" --version)" || fail "the packaged keithray finds no installed scenes: $("$kr" --version)"
+  if grep -q ', missing)' <<<"$("$kr" --version)"; then fail "the packaged keithray misses a module: $("$kr" --version)"; fi
   "$kr" render "$tmp/root/usr/share/keithray/scenes/assignment_02.json" --spp 1 --threads 2 -q >/dev/null ||
     fail "the packaged keithray's render"
   [ -s output/assignment_02.ppm ] || fail "the packaged keithray wrote no output/assignment_02.ppm"

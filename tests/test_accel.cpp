@@ -252,7 +252,8 @@ TEST(Accel, LaneClustersHoldEverySphereOnce) {
     }
     EXPECT_EQ(next, scene.spheres.size());
     EXPECT_GE(boxed, 60u / 8);
-    const RenderScene many = with_backend(random_spheres(200, 1.0, 7, true), AccelBackend::own);
+    const RenderScene many =
+        with_backend(random_spheres(int(kLaneScanMaxSpheres) + 8, 1.0, 7, true), AccelBackend::own);
     EXPECT_FALSE(many.bvh.lane_tree().nodes.empty());
     EXPECT_TRUE(many.bvh.lane_tree().clusters.empty());
     EXPECT_TRUE(many.bvh.lane_tree().scan_f.empty());

@@ -252,6 +252,20 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     // One row per BVH: ours, and Embree's where the build has it.
     EXPECT_NE(r.out.find("| 20 | own |"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("| 20 | embree |") != std::string::npos, kr::embree_available()) << r.out;
+    // --sweep: every count about 10 % above the last (8, 9, 10 here), then each BVH's steps and band.
+    r = cli("bench --sweep 8:10 --runs 1 --size 8 --accel own");
+    EXPECT_EQ(r.status, 0) << r.err;
+    for (const char* row : {"| 8 | own |", "| 9 | own |", "| 10 | own |", "Sweep of 3 counts, 8 to 10", "| own | "})
+        EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
+    EXPECT_NE(r.out.find("at 4 spp, wall time)"), std::string::npos) << r.out;
+    // --cpu-time: the same, timed by the process's CPU time.
+    r = cli("bench --sweep 8:9 --runs 1 --size 8 --accel own --threads 1 --cpu-time");
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(r.out.find("| 9 | own |"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("(1 threads, 1 runs, 8 x 8 at 4 spp, CPU time)"), std::string::npos) << r.out;
+    r = cli("bench --sweep 10:8");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_NE(r.err.find("--sweep: TO is below FROM in \"10:8\""), std::string::npos) << r.err;
     r = cli("bench --stress 20 --runs 1 --size 16 --accel bogus");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--accel expects \"auto\", \"own\" or \"embree\""), std::string::npos) << r.err;

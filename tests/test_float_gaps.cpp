@@ -6,6 +6,7 @@
 // NaN sample, and the brief's scenes keep the float lanes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -264,6 +265,50 @@ TEST(FloatGaps, EveryKernelRendersHostileScenesAsOnePath) {
                                  << " (limit " << r.z_limit << "), chi2 " << r.chi_square << " (limit "
                                  << r.chi_square_limit << ")";
         }
+    }
+}
+
+// The size rule sphere by sphere (float_sizes_fit): a floor of radius 1000, its far side
+// 2,001.5 from the origin, beside balls of radius 0.4, so the scene spans 5,000 smallest radii
+// (the global rule's limit is 4,096); but from a camera 1.5 above the floor rays reach it
+// only within about 110 of the origin. The float lanes take it, and render one path's image
+// (at another seed). A glass floor (rays cross it to its far side), a camera inside the
+// floor, or one 1,000 above it (its tangent to the floor 1,734 long) keep the double lanes.
+RenderScene far_floor_scene(MaterialType floor_type, const Vec3& camera) {
+    test::SceneBuilder b;
+    b.scene.renderer.width = b.scene.renderer.height = 16;
+    b.scene.cameras[0].position = camera;
+    const int grey = b.material(MaterialType::diffuse, Color(0.7));
+    b.sphere({0, -1001.5, 0}, 1000, b.material(floor_type, Color(0.7)));
+    for (int i = 0; i < 6; ++i) b.sphere({-2.5 + i, -1.0 + 0.3 * i, 0.5 * (i % 2)}, 0.4, grey);
+    b.emitter({0, 3, 0}, 0.5, Color(5), grey);
+    return b.build();
+}
+
+TEST(FloatGaps, SizesAreJudgedWhereRaysReach) {
+    const RenderScene scene = far_floor_scene(MaterialType::diffuse, {0, 0, -10});
+    double largest = 0, smallest = kInfinity;
+    for (const SphereGeom& s : scene.spheres) {
+        largest = std::max(largest, length(s.centre) + s.radius);
+        smallest = std::min(smallest, s.radius);
+    }
+    EXPECT_GT(largest, kFloatSizeRatio * smallest);  // beyond the global rule
+    EXPECT_TRUE(float_reach_fits(scene));
+    EXPECT_TRUE(float_lanes_fit(scene));
+    EXPECT_FALSE(float_lanes_fit(far_floor_scene(MaterialType::dielectric, {0, 0, -10})));
+    EXPECT_FALSE(float_lanes_fit(far_floor_scene(MaterialType::diffuse, {0, -10, -10})));
+    EXPECT_FALSE(float_lanes_fit(far_floor_scene(MaterialType::diffuse, {0, 1000, -10})));
+
+    const int passes = 48;
+    uint64_t nonfinite = 0;
+    const HdrImage one_path = render(scene, PacketIsa::one_path, 1, passes, nonfinite);
+    EXPECT_EQ(nonfinite, 0u);
+    for (PacketIsa kernels : {PacketIsa::best, PacketIsa::float8}) {
+        const HdrImage lanes = render(scene, kernels, 2, passes, nonfinite);
+        EXPECT_EQ(nonfinite, 0u) << packet_isa_names.name(kernels);
+        const StatisticalResult r = statistical_compare(lanes, "lanes", one_path, "one path", {});
+        EXPECT_TRUE(r.agree) << packet_isa_names.name(kernels) << ": max |z| " << r.max_abs_z << " (limit "
+                             << r.z_limit << "), chi2 " << r.chi_square << " (limit " << r.chi_square_limit << ")";
     }
 }
 

@@ -1,13 +1,17 @@
 // Where keithray finds its bundled files (core/data_dir.h) and what it never writes: the
 // lookup from the executable's folder in an install tree and in a build tree, the outputs of
 // bundled scenes moved out of the install tree, the viewer's read-only scenes. The installed
-// program itself is run by tests/install_check.sh (Install.*).
+// program itself is run by tests/install_check.sh (Install.*). Likewise its modules
+// (core/module.h): found beside bin/ in an install, through the marker in a build tree, and a
+// missing one refused in one line that names its file.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 
 #include "core/data_dir.h"
+#include "core/module.h"
+#include "render/accel.h"
 #include "scene/scene_list.h"
 #include "viewer/save_dialog.h"
 #include "test_util.h"
@@ -16,6 +20,43 @@ namespace fs = std::filesystem;
 using namespace kr;
 
 class DataDirLookup : public test::ScratchDirTest {};
+
+TEST_F(DataDirLookup, ModulesInTheInstallTreeWinOverTheBuildMarker) {
+    const fs::path installed = (dir / "prefix/bin" / installed_modules_from_bin()).lexically_normal();
+    fs::create_directories(installed);
+    fs::create_directories(dir / "prefix/bin");
+    fs::create_directories(dir / "modules");
+    write("modules/keithray_viewer.so", "");
+    write("prefix/bin/keithray-modules.path", (dir / "modules").string() + "\n");
+    // Only the build's: found through the marker.
+    EXPECT_EQ(find_module(dir / "prefix/bin", "viewer"), dir / "modules/keithray_viewer.so");
+    std::ofstream(installed / "keithray_viewer.so").put('x');
+    EXPECT_EQ(find_module(dir / "prefix/bin", "viewer"), installed / "keithray_viewer.so");
+    // Neither: the install's place, for the message.
+    EXPECT_EQ(find_module(dir / "prefix/bin", "mpi"), installed / "keithray_mpi.so");
+    EXPECT_EQ(find_module(dir / "elsewhere", "mpi"),
+              (dir / "elsewhere" / installed_modules_from_bin() / "keithray_mpi.so").lexically_normal());
+}
+
+TEST(Modules, AMissingModuleIsRefusedInOneLineNamingItsFile) {
+    try {
+        load_module("no_such_part", nullptr, "the part", "libnothing");
+        FAIL() << "a missing module loaded";
+    } catch (const std::runtime_error& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("the part: its module "), std::string::npos) << message;
+        EXPECT_NE(message.find("keithray_no_such_part.so is missing"), std::string::npos) << message;
+        EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    }
+}
+
+TEST(Modules, TheTestBinaryLoadsTheBuildsEmbreeModule) {
+    if (!embree_available()) GTEST_SKIP() << "this build has no Embree";
+    const EmbreeModule& module = embree_module();
+    EXPECT_NE(module.build, nullptr);
+    EXPECT_STRNE(module.embree_version, "");
+    EXPECT_EQ(&module, &embree_module());  // loaded once
+}
 
 TEST_F(DataDirLookup, InstallTreeBesideBinWinsOverTheBuildMarker) {
     fs::create_directories(dir / "prefix/bin");

@@ -8,6 +8,7 @@
 // agree to their rounding (lane_tolerance below).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <optional>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "render/precision.h"
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "scene/load.h"
@@ -301,6 +303,15 @@ TEST_P(Packet, ManySpheresAsOneByOne) {
         ASSERT_TRUE(scene.bvh.packets());
         ASSERT_FALSE(scene.bvh.one_leaf());
         ASSERT_FALSE(scene.bvh.lane_tree().nodes.empty());
+        // The floor's far side is 2,004 from the origin, beyond 4,096 of the smallest radii;
+        // rays reach the floor only within about 150 of it, so its sizes fit the float lanes
+        // (float_sizes_fit, render/precision.h), which take the first scene (the second has
+        // glass too near other surfaces: float_gaps_resolved).
+        double smallest = kInfinity;
+        for (const SphereGeom& s : scene.spheres) smallest = std::min(smallest, s.radius);
+        EXPECT_GT(2004, kFloatSizeRatio * smallest) << n;
+        EXPECT_TRUE(float_sizes_fit(scene)) << n;
+        EXPECT_EQ(float_lanes_fit(scene), n == 40) << n << " " << scene.float_gaps_resolved;
         for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area})
             for (Estimator estimator : {Estimator::sobol, Estimator::uniform}) {
                 RenderSettings settings = settings_of(scene);

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -33,7 +34,8 @@ namespace {
 constexpr const char* kBenchUsage = R"(Usage:
   keithray bench --throughput [SCENE.json ...] [--fraction F] [--runs N] [--threads N] [--linear|--accel NAME]
                  [--kernels best|double|float8|any|off] [--lens R]
-  keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W]
+  keithray bench --stress N[,N...] [--accel LIST] [--runs N] [--threads N] [--size W] [--cpu-time]
+  keithray bench --sweep FROM:TO [--accel LIST] [--runs N] [--threads N] [--size W] [--cpu-time]
   keithray bench --write-stress N OUT.json
   keithray bench --convergence [SCENE.json ...] [options]   (see keithray bench --convergence --help)
 
@@ -56,12 +58,23 @@ constexpr const char* kBenchUsage = R"(Usage:
               The table's last column says which ran for each scene.
 --stress      generated scenes of N random spheres (and a floor and a lamp, two spheres
               more) under a sphere light, path traced at W x W (default 256) with 4 spp:
-              ns per ray and ns per ray / log2(N), and how paths were traced (the SIMD
-              lanes cast rays down their own tree under own and auto, up to
-              kLaneTreeMaxSpheres; embree traces one path at a time).
+              ns per ray and ns per ray / log2(N), and how paths were traced: in SIMD
+              lanes, which scan the spheres a cluster at a time up to 1,024 spheres
+              and walk their own tree above, or one path at a time. Under auto the
+              lanes take up to 1,024 spheres (eight float lanes 768, double lanes
+              128) and Embree one path at a time above; under own, up to 2,048
+              (eight float lanes 1,024, double lanes 320) and our own tree one path
+              at a time above; embree always traces one path at a time.
+--sweep       --stress at every count from FROM to TO, each about 10 % above the last,
+              then per BVH its steps (the largest rise of ns per ray between
+              neighbouring counts, and how many rise by more than 15 %) and its band
+              (the largest over the smallest ns per ray / log2 N above 64 spheres).
 --accel LIST  the BVHs --stress compares, runs interleaved: own, embree, auto (default:
               own,embree where the build has Embree, else own). With --throughput, one
               of them (default auto).
+--cpu-time    time --stress and --sweep by the process's CPU time rather than the
+              clock: on a machine other programs share, what the renders themselves
+              cost (with --threads 1, where no thread waits for work).
 --write-stress writes such a scene as a scene file (for the viewer).
 )";
 
@@ -73,6 +86,13 @@ namespace {
 
 double now_seconds() {
     return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The CPU time of all the process's threads.
+double cpu_seconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 double median(std::vector<double> v) {
@@ -87,15 +107,17 @@ struct Timing {
 };
 
 // Renders `passes` passes into a fresh state, each planned as `keithray render` plans it
-// (adaptive allocation, by default); returns wall time and rays.
-Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes) {
+// (adaptive allocation, by default); returns wall time (or CPU time, `cpu`) and rays.
+Timing time_render(const RenderScene& scene, const RenderSettings& settings, int width, int height, int passes,
+                   bool cpu = false) {
+    const auto clock = cpu ? cpu_seconds : now_seconds;
     RenderState state(width, height);
-    const double start = now_seconds();
+    const double start = clock();
     for (int i = 0; i < passes; ++i) {
         state.plan_pass(settings);
         render_pass(scene, settings, state);
     }
-    return {now_seconds() - start, state.rays};
+    return {clock() - start, state.rays};
 }
 
 // N random spheres of a few diffuse colours in a cube of side 20, on a floor, under one
@@ -145,6 +167,7 @@ std::string stress_scene_json(int n, uint64_t seed, int indent = -1) {
 struct BenchOptions {
     bool throughput = false, linear = false;
     std::vector<int> stress;
+    bool sweep = false, cpu_time = false;
     std::vector<AccelBackend> accel;
     int write_stress = 0;
     fs::path write_path;
@@ -162,6 +185,7 @@ BenchOptions parse(int argc, char** argv) {
         auto value = [&] { return args.value(); };
         if (arg == "--throughput") o.throughput = true;
         else if (arg == "--linear") o.linear = true;
+        else if (arg == "--cpu-time") o.cpu_time = true;
         else if (arg == "--fraction") o.fraction = parse_number(arg, value(), 1e-6, 1.0);
         else if (arg == "--runs") o.runs = int(parse_number(arg, value(), 1, 1000));
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
@@ -171,6 +195,17 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--stress") {
             for (const std::string& item : split_list(value()))
                 o.stress.push_back(int(parse_number("--stress", item, 1, 1e7)));
+        } else if (arg == "--sweep") {
+            const std::string range = value();
+            const size_t colon = range.find(':');
+            if (colon == std::string::npos)
+                throw UsageError{"--sweep: expected FROM:TO (sphere counts), got " + quote_user_text(range, 40)};
+            const int from = int(parse_number("--sweep", range.substr(0, colon), 1, 1e7));
+            const int to = int(parse_number("--sweep", range.substr(colon + 1), 1, 1e7));
+            if (to < from) throw UsageError{"--sweep: TO is below FROM in " + quote_user_text(range, 40)};
+            for (int n = from; n <= to; n = std::max(n + 1, int(std::lround(n * 1.1)))) o.stress.push_back(n);
+            if (o.stress.back() != to) o.stress.push_back(to);
+            o.sweep = true;
         } else if (arg == "--accel") {
             for (const std::string& item : split_list(value())) {
                 const AccelBackend backend = parse_name(arg, item, accel_backend_names);
@@ -186,7 +221,7 @@ BenchOptions parse(int argc, char** argv) {
         else o.scenes.emplace_back(arg);
     }
     if (!o.throughput && o.stress.empty() && o.write_stress == 0)
-        throw UsageError{"choose --throughput, --stress, --write-stress or --convergence"};
+        throw UsageError{"choose --throughput, --stress, --sweep, --write-stress or --convergence"};
     if (o.throughput && o.accel.size() > 1) throw UsageError{"--throughput takes one --accel"};
     if (o.accel.empty()) {
         if (o.throughput) o.accel = {AccelBackend::automatic};
@@ -257,7 +292,30 @@ int bench_throughput(const BenchOptions& o) {
     return 0;
 }
 
+// --sweep's summary of one BVH's ns per ray at the sweep's counts.
+void print_sweep_summary(const char* bvh, const std::vector<int>& counts, const std::vector<double>& ns) {
+    double largest = 0, band_lo = kInfinity, band_hi = 0;
+    size_t at = 0;
+    int steps = 0;
+    for (size_t i = 1; i < counts.size(); ++i) {
+        const double rise = ns[i] / ns[i - 1];
+        if (rise > 1.15) ++steps;
+        if (rise > largest) largest = rise, at = i;
+    }
+    for (size_t i = 0; i < counts.size(); ++i)
+        if (counts[i] > 64) {
+            const double per_log = ns[i] / std::log2(double(counts[i]) + 1);
+            band_lo = std::min(band_lo, per_log);
+            band_hi = std::max(band_hi, per_log);
+        }
+    std::printf("| %s | %+.0f %% | %d to %d | %d | ", bvh, 100 * (largest - 1), at ? counts[at - 1] : 0,
+                at ? counts[at] : 0, steps);
+    if (band_hi > 0) std::printf("%.2f to %.2f | %.2fx |\n", band_lo, band_hi, band_hi / band_lo);
+    else std::printf("- | - |\n");
+}
+
 int bench_stress(const BenchOptions& o) {
+    std::vector<std::vector<double>> sweep(o.accel.size());  // ns per ray, per BVH, per count
     std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N | paths |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (int n : o.stress) {
@@ -281,7 +339,7 @@ int bench_stress(const BenchOptions& o) {
         settings.kernels = o.kernels;
         for (int run = 0; run < o.runs; ++run)
             for (size_t k = 0; k < o.accel.size(); ++k) {
-                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4);
+                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4, o.cpu_time);
                 seconds[k].push_back(t.seconds);
                 // Per-ray cost on all threads together, as a user sees it.
                 ns[k].push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
@@ -290,14 +348,28 @@ int bench_stress(const BenchOptions& o) {
             const SphereBvh& bvh = scenes[k].bvh;
             const bool own = bvh.backend() == AccelBackend::own;
             const double ns_ray = median(ns[k]);
+            sweep[k].push_back(ns_ray);
+            // How the SIMD lanes cast rays: the clusters a scan tests, or their tree.
+            const char* lanes = bvh.one_leaf() ? "" : !bvh.lane_tree().clusters.empty() ? ", scan"
+                                                  : !bvh.lane_tree().nodes.empty()     ? ", tree"
+                                                                                       : "";
             std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f | %s |\n", n,
                         o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())).c_str(),
                         own ? std::to_string(bvh.node_count()).c_str() : "-",
                         own ? std::to_string(bvh.depth()).c_str() : "-", prepare_ms, build_ms[k], median(seconds[k]),
                         ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1),
-                        std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))).c_str());
+                        (std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))) + lanes).c_str());
         }
         std::fflush(stdout);
+    }
+    if (o.sweep) {
+        std::printf("\nSweep of %zu counts, %d to %d (%d threads, %d runs, %d x %d at 4 spp, %s time):\n\n",
+                    o.stress.size(), o.stress.front(), o.stress.back(), omp_get_max_threads(), o.runs, o.size, o.size,
+                    o.cpu_time ? "CPU" : "wall");
+        std::printf("| --accel | largest step | between | steps over 15 %% | ns/ray / log2 N above 64 | band |\n");
+        std::printf("|---|---|---|---|---|---|\n");
+        for (size_t k = 0; k < o.accel.size(); ++k)
+            print_sweep_summary(std::string(accel_backend_names.name(o.accel[k])).c_str(), o.stress, sweep[k]);
     }
     return 0;
 }
@@ -314,6 +386,13 @@ int run_bench(int argc, char** argv) {
         return report_usage(e, kBenchUsage);
     }
     if (o.threads > 0) omp_set_num_threads(o.threads);
+    // Embree's module, asked for by name: loaded before anything is measured.
+    if (std::find(o.accel.begin(), o.accel.end(), AccelBackend::embree) != o.accel.end()) try {
+            embree_module();
+        } catch (const std::runtime_error& e) {
+            std::fprintf(stderr, "error: bench --accel embree: %s\n", e.what());
+            return 1;
+        }
     if (o.write_stress > 0) {
         std::error_code ec;
         if (fs::exists(o.write_path, ec)) {

@@ -1,6 +1,8 @@
 // The processes of one `keithray render` or `keithray view` (app/view_ranks.h): the ranks of an MPI job when a launcher (mpirun,
 // srun) started this process, else this process alone. Only cluster_mpi.cpp includes mpi.h;
-// a build without MPI has cluster_single.cpp, a cluster of one.
+// it is the module keithray_mpi.so (core/module.h), loaded with Open MPI only when a
+// launcher started this process: a plain run never loads MPI. cluster.cpp is the cluster of
+// one, and the program's side of the module.
 //
 // How a render is shared (docs/scaling.md): rank r renders the pixel rows y with
 // y mod N == r, every pixel's samples in the single-process order, so each pixel's sums are
@@ -28,6 +30,32 @@ struct RankCost {
     int exchanges = 0;           // passes after which the guard rows' statistics were exchanged
     uint64_t rays = 0;
     double received_bytes = 0;   // received in the exchanges between passes
+};
+
+// What the MPI module does for Cluster, in a process a launcher started (the same calls as
+// Cluster's below, across the job's ranks).
+class ClusterBackend {
+public:
+    virtual ~ClusterBackend() = default;
+    virtual int rank() const = 0;
+    virtual int size() const = 0;
+    virtual std::string failure() const = 0;
+    [[noreturn]] virtual void abort(int status) const = 0;
+    virtual void broadcast(std::string& bytes) const = 0;
+    virtual bool broadcast(bool value) const = 0;
+    virtual void broadcast_waiting(std::string& bytes) const = 0;
+    virtual int any_flags(int flags) const = 0;
+    virtual std::vector<RankCost> gather(const RankCost& cost) const = 0;
+    virtual std::vector<int> held_rows(int height) const = 0;
+    virtual void scatter_state(RenderState& state) const = 0;
+    virtual void gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const = 0;
+    virtual std::unique_ptr<PassHooks> deal_rows() const = 0;
+    virtual RankCost cost(const PassHooks& hooks) const = 0;
+};
+// The module's table (core/module.h): `join` starts MPI (MPI_Init_thread) and returns this
+// process's rank; it throws std::runtime_error (one line) where MPI cannot start.
+struct MpiModule {
+    std::unique_ptr<ClusterBackend> (*join)(int& argc, char**& argv, bool other_thread);
 };
 
 class Cluster {
@@ -83,6 +111,7 @@ public:
 private:
     int rank_ = 0, size_ = 1;
     bool mpi_ = false;
+    std::unique_ptr<ClusterBackend> backend_;  // the MPI module's, under a launcher
 };
 
 }  // namespace kr

@@ -1,4 +1,6 @@
-// Cluster over MPI (Open MPI): the only file that includes mpi.h.
+// Cluster over MPI (Open MPI): the only file that includes mpi.h. Built as the module
+// keithray_mpi.so (core/module.h), which cluster.cpp loads, with Open MPI, only in a process
+// that a launcher started.
 #include <mpi.h>
 
 #include <algorithm>
@@ -17,13 +19,6 @@
 namespace kr {
 
 namespace {
-
-// Whether a launcher started this process: Open MPI's mpirun, PMIx (srun --mpi=pmix) or PMI.
-bool launched_by_mpi() {
-    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK"})
-        if (std::getenv(name)) return true;
-    return false;
-}
 
 double cpu_seconds() {
     timespec t{};
@@ -309,12 +304,37 @@ void on_mpi_error(MPI_Comm*, int* code, ...) {
     for (;;) std::this_thread::sleep_for(std::chrono::hours(1));
 }
 
+// This rank of the job that launched the process (ClusterBackend's calls, cluster.h).
+class MpiCluster final : public ClusterBackend {
+public:
+    MpiCluster(int& argc, char**& argv, bool other_thread);
+    ~MpiCluster() override;
+    int rank() const override { return rank_; }
+    int size() const override { return size_; }
+    std::string failure() const override;
+    [[noreturn]] void abort(int status) const override;
+    void broadcast(std::string& bytes) const override;
+    bool broadcast(bool value) const override;
+    void broadcast_waiting(std::string& bytes) const override;
+    int any_flags(int flags) const override;
+    std::vector<RankCost> gather(const RankCost& cost) const override;
+    std::vector<int> held_rows(int height) const override;
+    void scatter_state(RenderState& state) const override;
+    void gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const override;
+    std::unique_ptr<PassHooks> deal_rows() const override;
+    RankCost cost(const PassHooks& hooks) const override;
+
+private:
+    bool leader() const { return rank_ == 0; }
+    int rank_ = 0, size_ = 1;
+    bool mpi_ = false;
+};
+
 }  // namespace
 
-std::string Cluster::failure() { return g_failed.load() ? std::string(g_failure) : std::string(); }
+std::string MpiCluster::failure() const { return g_failed.load() ? std::string(g_failure) : std::string(); }
 
-Cluster::Cluster(int& argc, char**& argv, bool other_thread) {
-    if (!launched_by_mpi()) return;
+MpiCluster::MpiCluster(int& argc, char**& argv, bool other_thread) {
     // One thread calls MPI at a time; OpenMP's threads render between the calls.
     const int level = other_thread ? MPI_THREAD_SERIALIZED : MPI_THREAD_FUNNELED;
     int provided = 0;
@@ -337,11 +357,11 @@ Cluster::Cluster(int& argc, char**& argv, bool other_thread) {
     MPI_Comm_size(MPI_COMM_WORLD, &size_);
 }
 
-Cluster::~Cluster() {
+MpiCluster::~MpiCluster() {
     if (mpi_) MPI_Finalize();
 }
 
-void Cluster::abort(int status) const {
+void MpiCluster::abort(int status) const {
     std::fflush(stdout);
     std::fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, status);
@@ -361,14 +381,14 @@ void broadcast_bytes(std::string& bytes, unsigned long long size) {
 
 }  // namespace
 
-void Cluster::broadcast(std::string& bytes) const {
+void MpiCluster::broadcast(std::string& bytes) const {
     if (!mpi_) return;
     unsigned long long size = bytes.size();
     MPI_Bcast(&size, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD);
     broadcast_bytes(bytes, size);
 }
 
-void Cluster::broadcast_waiting(std::string& bytes) const {
+void MpiCluster::broadcast_waiting(std::string& bytes) const {
     if (!mpi_) return;
     unsigned long long size = bytes.size();
     MPI_Request request;
@@ -380,21 +400,21 @@ void Cluster::broadcast_waiting(std::string& bytes) const {
     broadcast_bytes(bytes, size);
 }
 
-bool Cluster::broadcast(bool value) const {
+bool MpiCluster::broadcast(bool value) const {
     if (!mpi_) return value;
     int v = value;
     MPI_Bcast(&v, 1, MPI_INT, 0, MPI_COMM_WORLD);
     return v != 0;
 }
 
-int Cluster::any_flags(int flags) const {
+int MpiCluster::any_flags(int flags) const {
     if (!mpi_) return flags;
     int result = 0;
     MPI_Allreduce(&flags, &result, 1, MPI_INT, MPI_BOR, MPI_COMM_WORLD);
     return result;
 }
 
-std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
+std::vector<RankCost> MpiCluster::gather(const RankCost& cost) const {
     if (!mpi_) return {cost};
     constexpr int kFields = 6;
     const double mine[kFields] = {cost.busy_seconds,       cost.combine_seconds, cost.between_seconds,
@@ -407,9 +427,7 @@ std::vector<RankCost> Cluster::gather(const RankCost& cost) const {
     return costs;
 }
 
-void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const {
-    rays = state.rays;
-    nonfinite = state.nonfinite_samples;
+void MpiCluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfinite) const {
     if (!mpi_) return;
     const RowDeal deal{rank_, size_, state.width, state.height};
     std::vector<char> mine, gathered;
@@ -435,7 +453,7 @@ void Cluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonfini
     nonfinite = sum[1];
 }
 
-void Cluster::scatter_state(RenderState& state) const {
+void MpiCluster::scatter_state(RenderState& state) const {
     if (!mpi_) return;
     const RowDeal deal{rank_, size_, state.width, state.height};
     PixelBuffers& px = state.buffers();
@@ -466,19 +484,34 @@ void Cluster::scatter_state(RenderState& state) const {
     }
 }
 
-std::vector<int> Cluster::held_rows(int height) const {
+std::vector<int> MpiCluster::held_rows(int height) const {
     if (!mpi_ || leader()) return {};
     return rows_guarded(rank_, size_, height);
 }
 
-std::unique_ptr<PassHooks> Cluster::deal_rows() const {
+std::unique_ptr<PassHooks> MpiCluster::deal_rows() const {
     if (!mpi_) return nullptr;
     return std::make_unique<DealtRows>(rank_, size_);
 }
 
-RankCost Cluster::cost(const PassHooks& hooks) {
+RankCost MpiCluster::cost(const PassHooks& hooks) const {
     const auto* dealt = dynamic_cast<const DealtRows*>(&hooks);
     return dealt ? dealt->cost_ : RankCost{};
 }
 
+namespace {
+
+std::unique_ptr<ClusterBackend> join(int& argc, char**& argv, bool other_thread) {
+    return std::make_unique<MpiCluster>(argc, argv, other_thread);
+}
+
+constexpr MpiModule kModule{join};
+
+}  // namespace
+
 }  // namespace kr
+
+// The module's entry point (core/module.h).
+extern "C" __attribute__((visibility("default"))) const void* keithray_mpi_module(const char* version, const void*) {
+    return std::strcmp(version, KEITHRAY_MODULE_VERSION) == 0 ? &kr::kModule : nullptr;
+}

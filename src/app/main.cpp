@@ -22,11 +22,13 @@
 #include "app/docs.h"
 #include "app/progress.h"
 #include "app/view_ranks.h"
+#include "app/viewer_module.h"
 #include "core/args.h"
 #include "core/data_dir.h"
 #include "core/image.h"
 #include "core/limits.h"
 #include "core/memory.h"
+#include "core/module.h"
 #include "core/text.h"
 #include "core/file_write.h"
 #include "core/image_formats.h"
@@ -37,10 +39,8 @@
 #include "render/trace.h"
 #include "scene/load.h"
 #include "scene/scene_list.h"
-#include "viewer/gl_offscreen.h"
 #include "viewer/compare_view.h"
 #include "viewer/view_options.h"
-#include "viewer/viewer.h"
 
 namespace fs = std::filesystem;
 using namespace kr;
@@ -117,6 +117,13 @@ could not be written), 2 on bad usage.
 std::string render_options_help() { return kRenderIntro + shared_flags_help() + kRenderOnlyOptions; }
 std::string usage() { return kTitle + std::string(kSynopsis) + render_options_help(); }
 
+// Where a module (core/module.h) is, for --version; not loaded here.
+std::string module_place(const std::string& name) {
+    const fs::path path = module_path(name);
+    std::error_code ec;
+    return "module " + path.string() + (fs::is_regular_file(path, ec) ? "" : ", missing");
+}
+
 // `keithray --version`: what this build and this CPU run.
 int print_version() {
     std::printf("keithray %s\n", KEITHRAY_VERSION);
@@ -132,13 +139,17 @@ int print_version() {
                     "four in double, where a scene's sizes or gaps need it)\n",
                     name.c_str(), kernels == PacketKernels::x86_64_v4_float ? "sixteen" : "eight");
 #ifdef KEITHRAY_HAVE_EMBREE
-    std::printf("Embree: yes (%s): scenes of more than 32 spheres\n", KEITHRAY_EMBREE_VERSION);
+    std::printf("Embree: yes (%s): scenes of more than 32 spheres (%s)\n", KEITHRAY_EMBREE_VERSION,
+                module_place("embree").c_str());
 #else
     std::printf("Embree: no: every scene uses keithray's own BVH\n");
 #endif
-    std::printf("MPI: %s\n", KEITHRAY_MPI_BUILT ? "yes (Open MPI): mpirun -np N keithray render | view"
-                                                : "no: one process per render");
-    std::printf("viewer: yes (keithray view: GLFW and Dear ImGui; render --gl: OSMesa)\n");
+    if (KEITHRAY_MPI_BUILT)
+        std::printf("MPI: yes (Open MPI): mpirun -np N keithray render | view (%s)\n", module_place("mpi").c_str());
+    else
+        std::printf("MPI: no: one process per render\n");
+    std::printf("viewer: yes (keithray view: GLFW and Dear ImGui; render --gl: OSMesa) (%s)\n",
+                module_place("viewer").c_str());
     const std::optional<DataDir>& data = data_dir();
     if (data)
         std::printf("bundled scenes: %s (%s)\n", data->path.string().c_str(), data->installed ? "installed" : "build tree");
@@ -559,7 +570,7 @@ private:
             request.display = loaded_.scene.display;
             if (opt_.gl)
                 request.tone_map = [](const Image& radiance, const DisplaySettings& display) {
-                    return viewer::display_offscreen(radiance, display);
+                    return viewer_module().display_offscreen(radiance, display, nullptr);
                 };
             write_files_atomic(output_files(scene_, state_, request));
         } catch (const std::exception& e) {
@@ -632,17 +643,26 @@ int run_view(int argc, char** argv) {
         std::fprintf(stderr, "error: %s\n", e.what());
         return 1;
     }
+    if (joined->distributed() && !joined->leader()) return serve_view_passes(*joined);
+    // The window's libraries are loaded here, by the process that opens it.
+    const ViewerModule* module = nullptr;
+    try {
+        module = &viewer_module();
+    } catch (const std::runtime_error& e) {
+        std::fprintf(stderr, "error: %s\n", e.what());
+        if (joined->distributed()) joined->abort(1);  // the other ranks wait for rank 0's commands
+        return 1;
+    }
     if (!joined->distributed()) {
-        const int status = viewer::run_viewer(argc, argv);
+        const int status = module->run_viewer(argc, argv, nullptr);
         return stdout_written() ? status : 1;
     }
-    if (!joined->leader()) return serve_view_passes(*joined);
     int status = 1;
     {
         ViewRanks ranks(*joined);  // its end ends the other ranks' loops
         // mpirun ends the job with SIGTERM when a rank dies: the window says so before it ends.
         StopOnSignal stop_on_signal(true);
-        status = viewer::run_viewer(argc, argv, &ranks);
+        status = module->run_viewer(argc, argv, &ranks);
     }
     return stdout_written() ? status : 1;
 }
@@ -715,6 +735,15 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
+    // --gl's OSMesa is loaded before any render, by the rank that writes.
+    std::string gl_error;
+    if (opt.gl && cluster.leader()) try {
+            viewer_module();
+        } catch (const std::runtime_error& e) {
+            gl_error = e.what();
+            std::fprintf(stderr, "error: --gl: %s\n", e.what());
+        }
+    if (cluster.any_flags(!gl_error.empty())) return 1;
     if (cluster.any_flags(!team_started(opt.scenes.empty() ? std::string("render") : shown(opt.scenes.front())))) return 1;
     if (opt.scenes.empty()) {
         // Rank 0's list of the bundled scenes, in every rank.

@@ -20,7 +20,8 @@ bool holds_scenes(const fs::path& dir) {
     return !dir.empty() && fs::is_directory(dir / "scenes", ec);
 }
 
-// The first line of the build's marker file, a folder; empty where there is none.
+}  // namespace
+
 fs::path marker_target(const fs::path& marker) {
     std::ifstream in(marker);
     std::string line;
@@ -28,8 +29,6 @@ fs::path marker_target(const fs::path& marker) {
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.pop_back();
     return line;
 }
-
-}  // namespace
 
 fs::path installed_data_from_bin() { return KEITHRAY_DATA_FROM_BIN; }
 

@@ -31,6 +31,10 @@ std::optional<DataDir> find_data_dir(const std::filesystem::path& executable_fol
 inline constexpr const char* kDataMarker = "keithray-res.path";
 std::string data_dir_places();
 
+// The first line of a build's marker file (this one, or core/module.h's), a folder; empty
+// where there is none.
+std::filesystem::path marker_target(const std::filesystem::path& marker);
+
 // The path from the install's bin/ to its share/keithray/, as CMake computed it.
 std::filesystem::path installed_data_from_bin();
 

@@ -6,6 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/module.h"
 #include "render/lanes.h"
 #include "render/render_scene.h"
 
@@ -332,6 +333,13 @@ bool embree_available() {
 #endif
 }
 
+const EmbreeModule& embree_module() {
+    if (!embree_available())
+        throw std::runtime_error("this build of keithray has no Embree (libembree-dev was not found)");
+    static const EmbreeHost host{accepted_root};
+    return *static_cast<const EmbreeModule*>(load_module("embree", &host, "Embree", "libembree3"));
+}
+
 bool embree_fits(const std::vector<SphereGeom>& spheres) {
     double extent = 0;
     for (const SphereGeom& s : spheres) extent = std::max(extent, length(s.centre) + s.radius);
@@ -479,28 +487,31 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     blocks_.clear();
     depth_ = 0;
     embree_.reset();
+    embree_functions_ = nullptr;
     lane_tree_ = {};
     if (backend != AccelBackend::embree && spheres.size() > size_t(kMaxLeafSpheres) &&
-        (backend == AccelBackend::own || spheres.size() <= kLaneTreeMaxSpheres))
+        spheres.size() <= (backend == AccelBackend::own ? kLaneOwnMaxSpheres : kLaneTreeMaxSpheres))
         lane_tree_ = build_lane_tree(spheres);
-    if (backend == AccelBackend::embree && !embree_available())
-        throw std::runtime_error("this build of keithray has no Embree (libembree-dev was not found)");
-#ifdef KEITHRAY_HAVE_EMBREE
     if (backend == AccelBackend::embree) {
-        embree_ = build_embree_spheres(spheres);
+        const EmbreeModule& functions = embree_module();
+        embree_ = functions.build(spheres);
+        embree_functions_ = &functions;
         return;
     }
-    if (backend == AccelBackend::automatic && spheres.size() >= kEmbreeFromSpheres && embree_fits(spheres)) {
-        // Embree is only the faster choice here: where it fails (no device on this CPU, or
-        // its build runs out of memory), our own tree takes the scene.
+    if (backend == AccelBackend::automatic && embree_available() && spheres.size() >= kEmbreeFromSpheres &&
+        embree_fits(spheres)) {
+        // Embree is only the faster choice here: where it fails (its module or libembree3
+        // missing, no device on this CPU, or its build runs out of memory), our own tree
+        // takes the scene.
         try {
-            embree_ = build_embree_spheres(spheres);
+            const EmbreeModule& functions = embree_module();
+            embree_ = functions.build(spheres);
+            embree_functions_ = &functions;
             return;
         } catch (const std::runtime_error&) {
             // embree_ stays empty: on to our tree
         }
     }
-#endif
     Builder builder{build_items(spheres), nodes_, blocks_};
     if (spheres.empty()) return;
     builder.build(0, static_cast<int>(spheres.size()), 0);
@@ -509,17 +520,13 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
 
 // Two versions of each entry point (KR_CLONES, lanes.h).
 KR_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
-#ifdef KEITHRAY_HAVE_EMBREE
-    if (embree_) return embree_closest(*embree_, ray, t);
-#endif
+    if (embree_) return embree_functions_->closest(*embree_, ray, t);
     if (nodes_.empty()) return -1;
     return traverse<false>(nodes_, blocks_, ray, t);
 }
 
 KR_CLONES bool SphereBvh::any(const Ray& ray) const {
-#ifdef KEITHRAY_HAVE_EMBREE
-    if (embree_) return embree_any(*embree_, ray);
-#endif
+    if (embree_) return embree_functions_->any(*embree_, ray);
     if (nodes_.empty()) return false;
     double t;
     return traverse<true>(nodes_, blocks_, ray, t) >= 0;

@@ -18,6 +18,7 @@ namespace kr {
 struct Ray;
 struct SphereGeom;
 struct EmbreeSpheres;  // accel_embree.cpp
+struct EmbreeModule;
 
 // own:       our BVH. One leaf, without any box test, for up to 16 spheres: the faster one
 //            for small scenes (the brief's have 5 to 10 spheres).
@@ -39,9 +40,13 @@ bool embree_fits(const std::vector<SphereGeom>& spheres);
 
 // Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
 // well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
-// "Scenes of more than 16 spheres in the lanes": the single-precision lanes 1.7x Embree at
-// 128 spheres, the double lanes even at 256 and behind from 512).
-inline constexpr size_t kLaneTreeMaxSpheres = 256;
+// "Switch points": the single-precision lanes' scan meets Embree at about 1,100 spheres with
+// sixteen lanes and about 900 with eight; the double lanes stop earlier, packet.cpp).
+inline constexpr size_t kLaneTreeMaxSpheres = 1024;
+// Up to this many, AccelBackend::own builds it: above it one path down our own tree is the
+// faster (sixteen float lanes meet it at about 2,000 spheres; eight at about 1,200 and the
+// double lanes at about 350 stop earlier, packet.cpp).
+inline constexpr size_t kLaneOwnMaxSpheres = 2048;
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
@@ -66,8 +71,9 @@ struct LaneSphere {
     int32_t id;      // the sphere's index in the scene
 };
 // Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
-// walk the lane tree (docs/performance.md, "Sixteen single-precision lanes").
-inline constexpr size_t kLaneScanMaxSpheres = 128;
+// walk the lane tree (docs/performance.md, "Switch points": the scan is the cheaper up to
+// about 2,800 spheres with sixteen lanes and about 1,500 with eight).
+inline constexpr size_t kLaneScanMaxSpheres = 1024;
 // Spheres near each other that the scan tests after their box (boxed), or a sphere it tests
 // alone: scan_f[first, first + count).
 struct LaneCluster {
@@ -113,8 +119,8 @@ public:
     // Whether it is our one leaf, which the lanes test sphere by sphere without a box.
     bool one_leaf() const { return !embree_ && nodes_.size() == 1; }
     // The tree the lanes walk, built beside ours or Embree's for more than 16 spheres: up to
-    // kLaneTreeMaxSpheres under `automatic`, at any count under `own`, never under `embree`
-    // (which so measures one path through Embree's tree).
+    // kLaneTreeMaxSpheres under `automatic`, kLaneOwnMaxSpheres under `own`, never under
+    // `embree` (which so measures one path through Embree's tree).
     const LaneTree& lane_tree() const { return lane_tree_; }
 
     // Whether this and `other` are copies of one build (their trees are the same).
@@ -132,12 +138,24 @@ private:
     int depth_ = 0;
     LaneTree lane_tree_;
     std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
+    const EmbreeModule* embree_functions_ = nullptr;  // the module's, with embree_
     uint64_t build_id_ = 0;                        // a number per build() in this process
 };
 
-// Embree's side (accel_embree.cpp, only in builds with Embree).
-std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<SphereGeom>& spheres);
-int embree_closest(const EmbreeSpheres& accel, const Ray& ray, double& t);
-bool embree_any(const EmbreeSpheres& accel, const Ray& ray);
+// Embree's side: the module keithray_embree.so (accel_embree.cpp, built where CMake found
+// libembree-dev), loaded with libembree3 and TBB the first time a scene is given to Embree
+// (core/module.h). The program passes it its sphere test; it returns its functions.
+struct EmbreeHost {
+    double (*accepted_root)(const SphereGeom& s, int index, const Ray& ray, bool shadow);
+};
+struct EmbreeModule {
+    std::shared_ptr<const EmbreeSpheres> (*build)(const std::vector<SphereGeom>& spheres);
+    int (*closest)(const EmbreeSpheres& accel, const Ray& ray, double& t);
+    bool (*any)(const EmbreeSpheres& accel, const Ray& ray);
+    const char* embree_version;
+};
+// Loads the module once; throws std::runtime_error (one line naming its file and what is
+// missing) where this build has no Embree or the module or libembree3 cannot be loaded.
+const EmbreeModule& embree_module();
 
 }  // namespace kr

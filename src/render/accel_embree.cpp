@@ -1,14 +1,15 @@
 // Embree's BVH for scenes of more than 32 spheres (AccelBackend, accel.h). Embree traverses
 // its boxes in single precision; every sphere it reaches is tested by the same double-
 // precision rules as the plain path (accepted_root), through user-geometry callbacks, so the
-// hits are exact and the same as our own BVH's. Built only where CMake found libembree-dev.
-#ifdef KEITHRAY_HAVE_EMBREE
-
+// hits are exact and the same as our own BVH's. Built only where CMake found libembree-dev,
+// as the module keithray_embree.so (core/module.h): the program loads it, and with it
+// libembree3 and TBB, the first time a scene is given to Embree.
 #include <embree3/rtcore.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -33,6 +34,9 @@ struct EmbreeSpheres {
 };
 
 namespace {
+
+// The program's double-precision sphere test (render_scene.h), passed by the loader.
+const EmbreeHost* g_host = nullptr;
 
 // One device for the process: it holds Embree's settings and, for builds, its threads. One
 // build thread: the renderer's OpenMP threads are busy when the viewer rebuilds after an
@@ -81,7 +85,7 @@ void sphere_intersect(const RTCIntersectFunctionNArguments* args) {
     if (!args->valid[0]) return;
     QueryContext& q = *reinterpret_cast<QueryContext*>(args->context);
     const int index = int(args->primID);
-    const double t = accepted_root(q.accel->spheres[size_t(index)], index, q.ray, false);
+    const double t = g_host->accepted_root(q.accel->spheres[size_t(index)], index, q.ray, false);
     // Ties keep the first found (t <= tmax is accepted, so a later equal root is not taken).
     if (!(t < kInfinity) || (q.best >= 0 && !(t < q.ray.tmax))) return;
     q.ray.tmax = t;
@@ -97,7 +101,7 @@ void sphere_occluded(const RTCOccludedFunctionNArguments* args) {
     if (!args->valid[0]) return;
     QueryContext& q = *reinterpret_cast<QueryContext*>(args->context);
     const int index = int(args->primID);
-    if (accepted_root(q.accel->spheres[size_t(index)], index, q.ray, true) < kInfinity) {
+    if (g_host->accepted_root(q.accel->spheres[size_t(index)], index, q.ray, true) < kInfinity) {
         q.best = index;
         reinterpret_cast<RTCRay*>(args->ray)->tfar = -INFINITY;  // Embree's "occluded"
     }
@@ -137,6 +141,8 @@ bool embree_ray(const EmbreeSpheres& a, const Ray& ray, QueryContext& q, RTCRay&
 }
 
 }  // namespace
+
+namespace {
 
 std::shared_ptr<const EmbreeSpheres> build_embree_spheres(const std::vector<SphereGeom>& spheres) {
     auto a = std::make_shared<EmbreeSpheres>();
@@ -202,6 +208,16 @@ bool embree_any(const EmbreeSpheres& accel, const Ray& ray) {
     return q.best >= 0;
 }
 
+constexpr EmbreeModule kModule{build_embree_spheres, embree_closest, embree_any, KEITHRAY_EMBREE_VERSION};
+
+}  // namespace
+
 }  // namespace kr
 
-#endif  // KEITHRAY_HAVE_EMBREE
+// The module's entry point (core/module.h).
+extern "C" __attribute__((visibility("default"))) const void* keithray_embree_module(const char* version,
+                                                                                    const void* host) {
+    if (std::strcmp(version, KEITHRAY_MODULE_VERSION) != 0 || !host) return nullptr;
+    kr::g_host = static_cast<const kr::EmbreeHost*>(host);
+    return &kr::kModule;
+}

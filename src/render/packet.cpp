@@ -28,6 +28,7 @@
 #include "core/sampling.h"
 #include "render/lanes.h"
 #include "render/path.h"
+#include "render/precision.h"
 #include "render/trace.h"
 #include "render/vertex.h"
 
@@ -191,14 +192,14 @@ PacketKernels isa_kernels(const RenderSettings& settings) {
 }  // namespace
 
 bool float_lanes_fit(const RenderScene& scene) {
-    // Geometry: the largest distance is bounded by the camera's (its lens included) and the
-    // spheres' distances from the origin, as rays start at the camera or on a sphere.
+    // The largest distance is bounded by the camera's (its lens included) and the spheres'
+    // distances from the origin, as rays start at the camera or on a sphere.
     double largest = length(scene.camera.position) + std::max(scene.camera.lens_radius, 0.0), smallest_radius = kInf;
     for (const SphereGeom& s : scene.spheres) {
         largest = std::max(largest, length(s.centre) + s.radius);
         smallest_radius = std::min(smallest_radius, s.radius);
     }
-    if (!(std::isfinite(largest) && smallest_radius > 0 && largest <= 0x1.0p12 * smallest_radius)) return false;
+    if (!(std::isfinite(largest) && smallest_radius > 0)) return false;
     // Absolute range: the lanes square distances and radii, which must stay normal floats
     // (2^-126..2^128) with room for the products they enter; lengths of 2^-40..2^40 do.
     if (!(smallest_radius >= 0x1.0p-40 && largest <= 0x1.0p40)) return false;
@@ -214,7 +215,9 @@ bool float_lanes_fit(const RenderScene& scene) {
     for (const PointLight& light : scene.point_lights)
         if (!in_range(light.intensity)) return false;
     // Gaps: surfaces and lights no nearer each other than the lanes' rounding resolves.
-    return scene.float_gaps_resolved;
+    // Sizes (last, the dearest): each sphere's tests round to well under its radius
+    // (float_sizes_fit, precision.h), once per pass.
+    return scene.float_gaps_resolved && float_sizes_fit(scene);
 }
 
 PacketKernels cpu_kernels(PacketIsa isa) {
@@ -223,12 +226,37 @@ PacketKernels cpu_kernels(PacketIsa isa) {
     return isa_kernels(settings);
 }
 
+namespace {
+
+// The most spheres each kind of lanes takes under `best` (beyond one leaf) before one path at
+// a time is the faster: down Embree's tree where `automatic` built it beside the lanes' tree,
+// else down our own. Measured on the stress scenes, one thread, CPU time (`bench --stress N
+// --accel own,embree --kernels K --cpu-time --threads 1`; docs/performance.md, "Switch
+// points"). The sixteen float lanes' are the lane tree's own limits (accel.h).
+size_t lanes_max_spheres(PacketKernels kernels, bool beside_embree) {
+    switch (kernels) {
+    case PacketKernels::x86_64_v4_float: return beside_embree ? kLaneTreeMaxSpheres : kLaneOwnMaxSpheres;
+    case PacketKernels::x86_64_v3_float: return beside_embree ? 768 : 1024;
+    case PacketKernels::x86_64_v3:
+    case PacketKernels::x86_64: return beside_embree ? 128 : 320;
+    case PacketKernels::one_path: break;
+    }
+    return std::numeric_limits<size_t>::max();
+}
+
+}  // namespace
+
 PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings) {
     if (!packets_apply(scene, settings)) return PacketKernels::one_path;
-    const PacketKernels kernels = isa_kernels(settings);
+    PacketKernels kernels = isa_kernels(settings);
     if ((kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float) &&
         !float_lanes_fit(scene))
-        return PacketKernels::x86_64_v3;
+        kernels = PacketKernels::x86_64_v3;
+    // Kernels asked for by name run wherever they can (to measure them); `best` only where
+    // they are the faster.
+    if (settings.kernels == PacketIsa::best && !scene.bvh.one_leaf() &&
+        scene.spheres.size() > lanes_max_spheres(kernels, scene.bvh.backend() == AccelBackend::embree))
+        return PacketKernels::one_path;
     return kernels;
 }
 

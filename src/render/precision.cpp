@@ -18,6 +18,49 @@ double norm_l1(const Vec3& v) { return std::abs(v.x) + std::abs(v.y) + std::abs(
 
 bool emits(const Color& c) { return c[0] != 0 || c[1] != 0 || c[2] != 0; }
 
+// An axis-aligned box of points rays can reach (float_reach_fits); empty until a point is added.
+struct ReachBox {
+    double lo[3] = {kInfinity, kInfinity, kInfinity}, hi[3] = {-kInfinity, -kInfinity, -kInfinity};
+
+    static ReachBox around(const Vec3& centre, double half) {
+        ReachBox b;
+        for (int k = 0; k < 3; ++k) b.lo[k] = centre[k] - half, b.hi[k] = centre[k] + half;
+        return b;
+    }
+    bool empty() const { return !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]); }
+    void add(const ReachBox& b) {
+        for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], b.lo[k]), hi[k] = std::max(hi[k], b.hi[k]);
+    }
+    bool holds(const ReachBox& b) const {
+        for (int k = 0; k < 3; ++k)
+            if (b.lo[k] < lo[k] || b.hi[k] > hi[k]) return false;
+        return true;
+    }
+    // This box grown by `by` on every side, clipped to `clip`.
+    ReachBox grown_within(double by, const ReachBox& clip) const {
+        ReachBox b;
+        for (int k = 0; k < 3; ++k) b.lo[k] = std::max(lo[k] - by, clip.lo[k]), b.hi[k] = std::min(hi[k] + by, clip.hi[k]);
+        return b;
+    }
+    // The farthest and the nearest distance of its points from p.
+    double farthest(const Vec3& p) const {
+        double sum = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double d = std::max(std::abs(p[k] - lo[k]), std::abs(p[k] - hi[k]));
+            sum += d * d;
+        }
+        return std::sqrt(sum);
+    }
+    double nearest(const Vec3& p) const {
+        double sum = 0;
+        for (int k = 0; k < 3; ++k) {
+            const double d = std::max({lo[k] - p[k], p[k] - hi[k], 0.0});
+            sum += d * d;
+        }
+        return std::sqrt(sum);
+    }
+};
+
 }  // namespace
 
 double near_surface_fraction(const SphereGeom& a, const SphereGeom& b, double tolerance) {
@@ -145,6 +188,101 @@ bool float_resolves_gaps(const RenderScene& scene) {
     for (size_t i : large)
         for (size_t j = 0; j < spheres.size(); ++j)
             if (j != i && !(is_large[j] && j < i) && !pair_resolved(i, j)) return false;
+    return true;
+}
+
+bool float_sizes_fit(const RenderScene& scene) {
+    // Every distance a test meets is within the scene's: the camera's (its lens included) and
+    // the spheres' from the origin, as rays start at the camera or on a sphere.
+    double largest = length(scene.camera.position) + std::max(scene.camera.lens_radius, 0.0);
+    double smallest_radius = kInfinity;
+    for (const SphereGeom& s : scene.spheres) {
+        largest = std::max(largest, length(s.centre) + s.radius);
+        smallest_radius = std::min(smallest_radius, s.radius);
+    }
+    if (!(std::isfinite(largest) && smallest_radius > 0)) return false;
+    return largest <= kFloatSizeRatio * smallest_radius || float_reach_fits(scene);
+}
+
+bool float_reach_fits(const RenderScene& scene) {
+    const std::vector<SphereGeom>& spheres = scene.spheres;
+    const size_t n = spheres.size();
+    const CameraModel& camera = scene.camera;
+    const ReachBox lens = ReachBox::around(camera.position, std::max(camera.lens_radius, 0.0));
+    // Where rays start or end outside the spheres: the lens and the point lights.
+    ReachBox fixed_points = lens;
+    for (const PointLight& light : scene.point_lights) fixed_points.add(ReachBox::around(light.position, 0));
+    if (fixed_points.empty()) return false;  // a NaN position
+    // Per sphere: its box, whether it counts whole, and the part rays reach so far.
+    std::vector<ReachBox> box(n), reach(n);
+    std::vector<char> whole(n);
+    for (size_t s = 0; s < n; ++s) {
+        box[s] = ReachBox::around(spheres[s].centre, spheres[s].radius);
+        const int m = s < scene.sphere_material.size() ? scene.sphere_material[s] : -1;
+        const bool enters = m < 0 || size_t(m) >= scene.materials.size() ||
+                            scene.materials[size_t(m)].type == MaterialType::dielectric ||
+                            scene.materials[size_t(m)].type == MaterialType::translucent;
+        const bool emitter = s < scene.sphere_light.size() && scene.sphere_light[s] >= 0;
+        // The lens within (or touching) the ball: rays start inside it.
+        const bool lens_inside = !(lens.nearest(spheres[s].centre) > spheres[s].radius);
+        whole[s] = enters || emitter || lens_inside;
+        if (whole[s]) reach[s] = box[s];
+    }
+    // The box of every reach but sphere s's: per side, the farthest value and the one after
+    // it, with the sphere that gives the farthest (-1: the fixed points).
+    struct Side {
+        double best, next;
+        long which;
+    };
+    Side low[3], high[3];
+    // Rounds until no box grows. Each round's boxes only grow and stay within the spheres'
+    // boxes; a scene that does not settle in kRounds keeps the global rule's answer (no).
+    constexpr int kRounds = 64;
+    bool settled = false;
+    for (int round = 0; round < kRounds && !settled; ++round) {
+        for (int k = 0; k < 3; ++k) {
+            low[k] = {fixed_points.lo[k], kInfinity, -1};
+            high[k] = {fixed_points.hi[k], -kInfinity, -1};
+        }
+        for (size_t s = 0; s < n; ++s) {
+            if (reach[s].empty()) continue;
+            for (int k = 0; k < 3; ++k) {
+                const double lo = reach[s].lo[k], hi = reach[s].hi[k];
+                if (lo < low[k].best) low[k] = {lo, low[k].best, long(s)};
+                else low[k].next = std::min(low[k].next, lo);
+                if (hi > high[k].best) high[k] = {hi, high[k].best, long(s)};
+                else high[k].next = std::max(high[k].next, hi);
+            }
+        }
+        settled = true;
+        for (size_t s = 0; s < n; ++s) {
+            if (whole[s]) continue;
+            ReachBox others;
+            for (int k = 0; k < 3; ++k) {
+                others.lo[k] = low[k].which == long(s) ? std::min(low[k].next, fixed_points.lo[k]) : low[k].best;
+                others.hi[k] = high[k].which == long(s) ? std::max(high[k].next, fixed_points.hi[k]) : high[k].best;
+            }
+            const SphereGeom& sphere = spheres[s];
+            // Every origin outside the ball lies within `far` of its centre, and sees its
+            // surface no farther than the tangent length.
+            const double far = others.farthest(sphere.centre);
+            const double tangent = std::sqrt(std::max(far * far - sphere.radius * sphere.radius, 0.0));
+            const ReachBox reached = others.grown_within(tangent, box[s]);
+            if (reached.empty() || reach[s].holds(reached)) continue;
+            reach[s].add(reached);
+            settled = false;
+        }
+    }
+    if (!settled) return false;
+    ReachBox all = fixed_points;
+    for (const ReachBox& r : reach)
+        if (!r.empty()) all.add(r);
+    const double from_origin = all.farthest(Vec3(0));
+    for (const SphereGeom& s : spheres) {
+        const double limit = kFloatSizeRatio * s.radius;
+        if (!(from_origin <= limit && length(s.centre) + s.radius <= limit && all.farthest(s.centre) <= limit))
+            return false;
+    }
     return true;
 }
 

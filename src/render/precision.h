@@ -33,4 +33,26 @@ double near_surface_fraction(const SphereGeom& a, const SphereGeom& b, double to
 // The gap rules above, for the scene's spheres and lights (the camera plays no part).
 bool float_resolves_gaps(const RenderScene& scene);
 
+// The size rule of float_lanes_fit (trace.h): a float sphere test rounds to about 2^-24 of
+// the distances it meets (the coordinates of its ray's origin and of the sphere's centre, and
+// the distance between them), and that must stay below 2^-12 of the sphere's radius, as
+// kFloatSizeRatio says. Where every distance in the scene (the camera's, its lens's and every
+// sphere's from the origin) is within kFloatSizeRatio smallest radii, it holds at once.
+// Otherwise it is checked sphere by sphere over the points rays can reach
+// (float_reach_fits): a large floor's far side counts only where a ray can get there.
+inline constexpr double kFloatSizeRatio = 0x1.0p12;
+bool float_sizes_fit(const RenderScene& scene);
+
+// The per-sphere check. Rays start at the lens and on surfaces they hit. A ray that hits an
+// opaque sphere from outside starts within the tangent length sqrt(d^2 - r^2) of its origin
+// (d: the origin's distance from the centre), and a ray leaving a sphere's surface outwards
+// never hits that sphere again (spheres are convex). So the part of each sphere rays can
+// reach lies in its box and within that tangent length of the box of the points rays start
+// from elsewhere (the lens, point lights and the other spheres' reach), worked out until no
+// box grows. A sphere rays may enter (a dielectric, the lens inside it) or that lights are
+// sampled on (an emitter) counts whole. Then each sphere's radius must be at least
+// 1/kFloatSizeRatio of: the farthest reach of any point from the origin, its own farthest
+// point from the origin, and the farthest reach of any point from its centre.
+bool float_reach_fits(const RenderScene& scene);
+
 }  // namespace kr

@@ -62,7 +62,8 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
 
 // What trace_samples runs for path tracing with these settings on this scene, as the
-// settings' kernels, the CPU and the scene decide.
+// settings' kernels, the CPU and the scene decide (under `best`, each kind of lanes only up
+// to the sphere count where one path at a time becomes the faster: packet.cpp).
 enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_v4_float };
 inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
     {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
@@ -86,7 +87,9 @@ void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene,
                                 const uint32_t* index_reversed, int count, SampleResult* results);
 
 // Whether single-precision lanes keep the scene: their rounding, about 2^-24 of the largest
-// distance a sphere test meets, stays below 2^-12 of the smallest radius, every length is
+// distance a sphere test meets, stays below 2^-12 of the sphere's radius (float_sizes_fit,
+// render/precision.h: at once where the whole scene is within 2^12 smallest radii, else
+// sphere by sphere over the points rays can reach), every length is
 // within 2^-40 to 2^40 (its square a normal float), and its lights' radiance stays far
 // inside their range (2^-60 to 2^60; a light of 1e30 is double's), and its rays resolve
 // the gaps between its surfaces and lights (scene.float_gaps_resolved, render/precision.h).
