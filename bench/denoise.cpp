@@ -342,9 +342,6 @@ NlmParams parse_params(const std::string& text) {
         else if (key == "sigma_albedo") params.sigma_albedo = float(value);
         else if (key == "sigma_depth") params.sigma_depth = float(value);
         else if (key == "fade_error") params.fade_error = float(value);
-        else if (key == "first_order") params.first_order = int(value);
-        else if (key == "ridge") params.ridge = float(value);
-        else if (key == "sigma_normal_fit") params.sigma_normal_fit = float(value);
         else throw std::invalid_argument("unknown parameter '" + key + "'");
     }
     return params;

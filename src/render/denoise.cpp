@@ -593,32 +593,21 @@ void patch_terms(const float* const u[3], const float* const v[3], size_t at, pt
 }
 
 
-// The first-order fit's sums of one half (kFitSums planes): with d = n_q - n_p the normal's
-// change from the centre and u_q the half's demodulated radiance, sum w d_j (3), sum w d_j d_l
-// (6: 00 01 02 11 12 22) and sum w d_j u_q,c (9: j major).
-constexpr int kFitSums = 18;
-
 // One non-local means filter of both halves at distance scale k: p.acc[g] gets half g's
-// sums with weights from the other half, and their weights (the centre's is 1); with
-// `first_order`, p.fit[g] the sums of the weighted least-squares fit in the normal
-// (first_order_fit).
-void nlm_filter(const NlmParams& params, float k, float sigma_normal, bool first_order, Planes& p) {
+// sums with weights from the other half, and their weights (the centre's is 1).
+void nlm_filter(const NlmParams& params, float k, Planes& p) {
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
     for (int g = 0; g < 2; ++g) {
         p.hbox[g].assign(n, 0.f);
         for (auto& plane : p.acc[g]) plane.assign(n, 0.f);
-        for (auto& plane : p.fit[g]) {
-            if (first_order) plane.assign(n, 0.f);
-            else plane.clear();
-        }
     }
     const int r = std::max(0, params.radius), f = std::max(0, params.patch);
     const float k2 = k * k, inv_patch = 1.f / float((2 * f + 1) * (2 * f + 1));
     const float inv_albedo2 = 1.f / (params.sigma_albedo * params.sigma_albedo);
 #pragma omp parallel
     {
-        std::vector<float> terms(static_cast<size_t>(w)), wf(static_cast<size_t>(w)), wrow(static_cast<size_t>(w));
+        std::vector<float> terms(static_cast<size_t>(w)), wf(static_cast<size_t>(w));
         for (int oy = -r; oy <= r; ++oy)
             for (int ox = -r; ox <= r; ++ox) {
                 // The pixels whose offset neighbour q = p + (ox, oy) lies in the image.
@@ -663,7 +652,7 @@ void nlm_filter(const NlmParams& params, float k, float sigma_normal, bool first
                     for (int x = x0; x < x1; ++x) {
                         const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
                         const float da0 = a0[x] - b0[x], da1 = a1[x] - b1[x], da2 = a2[x] - b2[x];
-                        wf[size_t(x)] = sigma_normal * std::max(0.f, 1.f - fd) +
+                        wf[size_t(x)] = params.sigma_normal * std::max(0.f, 1.f - fd) +
                                         (da0 * da0 + da1 * da1 + da2 * da2) * inv_albedo2 +
                                         std::fabs(z[x] - qz[x]) / (zscale * zg[x] + 1e-3f * z[x] + 1e-9f);
                     }
@@ -687,92 +676,10 @@ void nlm_filter(const NlmParams& params, float k, float sigma_normal, bool first
                             sr[x] += wt * ur[x];
                             sg[x] += wt * ug[x];
                             sb[x] += wt * ub[x];
-                            wrow[size_t(x)] = wt;
-                        }
-                        if (!first_order) continue;
-                        // The fit's sums (first_order_fit): the normal's change from p to q.
-                        float* __restrict s[kFitSums];
-                        for (int j = 0; j < kFitSums; ++j) s[j] = p.fit[o][size_t(j)].data() + row;
-#pragma omp simd
-                        for (int x = x0; x < x1; ++x) {
-                            const float wt = wrow[size_t(x)];
-                            const float d[3] = {q0[x] - f0[x], q1[x] - f1[x], q2[x] - f2[x]};
-                            const float u3[3] = {ur[x], ug[x], ub[x]};
-                            const float wd[3] = {wt * d[0], wt * d[1], wt * d[2]};
-                            s[0][x] += wd[0];
-                            s[1][x] += wd[1];
-                            s[2][x] += wd[2];
-                            s[3][x] += wd[0] * d[0];
-                            s[4][x] += wd[0] * d[1];
-                            s[5][x] += wd[0] * d[2];
-                            s[6][x] += wd[1] * d[1];
-                            s[7][x] += wd[1] * d[2];
-                            s[8][x] += wd[2] * d[2];
-                            for (int j = 0; j < 3; ++j)
-                                for (int c = 0; c < 3; ++c) s[9 + 3 * j + c][x] += wd[j] * u3[c];
                         }
                     }
                 }
             }
-    }
-}
-
-// The first-order candidate (NFOR's regression, Bitterli et al. 2016, on the normal): per
-// half g and pixel, the weighted least-squares fit u_q ~ a + b.(n_q - n_p) over the window,
-// the weights those of nlm_filter (from the other half), with a ridge of `ridge` times the
-// weights' sum on b; the fit's value at p is a. Written where denoise_nlmeans reads a
-// zero-order filter's result: p.acc[g][c] = a_c / s and p.acc[g][3] = 1 / s, s = da/du_p
-// (the centre's leverage, e0' M^-1 e0 for the normal matrix M: a is linear in the half it
-// filters, so Stein's risk estimate takes s where the zero-order filter has 1 / sum w).
-void first_order_fit(float ridge, Planes& p) {
-    const size_t n = size_t(p.w) * size_t(p.h);
-    const long count = long(n);
-#pragma omp parallel for schedule(static)
-    for (long li = 0; li < count; ++li) {
-        const size_t i = size_t(li);
-        for (int g = 0; g < 2; ++g) {
-            const auto& f = p.fit[g];
-            const double sw = p.acc[g][3][i];
-            // M = [[sw, sd'], [sd, S + ridge sw I]], in double: the normal's changes are small.
-            double m[4][4] = {{sw, f[0][i], f[1][i], f[2][i]},
-                              {f[0][i], f[3][i] + ridge * sw, f[4][i], f[5][i]},
-                              {f[1][i], f[4][i], f[6][i] + ridge * sw, f[7][i]},
-                              {f[2][i], f[5][i], f[7][i], f[8][i] + ridge * sw}};
-            // Cholesky M = L L'; z = M^-1 e0.
-            double l[4][4] = {};
-            bool ok = sw > 0;
-            for (int a = 0; a < 4 && ok; ++a)
-                for (int b = 0; b <= a; ++b) {
-                    double v = m[a][b];
-                    for (int c = 0; c < b; ++c) v -= l[a][c] * l[b][c];
-                    if (a == b) {
-                        ok = v > 1e-12 * sw;
-                        l[a][a] = ok ? std::sqrt(v) : 1;
-                    } else {
-                        l[a][b] = v / l[b][b];
-                    }
-                }
-            if (!ok) continue;  // the zero-order sums stay
-            double y[4], z[4];
-            for (int a = 0; a < 4; ++a) {
-                double v = a == 0 ? 1 : 0;
-                for (int c = 0; c < a; ++c) v -= l[a][c] * y[c];
-                y[a] = v / l[a][a];
-            }
-            for (int a = 3; a >= 0; --a) {
-                double v = y[a];
-                for (int c = a + 1; c < 4; ++c) v -= l[c][a] * z[c];
-                z[a] = v / l[a][a];
-            }
-            if (!(z[0] > 0) || !std::isfinite(z[0])) continue;
-            // a_c = z' b_c, b_c = (sum w u_c, sum w d_j u_c).
-            for (int c = 0; c < 3; ++c) {
-                const double fitted = z[0] * p.acc[g][c][i] + z[1] * f[size_t(9 + c)][i] +
-                                      z[2] * f[size_t(12 + c)][i] + z[3] * f[size_t(15 + c)][i];
-                p.acc[g][c][i] = float(fitted / z[0]);
-            }
-            p.acc[g][3][i] = float(1 / z[0]);
-        }
     }
 }
 
@@ -820,11 +727,9 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     // in radiance), so that the box compares relative errors, as relMSE does: in absolute
     // terms a few bright noisy pixels outvote the dark ones beside them, whose every sample
     // was dark and which the filter would light with the bright ones' noise.
-    // The candidates: the zero-order filter at each strength, and after the one that
-    // params.first_order names, the first-order fit with its weights (first_order_fit).
     const float strengths[2] = {params.k, params.k_weak};
-    int candidates = 0;
-    const auto add_candidate = [&](int c) {
+    for (int c = 0; c < 2; ++c) {
+        nlm_filter(params, strengths[c], p);
         for (auto& plane : p.cand[c]) plane.resize(n);
         p.own_gain[c].resize(n);
 #pragma omp parallel for schedule(static)
@@ -857,16 +762,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
         }
         box_mean(w, h, params.select_radius, p.cand[c][3], p.hbox[0], p.hbox[1]);
         std::swap(p.cand[c][3], p.hbox[1]);
-    };
-    for (int strength = 0; strength < 2; ++strength) {
-        const bool fit = params.first_order == strength + 1;
-        nlm_filter(params, strengths[strength], fit ? params.sigma_normal_fit : params.sigma_normal, fit, p);
-        add_candidate(candidates++);
-        if (!fit) continue;
-        first_order_fit(params.ridge, p);
-        add_candidate(candidates++);
     }
-    const int raw = candidates;
     // Per pixel the candidate of the largest estimated gain over the box, or the raw mean
     // where neither gains (a converged or noiseless region). Then the pixel's own samples:
     // - where the box keeps the raw mean but the pixel's own estimate says a filter gains (a
@@ -884,14 +780,12 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < long(n); ++li) {
         const size_t i = size_t(li);
-        int c = 0;
-        for (int o = 1; o < candidates; ++o)
-            if (p.cand[o][3][i] < p.cand[c][3][i]) c = o;
+        int c = p.cand[1][3][i] < p.cand[0][3][i] ? 1 : 0;
         if (!(p.cand[c][3][i] < 0)) {
-            c = raw;
+            c = 2;
             if (halves) {
                 float best = 0;
-                for (int o = 0; o < candidates; ++o)
+                for (int o = 0; o < 2; ++o)
                     if (p.own_gain[o][i] < best) {
                         best = p.own_gain[o][i];
                         c = o;
@@ -905,9 +799,9 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
                 lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.demod[k][i];
                 var += kLum[k] * kLum[k] * float(input.variance[i][k] * p.var_scale);
             }
-            if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = raw;
+            if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = 2;
         }
-        if (c < raw)
+        if (c < 2)
             for (int k = 0; k < 3; ++k) p.c[k][i] = p.cand[c][k][i];
         else if (!p.clamped[i])
             p.c[0][i] = NAN;

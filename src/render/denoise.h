@@ -72,9 +72,7 @@ struct DenoiseWorkspace {
     // distances of one offset (summed along rows), the filtered sums and weights; per half the
     // pixel's own variance (not prefiltered, summed over the channels); per candidate the
     // pixel's own estimate of what filtering gains.
-    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4], own_var[2], own_gain[3];
-    // Per half the first-order fit's sums (denoise.cpp, first_order_fit).
-    std::vector<float> fit[2][18];
+    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4], own_var[2], own_gain[2];
     std::vector<uint8_t> clamped;  // per pixel: a half was clamped (a firefly)
 };
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
@@ -91,12 +89,6 @@ struct NlmParams {
     float sigma_albedo = 0.1f;  // albedo stop: exp(-|a - a'|^2 / sigma^2)
     float sigma_depth = 1;      // depth stop in units of the local depth gradient times the offset
     float fade_error = 0.01f;   // as AtrousParams::fade_error
-    // A third candidate: the weighted least-squares fit in the normal with the weights of the
-    // strength this names (1: k, 2: k_weak; 0: none), its slopes' ridge times the weights' sum.
-    // That strength's normal stop (the fit explains the shading's change with the normal).
-    int first_order = 1;
-    float ridge = 1e-3f;
-    float sigma_normal_fit = 16;
 };
 
 // The final-quality filter: joint non-local means (Buades et al. 2005) with the patch
@@ -117,6 +109,6 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, D
 // The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
 // The estimates' variance is in double while the filter runs (3 floats more than its layer).
 inline constexpr uint64_t kDenoiseBytesPerPixel =
-    (39 + 39 + 36 + 3) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
+    (39 + 38 + 3) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
 
 }  // namespace kr
