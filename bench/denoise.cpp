@@ -155,23 +155,8 @@ int cost(int rounds, const std::string& scene_file, int final_rounds) {
         const Prepared p = prepare(scene_file, w, h, false);
         const RenderState state = render(p, 4, 1);
         RenderEstimates est = render_estimates(state, kAllLayers);
-        const SurfaceLayers features = averaged_surface_layers(p.rs, p.settings, w, h, kFeatureSamples);
-        std::vector<float> albedo, normal;
-        for (size_t i = 0; i < features.albedo.size(); ++i)
-            for (int k = 0; k < 3; ++k) {
-                albedo.push_back(float(features.albedo[i][k]));
-                normal.push_back(float(features.normal[i][k]));
-            }
-        DenoiseInput in;
-        in.radiance = &est.radiance;
-        in.variance = est.variance;
-        in.albedo = albedo;
-        in.normal = normal;
-        in.depth = est.depth;
-        for (int h = 0; h < 2; ++h) {
-            in.half[h] = &est.halves.mean[h];
-            in.half_count[h] = est.halves.count[h];
-        }
+        feature_buffers(p.rs, p.settings, w, h, est.albedo, est.normal);
+        const DenoiseInput in = denoise_input(est, est.radiance, true);
         std::vector<double> ms, cpu_ms, feature_ms, final_ms, final_cpu_ms;
         DenoiseWorkspace workspace;  // as the viewer keeps it
         for (int r = 0; r < rounds; ++r) {
@@ -363,16 +348,7 @@ int tune(int size, int reference_spp, int spp, const std::vector<std::string>& v
         RenderSettings sampling = p.settings;
         sampling.seed = 1;
         feature_buffers(p.rs, sampling, size, size, est.albedo, est.normal);
-        DenoiseInput in;
-        in.radiance = &est.radiance;
-        in.variance = est.variance;
-        in.albedo = est.albedo;
-        in.normal = est.normal;
-        in.depth = est.depth;
-        for (int h = 0; h < 2; ++h) {
-            in.half[h] = &est.halves.mean[h];
-            in.half_count[h] = est.halves.count[h];
-        }
+        const DenoiseInput in = denoise_input(est, est.radiance, true);
         std::printf("%s", name.c_str());
         for (size_t v = 0; v < variants.size(); ++v) {
             const Image den = denoise_nlmeans(in, parse_params(variants[v]));

@@ -64,6 +64,9 @@ inline constexpr double kWhittedRawSpp = 4;
 // albedo and normal views show them).
 void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, int width, int height,
                      std::vector<float>& albedo, std::vector<float>& normal);
+// What the denoiser reads of `estimates` (their feature buffers filled) for the image
+// `radiance` (the mean, or its blurred picture), with the halves where `with_halves`.
+DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radiance, bool with_halves);
 // The layers develop reads for `options` besides those of its output.
 unsigned develop_reads(const DevelopOptions& options);
 
