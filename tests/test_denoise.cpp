@@ -13,6 +13,8 @@
 #include "render/outputs.h"
 #include "render/options.h"
 #include "render/progressive.h"
+#include "render/render_scene.h"
+#include "scene/load.h"
 #include "test_util.h"
 #include "viewer/status.h"
 
@@ -641,6 +643,47 @@ TEST(Denoise, ViewerShowsRawDenoisedOrSplit) {
     EXPECT_EQ(viewer::shown_word(frame, DenoiseView::split), "split");
     frame.denoised = Image();  // a frame the worker did not denoise shows raw
     EXPECT_EQ(viewer::shown_word(frame, DenoiseView::on), "raw");
+}
+
+// bench/denoise_scenes.py, the scenes the denoiser's goals are measured on
+// (scripts/bench_denoise.sh): the same seed writes the same bytes, every scene loads without
+// a warning and prepares for rendering, and they have what the generator promises (5 to 200
+// spheres besides the floor, walls and lamps; 1 to 3 lights).
+class GeneratedScenes : public test::ScratchDirTest {};
+
+TEST_F(GeneratedScenes, AreDeterministicByTheirSeedAndLoad) {
+    const std::filesystem::path script =
+        std::filesystem::path(KEITHRAY_RES_DIR).parent_path() / "bench" / "denoise_scenes.py";
+    for (const char* out : {"a", "b"}) {
+        const test::CommandResult run = test::run_command(
+            "python3 '" + script.string() + "' '" + (dir / out).string() + "' --tune 2 --eval 3 --size 32", dir);
+        ASSERT_EQ(run.status, 0) << run.err;
+    }
+    std::vector<std::string> texts;
+    for (const char* name : {"tune_00", "tune_01", "eval_00", "eval_01", "eval_02"}) {
+        const std::filesystem::path a = dir / "a" / (std::string(name) + ".json"), b = dir / "b" / (std::string(name) + ".json");
+        const std::string text = read_scene_text(a);
+        EXPECT_EQ(text, read_scene_text(b)) << name;
+        texts.push_back(text);
+        const LoadedScene loaded = load_scene_file(a);
+        EXPECT_TRUE(loaded.warnings.empty()) << name << ": " << (loaded.warnings.empty() ? "" : loaded.warnings[0]);
+        const Scene& scene = loaded.scene;
+        int spheres = 0;
+        for (const Primitive& prim : scene.primitives) {
+            const std::string& id = scene.shapes[size_t(prim.shape)].id;
+            spheres += prim.type == PrimitiveType::geometric && id != "floor" && id != "back" && id != "left" &&
+                       id != "right";
+        }
+        EXPECT_GE(spheres, 5) << name;
+        EXPECT_LE(spheres, 200) << name;
+        EXPECT_GE(scene.active_lights.size(), 1u) << name;
+        EXPECT_LE(scene.active_lights.size(), 3u) << name;
+        EXPECT_EQ(scene.renderer.width, 32) << name;
+        EXPECT_NO_THROW((void)prepare_scene(scene)) << name;
+    }
+    // Each seed its own scene.
+    for (size_t i = 0; i < texts.size(); ++i)
+        for (size_t j = i + 1; j < texts.size(); ++j) EXPECT_NE(texts[i], texts[j]) << i << " " << j;
 }
 
 }  // namespace

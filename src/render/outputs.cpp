@@ -69,6 +69,21 @@ void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vect
         }
 }
 
+DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radiance, bool with_halves) {
+    DenoiseInput input;
+    input.radiance = &radiance;
+    input.variance = estimates.variance;
+    input.albedo = estimates.albedo;
+    input.normal = estimates.normal;
+    input.depth = estimates.depth;
+    if (with_halves)
+        for (int h = 0; h < 2; ++h) {
+            input.half[h] = &estimates.halves.mean[h];
+            input.half_count[h] = estimates.halves.count[h];
+        }
+    return input;
+}
+
 unsigned develop_reads(const DevelopOptions& options) {
     if (options.denoise == Denoise::off) return 0;
     // The interactive filter leaves a Whitted render raw past its first passes: it counts them.
@@ -84,18 +99,8 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
     if (options.denoise != Denoise::off) {
         if (estimates.albedo.empty() || estimates.normal.empty())
             feature_buffers(scene, options.sampling, width, height, estimates.albedo, estimates.normal);
-        DenoiseInput input;
-        input.radiance = &out.radiance;
-        input.variance = estimates.variance;
-        input.albedo = estimates.albedo;
-        input.normal = estimates.normal;
-        input.depth = estimates.depth;
         // The halves are of the unblurred mean: a blurred image is filtered without them.
-        if (options.blur == 0)
-            for (int h = 0; h < 2; ++h) {
-                input.half[h] = &estimates.halves.mean[h];
-                input.half_count[h] = estimates.halves.count[h];
-            }
+        const DenoiseInput input = denoise_input(estimates, out.radiance, options.blur == 0);
         // A Whitted render's only noise is the pixel's anti-aliasing, whose error falls about
         // as 1/spp: the final filter would only soften its edges (docs/denoising.md), and the
         // interactive one helps only its first passes, so both keep the raw image from

@@ -69,6 +69,9 @@ void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, i
 // add_surface_samples): of kFeatureSamples, what feature_buffers makes, bit for bit.
 void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vector<float>& albedo,
                                std::vector<float>& normal);
+// What the denoiser reads of `estimates` (their feature buffers filled) for the image
+// `radiance` (the mean, or its blurred picture), with the halves where `with_halves`.
+DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radiance, bool with_halves);
 // The layers develop reads for `options` besides those of its output.
 unsigned develop_reads(const DevelopOptions& options);
 
