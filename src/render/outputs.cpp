@@ -84,6 +84,20 @@ DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radian
     return input;
 }
 
+Image denoised_image(const RenderEstimates& estimates, const Image& radiance, const DevelopOptions& options) {
+    // The halves are of the unblurred mean: a blurred image is filtered without them.
+    const DenoiseInput input = denoise_input(estimates, radiance, options.blur == 0);
+    // A Whitted render's only noise is the pixel's anti-aliasing, whose error falls about
+    // as 1/spp: the final filter would only soften its edges (docs/denoising.md), and the
+    // interactive one helps only its first passes, so both keep the raw image from
+    // kWhittedRawSpp samples per pixel on.
+    const bool whitted_raw = options.sampling.integrator == Integrator::wrt &&
+                             (!options.interactive || mean_samples(estimates.samples) >= kWhittedRawSpp);
+    return whitted_raw           ? radiance
+           : options.interactive ? denoise_atrous(input, {}, options.workspace)
+                                 : denoise_nlmeans(input, {}, options.workspace);
+}
+
 unsigned develop_reads(const DevelopOptions& options) {
     if (options.denoise == Denoise::off) return 0;
     // The interactive filter leaves a Whitted render raw past its first passes: it counts them.
@@ -99,17 +113,7 @@ Developed develop(const RenderScene& scene, RenderEstimates estimates, const Dev
     if (options.denoise != Denoise::off) {
         if (estimates.albedo.empty() || estimates.normal.empty())
             feature_buffers(scene, options.sampling, width, height, estimates.albedo, estimates.normal);
-        // The halves are of the unblurred mean: a blurred image is filtered without them.
-        const DenoiseInput input = denoise_input(estimates, out.radiance, options.blur == 0);
-        // A Whitted render's only noise is the pixel's anti-aliasing, whose error falls about
-        // as 1/spp: the final filter would only soften its edges (docs/denoising.md), and the
-        // interactive one helps only its first passes, so both keep the raw image from
-        // kWhittedRawSpp samples per pixel on.
-        const bool whitted_raw = options.sampling.integrator == Integrator::wrt &&
-                                 (!options.interactive || mean_samples(estimates.samples) >= kWhittedRawSpp);
-        Image denoised = whitted_raw            ? out.radiance
-                         : options.interactive ? denoise_atrous(input, {}, options.workspace)
-                                               : denoise_nlmeans(input, {}, options.workspace);
+        Image denoised = denoised_image(estimates, out.radiance, options);
         out.raw = std::exchange(out.radiance, std::move(denoised));
         // An output with first-surface layers keeps the feature buffers the denoiser read.
         if (layers & kLayerAlbedo) out.albedo = std::move(estimates.albedo);

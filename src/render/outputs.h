@@ -72,6 +72,10 @@ void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vect
 // What the denoiser reads of `estimates` (their feature buffers filled) for the image
 // `radiance` (the mean, or its blurred picture), with the halves where `with_halves`.
 DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radiance, bool with_halves);
+// The denoised picture of `radiance` (the estimates' mean, or its blurred picture) as develop
+// makes it for `options` (denoise on): the estimates hold the feature buffers and the layers
+// develop_reads names; nothing is copied.
+Image denoised_image(const RenderEstimates& estimates, const Image& radiance, const DevelopOptions& options);
 // The layers develop reads for `options` besides those of its output.
 unsigned develop_reads(const DevelopOptions& options);
 

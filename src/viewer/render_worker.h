@@ -197,7 +197,7 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
                         Snapshot& frame);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
 // `features` (null: not denoised) and the pixel statistics.
-void make_full_frame(const RenderJob& job, const RenderState& state, const DisplayFeatures* features,
+void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
                      DenoiseWorkspace& workspace, Snapshot& frame);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
