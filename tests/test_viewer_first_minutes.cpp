@@ -187,15 +187,16 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
     EXPECT_EQ(run_status(nullptr, s, true).state, RunState::error);
     Snapshot f;
     f.spp = 16;
-    f.full_seconds = 8;  // 0.5 s a pass
-    f.seconds = 8.2;
+    f.full_seconds = 8;  // the passes' own time: 0.5 s a pass
+    f.seconds = 8.2;     // wall time since the edit: 0.5125 s a pass, what the ETA goes by
     f.rays = 16000000;
     f.relative_error = 0.04;
     RunStatus st = run_status(&f, s, false);
     EXPECT_EQ(st.state, RunState::rendering);
     EXPECT_DOUBLE_EQ(st.progress, 0.25);
-    EXPECT_DOUBLE_EQ(st.eta, 48 * 0.5);
-    EXPECT_DOUBLE_EQ(st.mrays_per_second, 2);
+    EXPECT_DOUBLE_EQ(st.eta, 48 * 8.2 / 16);
+    EXPECT_DOUBLE_EQ(st.elapsed, 8.2);
+    EXPECT_DOUBLE_EQ(st.mrays_per_second, 2);  // the engine's: rays over the passes' time
     EXPECT_DOUBLE_EQ(st.noise, 0.04);
     s.paused = true;
     EXPECT_EQ(run_status(&f, s, false).state, RunState::paused);
