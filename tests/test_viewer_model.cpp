@@ -436,6 +436,15 @@ TEST(RenderThread, RegionRefinesOnlyItsPixels) {
     EXPECT_EQ(f->sample_count[size_t(box.y0) * 40 + size_t(box.x0)], 6u);
 }
 
+// The worker's frames until one is finished (at most two minutes, on a loaded machine).
+static std::shared_ptr<const Snapshot> finished_frame(const RenderWorker& worker) {
+    std::shared_ptr<const Snapshot> f;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
+        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    return f;
+}
+
 // Past the warm-up (adaptive passes), a region's pass plans only its pixels: the samples of
 // a pass are as many as its pixels (not the whole image's, heaped on them), so the region
 // reaches its target as its pixels' share of the work.
@@ -447,10 +456,7 @@ TEST(RenderThread, ARegionsPassesCostWhatItsPixelsCost) {
     RenderWorker worker;
     worker.set_region(box);
     worker.submit({1, scene, settings, StopRule{settings.target_spp}});
-    std::shared_ptr<const Snapshot> f;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
-        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    const std::shared_ptr<const Snapshot> f = finished_frame(worker);
     ASSERT_TRUE(f && f->finished);
     ASSERT_EQ(f->spp, 16);
     uint64_t inside = 0, outside = 0;
@@ -496,10 +502,7 @@ TEST(RenderThread, FramesCountWallTimeFromTheEdit) {
     RenderJob job{1, scene, settings, StopRule{1}};
     job.edited = std::chrono::steady_clock::now() - std::chrono::seconds(2);
     worker.submit(job);
-    std::shared_ptr<const Snapshot> f;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!(f && f->finished) && std::chrono::steady_clock::now() < deadline)
-        f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(500));
+    const std::shared_ptr<const Snapshot> f = finished_frame(worker);
     ASSERT_TRUE(f && f->finished);
     EXPECT_GE(f->seconds, 2.0);
     EXPECT_LT(f->full_seconds, f->seconds);  // the engine's own clock: its passes alone
