@@ -5,8 +5,9 @@ the X server's copy of the window (x_window_shot.py). Run inside xvfb-run. Print
   viewer_drag.py test  KEITHRAY SCENE WORKDIR
       For tests/test_viewer_window.cpp; never waits for time, only for conditions (bounded by a
       generous limit): the button goes down, then each of STEPS moves of the pointer is
-      followed by a wait until the window shows a frame of the camera that move made, with
-      the button still held; each such frame must differ from the one before. Then the button
+      followed by a wait until the window shows a frame of the camera that move made (the
+      status file names it, then the X server's copy of the window changes), with the button
+      still held; each such frame must differ from the one before. Then the button
       goes up. Prints steps=, shown_during_drag= (moves whose frame came before the next move),
       changed_during_drag=, still_pressed= and the final generation.
 
@@ -138,7 +139,19 @@ def run_test(args):
         s = v.wait(lambda s, g=g: shown(s) and shown(s)[0] >= g, "a frame of the moved camera")
         if s.get("press") not in (None, "0"):
             shown_during += 1
+        # The status line is written as the frame is drawn, before the buffers swap: the
+        # new picture reaches the X server a moment later. Wait for it (bounded), then for two
+        # grabs alike (not one caught mid-copy).
+        end = time.monotonic() + min(LIMIT, 30)
         now = v.image(s)
+        while now == before and time.monotonic() < end:
+            time.sleep(0.01)
+            now = v.image(s)
+        while time.monotonic() < end:
+            again = v.image(s)
+            if again == now:
+                break
+            now = again
         changed += now != before
         before = now
     pressed = v.status().get("press")
