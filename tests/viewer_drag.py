@@ -25,6 +25,7 @@ import sys
 import threading
 import time
 
+sys.dont_write_bytecode = True  # no __pycache__ left in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import ctypes  # noqa: E402
 from x_window_shot import XImage, open_x11, shift_of  # noqa: E402
