@@ -485,8 +485,7 @@ TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
     // Frames costing 0.1 s (making and drawing) come at most every 0.5 s (a fifth of the time).
     EXPECT_FALSE(s.due(0.2, 0.4, 0.1));
     EXPECT_TRUE(s.due(0.2, 0.5, 0.1));
-    // The counts frames are made at: balanced ones, and through a lens after previews none
-    // below 4 spp.
+    // The counts frames are made at: balanced ones, and after previews none below 4 spp.
     for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp, false)) << spp;
     for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp, false)) << spp;
     EXPECT_FALSE(frame_spp(1, true));

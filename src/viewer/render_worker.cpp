@@ -50,8 +50,8 @@ bool FrameSchedule::due(double age, double since_last, double cost) const {
     return since_last >= std::max(by_age, cost / cost_share);
 }
 
-bool frame_spp(int spp, bool lens_after_previews) {
-    if (spp < (lens_after_previews ? kFirstLensFrameSpp : 1)) return false;
+bool frame_spp(int spp, bool after_previews) {
+    if (spp < (after_previews ? kFirstFrameSpp : 1)) return false;
     return spp <= 8 ? (spp & (spp - 1)) == 0 : spp % 8 == 0;
 }
 
@@ -443,8 +443,7 @@ void RenderWorker::run() {
             bool due = false;
             {
                 std::lock_guard lock(mutex_);
-                const bool lens = job.scene->camera.lens_radius > 0;
-                const bool by_schedule = frame_spp(state.passes, lens && !previews.empty()) &&
+                const bool by_schedule = frame_spp(state.passes, !previews.empty()) &&
                     (!full_frame_made ||
                      schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load()));
                 due = by_schedule || paused_ || stop_reason() || (features_.load() && !(latest_ && latest_->features));

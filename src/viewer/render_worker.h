@@ -201,13 +201,13 @@ void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeat
                      DenoiseWorkspace& workspace, Snapshot& frame);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
-// (a stop rule met or a pause makes one at any count): through a lens, after previews, from
-// kFirstLensFrameSpp on (fewer samples, denoised, looked worse than the last preview: the
-// lens's blur is noise at 1 spp); and only where the samples are balanced: powers of two up
-// to 8, then multiples of 8 (a Sobol or stratified estimate between them is less even: a
-// Whitted render lost about 1 dB from 8 spp to 9).
-inline constexpr int kFirstLensFrameSpp = 4;
-bool frame_spp(int spp, bool lens_after_previews);
+// (a stop rule met or a pause makes one at any count): after previews, from kFirstFrameSpp on
+// (fewer samples, denoised, can look worse than the last preview: the a-trous filter at 1 spp
+// speckles, and a lens's blur is noisy); and only where the samples are balanced: powers of
+// two up to 8, then multiples of 8 (a Sobol or stratified estimate between them is less even:
+// a Whitted render lost about 1 dB from 8 spp to 9).
+inline constexpr int kFirstFrameSpp = 4;
+bool frame_spp(int spp, bool after_previews);
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
 // to full resolution. first_scale is the smallest power of two (up to 16) whose pass is
