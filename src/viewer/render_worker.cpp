@@ -60,8 +60,8 @@ RenderWorker::RenderWorker(std::function<void()> on_publish, SharedPasses* ranks
     // A frame allocates its images afresh (about 30 MB at 512x512: the radiance, variance,
     // depth, halves and statistics), and glibc gives blocks this large their own mapping,
     // whose pages fault in zeroed each time and go back to the system when the UI drops the
-    // frame: half of a frame's cost. Kept in the heap instead, the next frame reuses them
-    // (a 512x512 frame: 35 -> 22 ms). The viewer holds that memory while it runs.
+    // frame: half of a frame's cost (docs/viewer.md). Kept in the heap instead, the next frame
+    // reuses them. The viewer holds that memory while it runs.
     static const bool heap_kept = [] {
         mallopt(M_MMAP_THRESHOLD, 256 << 20);
         mallopt(M_TRIM_THRESHOLD, 512 << 20);
