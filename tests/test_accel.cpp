@@ -202,6 +202,43 @@ TEST(Accel, LargeSceneBuildsShallowTree) {
     EXPECT_LE(a.mismatches, a.rays / 2000);
 }
 
+// Rays along the axes, their other components +0 or -0 (a slab's reciprocal +inf or -inf:
+// the tree takes its near plane by that sign), from inside and outside the spheres' cube and
+// from exactly on a box's plane: the tree's hits are the linear scan's.
+TEST(Accel, AxisRaysWithSignedZerosThroughTheTree) {
+    for (AccelBackend backend : backends()) {
+        const RenderScene scene = with_backend(random_spheres(300, 1.0, 21, false), backend);
+        Rng rng(4, 2);
+        int rays = 0, hits = 0, mismatches = 0;
+        for (int i = 0; i < 400; ++i) {
+            const SphereGeom& s = scene.spheres[size_t(rng.next() * double(scene.spheres.size()))];
+            for (int axis = 0; axis < 3; ++axis)
+                for (double sign : {1.0, -1.0})
+                    for (double zero : {0.0, -0.0}) {
+                        Ray ray;
+                        double o[3] = {s.centre.x, s.centre.y, s.centre.z}, d[3] = {zero, zero, zero};
+                        // Through the sphere, or on its box's plane (lo or hi) and clear of it.
+                        const int other = (axis + 1) % 3, third = (axis + 2) % 3;
+                        o[other] += (i % 3 == 0) ? s.radius * (rng.next() - 0.5) : (i % 3 == 1 ? -s.radius : s.radius);
+                        if (i % 3 != 0) o[third] += 0.5 * s.radius;
+                        o[axis] -= sign * (i % 2 ? 3.0 : 0.0);
+                        d[axis] = sign;
+                        ray.o = {o[0], o[1], o[2]};
+                        ray.d = {d[0], d[1], d[2]};
+                        Hit lin, fast;
+                        const bool hit_lin = scene.intersects_linear(ray, lin), hit_fast = scene.intersects(ray, fast);
+                        ++rays;
+                        hits += hit_lin;
+                        if (hit_lin != hit_fast || (hit_lin && (lin.sphere != fast.sphere || std::abs(lin.t - fast.t) > 1e-12 * (lin.t + 1))) ||
+                            scene.is_occluded_linear(ray) != scene.is_occluded(ray))
+                            ++mismatches;
+                    }
+        }
+        EXPECT_GT(hits, rays / 4) << accel_backend_names.name(backend);
+        EXPECT_EQ(mismatches, 0) << accel_backend_names.name(backend);
+    }
+}
+
 // Up to 16 spheres are one leaf of four blocks, tested without box tests: for the brief's
 // rooms of wall spheres, whose huge boxes every ray enters, a tree cost 40% more instructions.
 TEST(Accel, SmallScenesAreOneLeaf) {

@@ -74,7 +74,9 @@ Options:
 constexpr const char* kRenderOnlyOptions = R"(  --gl                  tone map through the viewer's GLSL display shaders in an
                         offscreen OSMesa framebuffer (no display, no GPU needed)
   --blur R              box blur of radius R pixels on the radiance, 0..4096 (default: 0)
-  --threads N           worker threads, 1..4096 (default: all cores)
+  --threads N           worker threads, 1..4096 (default: all cores); a render of at
+                        most 16,384 samples (width x height x spp) runs on one, which
+                        makes the same image for less CPU
   --kernels NAME        how paths are traced: best | double | float8 | any | off (default:
                         best, in SIMD lanes where the CPU has AVX2: in single precision
                         where the scene's sizes allow, sixteen at a time with AVX-512, else
@@ -202,6 +204,7 @@ struct Options {
     std::vector<fs::path> scenes;
     RenderOptions render;  // the flags view takes too: render/options.h
     std::optional<int> threads;
+    int team = 1;  // threads for a render above kOneThreadMaxSamples: --threads, else OpenMP's default
     int blur = 0;
     std::optional<fs::path> output;
     bool quiet = false;
@@ -253,6 +256,13 @@ bool team_started(const std::string& file) {
                  file.c_str(), wanted, started, started, started);
     return false;
 }
+
+// A render of at most this many samples (width x height x spp, 64x64 at 4 spp) runs on one
+// thread, whose team is then never started: its passes cost a few milliseconds, less than
+// another thread costs to start and to wait in (libgomp's idle threads spin about 20 ms of
+// CPU after each parallel region unless OMP_WAIT_POLICY=passive, which only the environment
+// sets). The image is the same on any number of threads (docs/performance.md, "Start-up").
+constexpr uint64_t kOneThreadMaxSamples = 64 * 64 * 4;
 
 // Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
 // why where it could not be written; the previous checkpoint then stays as it was.
@@ -321,6 +331,7 @@ public:
         start_ = std::chrono::steady_clock::now();
         set_stop_rule();
         if (!resume()) return false;
+        if (!start_threads()) return false;
         const StopReason reason = render();
         if (reason == StopReason::cancelled) {
             if (leader_)
@@ -476,6 +487,16 @@ private:
         }
         rays_before_ = state_.rays;
         return true;
+    }
+
+    // One thread for a render of at most kOneThreadMaxSamples (the same choice in every rank:
+    // it depends on the scene and the options), else the team, started before the passes.
+    bool start_threads() {
+        const uint64_t samples = uint64_t(scene_.renderer.width) * uint64_t(scene_.renderer.height) *
+                                 uint64_t(std::max(rule_.max_passes, 0));
+        const bool one = !open_ended_ && samples <= kOneThreadMaxSamples;
+        omp_set_num_threads(one ? 1 : opt_.team);
+        return one || !cluster_.any_flags(!team_started(file_));
     }
 
     // The passes, with the checkpoints, the stop signals and the progress bar between them.
@@ -735,6 +756,7 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (opt.threads) omp_set_num_threads(*opt.threads);
+    opt.team = omp_get_max_threads();
     // --gl's OSMesa is loaded before any render, by the rank that writes.
     std::string gl_error;
     if (opt.gl && cluster.leader()) try {
@@ -744,7 +766,6 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "error: --gl: %s\n", e.what());
         }
     if (cluster.any_flags(!gl_error.empty())) return 1;
-    if (cluster.any_flags(!team_started(opt.scenes.empty() ? std::string("render") : shown(opt.scenes.front())))) return 1;
     if (opt.scenes.empty()) {
         // Rank 0's list of the bundled scenes, in every rank.
         std::string names;

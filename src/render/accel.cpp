@@ -238,86 +238,143 @@ inline __attribute__((always_inline)) bool take_nearest(const SphereBlock& b, v4
     return true;
 }
 
-struct SlabRay {
-    double o[3], inv[3];
-    explicit SlabRay(const Ray& ray) {
-        const double d[3] = {ray.d.x, ray.d.y, ray.d.z};
-        const double o_[3] = {ray.o.x, ray.o.y, ray.o.z};
-        for (int a = 0; a < 3; ++a) {
-            o[a] = o_[a];
-            inv[a] = 1.0 / d[a];  // +-inf for a zero component: that slab test degenerates safely
-        }
-    }
-    // Entry distance into the node's box within [tmin, tmax], or +inf if missed.
-    double enter(const BvhNode& n, double tmin, double tmax) const {
-        // tmax widened by 2 gamma(3) (pbrt's bound) so rounding never culls a grazing hit.
-        constexpr double kWiden = 1.0 + 2.0 * 3.0 * std::numeric_limits<double>::epsilon();
-        for (int a = 0; a < 3; ++a) {
-            double t0 = (n.lo[a] - o[a]) * inv[a], t1 = (n.hi[a] - o[a]) * inv[a];
-            if (t0 > t1) std::swap(t0, t1);
-            t1 *= kWiden;
-            tmin = t0 > tmin ? t0 : tmin;  // NaN (0 * inf) leaves the bound unchanged
-            tmax = t1 < tmax ? t1 : tmax;
-        }
-        return tmin <= tmax ? tmin : kInf;
-    }
-};
-
+// One leaf (scenes of up to 16 spheres): its blocks in turn, no box to test and no
+// reciprocals to compute.
 template <bool kAny>
-inline __attribute__((always_inline)) int traverse(const std::vector<BvhNode>& nodes,
-                                                   const std::vector<SphereBlock>& blocks, const Ray& ray,
-                                                   double& t_best) {
+inline __attribute__((always_inline)) int scan_leaf(const std::vector<SphereBlock>& blocks, uint32_t count,
+                                                    const Ray& ray, double& t_best) {
     double best = ray.tmax;
     int best_id = -1;
-    if (nodes[0].blocks > 0) {
-        // One leaf (scenes of a few spheres): no box to test, and no reciprocals to compute.
-        for (uint32_t k = 0; k < nodes[0].blocks; ++k)
-            if (take_nearest(blocks[k], block_distances<kAny>(blocks[k], ray, best), best, best_id) && kAny) break;
-        t_best = best;
-        return best_id;
+    for (uint32_t k = 0; k < count; ++k)
+        if (take_nearest(blocks[k], block_distances<kAny>(blocks[k], ray, best), best, best_id) && kAny) break;
+    t_best = best;
+    return best_id;
+}
+
+}  // namespace
+
+// Our tree for one path at a time, above one leaf: the binary SAH tree collapsed into nodes
+// of up to four children, whose four boxes one ray tests together in the four lanes (the
+// binary tree's one box at a time took twice the box tests and a cache line a box). The
+// boxes stay in double precision: own takes the scenes outside Embree's single-precision
+// range too.
+struct WideBvh {
+    struct alignas(32) Node {
+        double lo[3][4], hi[3][4];  // the children's boxes by axis; an empty slot lo +inf, hi -inf
+        int32_t child[4];           // >= 0: a node; < 0: a leaf, ~(its first block)
+        uint16_t blocks[4];         // a leaf's blocks (BvhNode's); 0 for a node or an empty slot
+    };
+    std::vector<Node> nodes;
+    int depth = 0;
+};
+
+namespace {
+
+// Collapses the binary subtree at `b` into WideBvh nodes: a node's children are its binary
+// node's two, each inner one replaced by its two children while there are fewer than four,
+// the largest box (by area: the likeliest to be entered) first.
+int32_t collapse_wide(const std::vector<BvhNode>& bin, uint32_t b, WideBvh& wide, int level) {
+    wide.depth = std::max(wide.depth, level + 1);
+    const auto half_area = [&](uint32_t n) {
+        const double x = bin[n].hi[0] - bin[n].lo[0], y = bin[n].hi[1] - bin[n].lo[1], z = bin[n].hi[2] - bin[n].lo[2];
+        return x * y + y * z + z * x;
+    };
+    uint32_t kids[4] = {b + 1, bin[b].index, 0, 0};
+    int count = 2;
+    while (count < 4) {
+        int pick = -1;
+        for (int k = 0; k < count; ++k)
+            if (bin[kids[k]].blocks == 0 && (pick < 0 || half_area(kids[k]) > half_area(kids[pick]))) pick = k;
+        if (pick < 0) break;
+        const uint32_t n = kids[pick];
+        kids[pick] = n + 1;
+        kids[count++] = bin[n].index;
     }
-    const SlabRay slab(ray);
-    const bool dir_negative[3] = {ray.d.x < 0, ray.d.y < 0, ray.d.z < 0};
-    uint32_t stack[kMaxTreeDepth + 1];
+    const uint32_t at = static_cast<uint32_t>(wide.nodes.size());
+    wide.nodes.emplace_back();
+    for (int k = 0; k < 4; ++k)
+        for (int a = 0; a < 3; ++a) {
+            wide.nodes[at].lo[a][k] = k < count ? bin[kids[k]].lo[a] : kInf;
+            wide.nodes[at].hi[a][k] = k < count ? bin[kids[k]].hi[a] : -kInf;
+        }
+    for (int k = 0; k < 4; ++k) {
+        int32_t ref = ~int32_t(0);  // an empty slot: its box is never entered
+        uint16_t blocks = 0;
+        if (k < count) {
+            const BvhNode& n = bin[kids[k]];
+            blocks = n.blocks;
+            ref = n.blocks > 0 ? ~int32_t(n.index) : collapse_wide(bin, kids[k], wide, level + 1);
+        }
+        wide.nodes[at].child[k] = ref;
+        wide.nodes[at].blocks[k] = blocks;
+    }
+    return int32_t(at);
+}
+
+// One ray down the wide tree: the four boxes of a node at once, the entered children taken
+// nearest first (the others stacked with their entry distance, dropped when a closer hit has
+// been found since). A box's slabs in double precision, its far distances widened by
+// 2 gamma(3) (pbrt's bound) so that rounding never culls a grazing hit.
+template <bool kAny>
+inline __attribute__((always_inline)) int traverse_wide(const WideBvh& tree, const std::vector<SphereBlock>& blocks,
+                                                        const Ray& ray, double& t_best) {
+    constexpr double kWiden = 1.0 + 2.0 * 3.0 * std::numeric_limits<double>::epsilon();
+    double best = ray.tmax;
+    int best_id = -1;
+    const double o[3] = {ray.o.x, ray.o.y, ray.o.z};
+    const double d[3] = {ray.d.x, ray.d.y, ray.d.z};
+    v4d org[3], inv[3];
+    int near_is_hi[3];
+    for (int a = 0; a < 3; ++a) {
+        const double r = 1.0 / d[a];  // +-inf for a zero component, by its sign
+        org[a] = splat(o[a]);
+        inv[a] = splat(r);
+        near_is_hi[a] = std::signbit(r);
+    }
+    const v4d tmin = splat(ray.tmin);
+    struct Entry {
+        int32_t ref;
+        uint32_t blocks;
+        double t;
+    };
+    Entry stack[3 * kMaxTreeDepth + 4];
     int top = 0;
-    uint32_t node = 0;
-    if (slab.enter(nodes[0], ray.tmin, best) == kInf) return -1;
-    for (;;) {
-        const BvhNode& n = nodes[node];
-        if (n.blocks > 0) {
-            for (uint32_t k = 0; k < n.blocks; ++k)
-                if (take_nearest(blocks[n.index + k], block_distances<kAny>(blocks[n.index + k], ray, best), best,
-                                 best_id) &&
-                    kAny) {
+    stack[top++] = {0, 0, ray.tmin};
+    while (top > 0) {
+        const Entry e = stack[--top];
+        if (e.t > best) continue;  // beyond the closest hit found since it was stacked
+        if (e.ref < 0) {
+            const uint32_t first = uint32_t(~e.ref), end = first + e.blocks;
+            for (uint32_t k = first; k < end; ++k)
+                if (take_nearest(blocks[k], block_distances<kAny>(blocks[k], ray, best), best, best_id) && kAny) {
                     t_best = best;
                     return best_id;
                 }
-        } else {
-            // Visit the child on the ray's side of the split first; skip boxes beyond `best`.
-            uint32_t first = node + 1, second = n.index;
-            if (dir_negative[n.axis]) std::swap(first, second);
-            const bool hit_first = slab.enter(nodes[first], ray.tmin, best) < kInf;
-            const bool hit_second = slab.enter(nodes[second], ray.tmin, best) < kInf;
-            if (hit_first) {
-                if (hit_second) stack[top++] = second;
-                node = first;
-                continue;
-            }
-            if (hit_second) {
-                node = second;
-                continue;
-            }
+            continue;
         }
-        if (top == 0) break;
-        node = stack[--top];
-        // A box pushed earlier may now lie beyond the closest hit found since.
-        while (slab.enter(nodes[node], ray.tmin, best) == kInf) {
-            if (top == 0) {
-                t_best = best;
-                return best_id;
-            }
-            node = stack[--top];
+        const WideBvh::Node& n = tree.nodes[size_t(e.ref)];
+        v4d enter = tmin, leave = splat(best);
+        for (int a = 0; a < 3; ++a) {
+            const v4d lo = load_lanes(n.lo[a]), hi = load_lanes(n.hi[a]);
+            const v4d t0 = ((near_is_hi[a] ? hi : lo) - org[a]) * inv[a];
+            const v4d t1 = ((near_is_hi[a] ? lo : hi) - org[a]) * inv[a] * kWiden;
+            enter = select(t0 > enter, t0, enter);  // NaN (0 * inf) leaves the bound unchanged
+            leave = select(t1 < leave, t1, leave);
         }
+        const v4l entered = enter <= leave;
+        if (!any_lane(entered)) continue;
+        // Stack the entered children farthest first, so the nearest is taken next.
+        int order[4], hits = 0;
+        for (int k = 0; k < 4; ++k)
+            if (entered[k]) {
+                int at = hits++;
+                while (at > 0 && enter[order[at - 1]] < enter[k]) {
+                    order[at] = order[at - 1];
+                    --at;
+                }
+                order[at] = k;
+            }
+        for (int h = 0; h < hits; ++h) stack[top++] = {n.child[order[h]], n.blocks[order[h]], enter[order[h]]};
     }
     t_best = best;
     return best_id;
@@ -488,6 +545,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     depth_ = 0;
     embree_.reset();
     embree_functions_ = nullptr;
+    wide_.reset();
     lane_tree_ = {};
     if (backend != AccelBackend::embree && spheres.size() > size_t(kMaxLeafSpheres) &&
         spheres.size() <= (backend == AccelBackend::own ? kLaneOwnMaxSpheres : kLaneTreeMaxSpheres))
@@ -516,20 +574,28 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     if (spheres.empty()) return;
     builder.build(0, static_cast<int>(spheres.size()), 0);
     depth_ = builder.depth;
+    if (nodes_.size() > 1) {
+        auto wide = std::make_shared<WideBvh>();
+        wide->nodes.reserve(nodes_.size() / 2 + 1);
+        collapse_wide(nodes_, 0, *wide, 0);
+        wide_ = std::move(wide);
+    }
 }
 
 // Two versions of each entry point (KR_CLONES, lanes.h).
 KR_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
     if (embree_) return embree_functions_->closest(*embree_, ray, t);
     if (nodes_.empty()) return -1;
-    return traverse<false>(nodes_, blocks_, ray, t);
+    if (wide_) return traverse_wide<false>(*wide_, blocks_, ray, t);
+    return scan_leaf<false>(blocks_, nodes_[0].blocks, ray, t);
 }
 
 KR_CLONES bool SphereBvh::any(const Ray& ray) const {
     if (embree_) return embree_functions_->any(*embree_, ray);
     if (nodes_.empty()) return false;
     double t;
-    return traverse<true>(nodes_, blocks_, ray, t) >= 0;
+    if (wide_) return traverse_wide<true>(*wide_, blocks_, ray, t) >= 0;
+    return scan_leaf<true>(blocks_, nodes_[0].blocks, ray, t) >= 0;
 }
 
 }  // namespace kr

@@ -19,6 +19,7 @@ struct Ray;
 struct SphereGeom;
 struct EmbreeSpheres;  // accel_embree.cpp
 struct EmbreeModule;
+struct WideBvh;        // accel.cpp: our tree as it is walked, four children a node
 
 // own:       our BVH. One leaf, without any box test, for up to 16 spheres: the faster one
 //            for small scenes (the brief's have 5 to 10 spheres).
@@ -136,6 +137,7 @@ private:
     std::vector<BvhNode> nodes_;
     std::vector<SphereBlock> blocks_;
     int depth_ = 0;
+    std::shared_ptr<const WideBvh> wide_;          // our tree for one path at a time; copies share it
     LaneTree lane_tree_;
     std::shared_ptr<const EmbreeSpheres> embree_;  // immutable once built: copies share it
     const EmbreeModule* embree_functions_ = nullptr;  // the module's, with embree_
