@@ -255,7 +255,7 @@ TEST(Accel, SmallScenesAreOneLeaf) {
 
 // The float lanes' scan of up to kLaneScanMaxSpheres (LaneTree::clusters): every sphere once,
 // the wall (a box spanning the scene) first and alone, the others in clusters of up to eight
-// whose padded boxes hold them; none above kLaneScanMaxSpheres, where the lanes walk the tree.
+// whose padded boxes hold them.
 TEST(Accel, LaneClustersHoldEverySphereOnce) {
     const RenderScene scene = with_backend(random_spheres(60, 1.0, 7, true), AccelBackend::own);
     const LaneTree& tree = scene.bvh.lane_tree();
@@ -289,11 +289,18 @@ TEST(Accel, LaneClustersHoldEverySphereOnce) {
     }
     EXPECT_EQ(next, scene.spheres.size());
     EXPECT_GE(boxed, 60u / 8);
+    // Every lane tree of own's is scanned (kLaneOwnMaxSpheres spheres, the wall one of them);
+    // above it there is none: one path at a time down our tree.
+    static_assert(kLaneScanMaxSpheres >= kLaneOwnMaxSpheres);
+    const RenderScene most =
+        with_backend(random_spheres(int(kLaneOwnMaxSpheres) - 1, 1.0, 7, true), AccelBackend::own);
+    EXPECT_FALSE(most.bvh.lane_tree().nodes.empty());
+    EXPECT_EQ(most.bvh.lane_tree().scan_f.size(), most.spheres.size());
     const RenderScene many =
-        with_backend(random_spheres(int(kLaneScanMaxSpheres) + 8, 1.0, 7, true), AccelBackend::own);
-    EXPECT_FALSE(many.bvh.lane_tree().nodes.empty());
+        with_backend(random_spheres(int(kLaneOwnMaxSpheres) + 8, 1.0, 7, true), AccelBackend::own);
+    EXPECT_TRUE(many.bvh.lane_tree().nodes.empty());
     EXPECT_TRUE(many.bvh.lane_tree().clusters.empty());
-    EXPECT_TRUE(many.bvh.lane_tree().scan_f.empty());
+    EXPECT_FALSE(many.bvh.packets());
 }
 
 TEST(Accel, CoincidentCentresStillSplit) {

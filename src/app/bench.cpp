@@ -59,12 +59,12 @@ constexpr const char* kBenchUsage = R"(Usage:
 --stress      generated scenes of N random spheres (and a floor and a lamp, two spheres
               more) under a sphere light, path traced at W x W (default 256) with 4 spp:
               ns per ray and ns per ray / log2(N), and how paths were traced: in SIMD
-              lanes, which scan the spheres a cluster at a time up to 1,024 spheres
-              and walk their own tree above, or one path at a time. Under auto the
-              lanes take up to 1,024 spheres (eight float lanes 768, double lanes
-              128) and Embree one path at a time above; under own, up to 2,048
-              (eight float lanes 1,024, double lanes 320) and our own tree one path
-              at a time above; embree always traces one path at a time.
+              lanes (single-precision lanes scan the spheres a cluster at a time,
+              double lanes walk a tree) or one path at a time. Under auto the lanes
+              take up to 1,800 spheres (eight float lanes 768, double lanes 128)
+              and Embree one path at a time above; under own, up to 2,048 (eight
+              float lanes 1,024, double lanes 320) and our own tree one path at a
+              time above (never Embree); embree always traces one path at a time.
 --sweep       --stress at every count from FROM to TO, each about 10 % above the last,
               then per BVH its steps (the largest rise of ns per ray between
               neighbouring counts, and how many rise by more than 15 %) and its band

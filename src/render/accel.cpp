@@ -363,6 +363,12 @@ inline __attribute__((always_inline)) int traverse_wide(const WideBvh& tree, con
         }
         const v4l entered = enter <= leave;
         if (!any_lane(entered)) continue;
+        if constexpr (kAny) {
+            // Any hit ends the walk: no order to keep.
+            for (int k = 0; k < 4; ++k)
+                if (entered[k]) stack[top++] = {n.child[k], n.blocks[k], enter[k]};
+            continue;
+        }
         // Stack the entered children farthest first, so the nearest is taken next.
         int order[4], hits = 0;
         for (int k = 0; k < 4; ++k)

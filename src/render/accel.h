@@ -41,12 +41,12 @@ bool embree_fits(const std::vector<SphereGeom>& spheres);
 
 // Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
 // well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
-// "Switch points": the single-precision lanes' scan meets Embree at about 1,100 spheres with
-// sixteen lanes and about 900 with eight; the double lanes stop earlier, packet.cpp).
-inline constexpr size_t kLaneTreeMaxSpheres = 1024;
+// "Switch points": the sixteen single-precision lanes' scan meets Embree at about 1,800
+// spheres, the eight at about 900; the double lanes stop earlier, packet.cpp).
+inline constexpr size_t kLaneTreeMaxSpheres = 1800;
 // Up to this many, AccelBackend::own builds it: above it one path down our own tree is the
-// faster (sixteen float lanes meet it at about 2,000 spheres; eight at about 1,200 and the
-// double lanes at about 350 stop earlier, packet.cpp).
+// faster (the sixteen float lanes' scan meets it at about 2,500 spheres; eight at about 1,200
+// and the double lanes at about 350 stop earlier, packet.cpp).
 inline constexpr size_t kLaneOwnMaxSpheres = 2048;
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
@@ -73,8 +73,10 @@ struct LaneSphere {
 };
 // Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
 // walk the lane tree (docs/performance.md, "Switch points": the scan is the cheaper up to
-// about 2,800 spheres with sixteen lanes and about 1,500 with eight).
-inline constexpr size_t kLaneScanMaxSpheres = 1024;
+// about 2,500 spheres with sixteen lanes and about 1,500 with eight). It covers every lane
+// tree built for the float lanes under `--kernels best` (kLaneOwnMaxSpheres): their tree walk
+// runs only with kernels named for measuring, and the double lanes always walk it.
+inline constexpr size_t kLaneScanMaxSpheres = 2048;
 // Spheres near each other that the scan tests after their box (boxed), or a sphere it tests
 // alone: scan_f[first, first + count).
 struct LaneCluster {
