@@ -258,11 +258,13 @@ TEST_F(Cli, BenchPrintsFiguresAndRejectsBadUsage) {
     for (const char* row : {"| 8 | own |", "| 9 | own |", "| 10 | own |", "Sweep of 3 counts, 8 to 10", "| own | "})
         EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
     EXPECT_NE(r.out.find("at 4 spp, wall time)"), std::string::npos) << r.out;
-    // --cpu-time: the same, timed by the process's CPU time.
-    r = cli("bench --sweep 8:9 --runs 1 --size 8 --accel own --threads 1 --cpu-time");
+    // --cpu-time: the same, timed by the process's CPU time; two rounds over the counts, one row
+    // per count and BVH all the same.
+    r = cli("bench --sweep 8:9 --runs 2 --size 8 --accel own --threads 1 --cpu-time");
     EXPECT_EQ(r.status, 0) << r.err;
     EXPECT_NE(r.out.find("| 9 | own |"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("(1 threads, 1 runs, 8 x 8 at 4 spp, CPU time)"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("| 9 | own |"), r.out.rfind("| 9 | own |")) << r.out;
+    EXPECT_NE(r.out.find("(1 threads, 2 runs, 8 x 8 at 4 spp, CPU time)"), std::string::npos) << r.out;
     r = cli("bench --sweep 10:8");
     EXPECT_EQ(r.status, 2);
     EXPECT_NE(r.err.find("--sweep: TO is below FROM in \"10:8\""), std::string::npos) << r.err;

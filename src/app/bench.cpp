@@ -65,6 +65,9 @@ constexpr const char* kBenchUsage = R"(Usage:
               and Embree one path at a time above; under own, up to 2,048 (eight
               float lanes 1,024, double lanes 320) and our own tree one path at a
               time above (never Embree); embree always traces one path at a time.
+              --runs rounds each render every count once (each BVH in turn); the
+              table gives their medians, so that a burst of load on a shared
+              machine moves one run of many counts rather than one count's median.
 --sweep       --stress at every count from FROM to TO, each about 10 % above the last,
               then per BVH its steps (the largest rise of ns per ray between
               neighbouring counts, and how many rise by more than 15 %) and its band
@@ -314,54 +317,78 @@ void print_sweep_summary(const char* bvh, const std::vector<int>& counts, const 
     else std::printf("- | - |\n");
 }
 
+// One generated scene's figures under each BVH of --stress, gathered over the rounds.
+struct StressCount {
+    double prepare_ms = 0;
+    std::vector<double> build_ms;
+    std::vector<std::vector<double>> seconds, ns;  // per BVH, one per round
+    struct Built {
+        std::string bvh, nodes, depth, paths;  // the table's columns that describe what ran
+    };
+    std::vector<Built> built;  // per BVH
+};
+
 int bench_stress(const BenchOptions& o) {
-    std::vector<std::vector<double>> sweep(o.accel.size());  // ns per ray, per BVH, per count
+    const size_t bvhs = o.accel.size();
+    std::vector<StressCount> counts(o.stress.size());
+    // Rounds: every count once a round, each BVH in turn on copies of one prepared scene, so
+    // that the ratios come from the same moments of a shared machine and a burst of load lands
+    // in one run of many counts (which their medians drop) rather than in every run of one.
+    for (int run = 0; run < o.runs; ++run)
+        for (size_t c = 0; c < o.stress.size(); ++c) {
+            const int n = o.stress[c];
+            StressCount& count = counts[c];
+            const double prepare_start = now_seconds();
+            const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1), "stress.json").scene);
+            if (run == 0) {
+                count.prepare_ms = (now_seconds() - prepare_start) * 1e3;
+                count.build_ms.resize(bvhs);
+                count.seconds.resize(bvhs);
+                count.ns.resize(bvhs);
+                count.built.resize(bvhs);
+            }
+            RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
+            settings.target_spp = 4;
+            settings.kernels = o.kernels;
+            for (size_t k = 0; k < bvhs; ++k) {
+                RenderScene scene = prepared;
+                scene.linear_scan = o.linear;
+                scene.accel_backend = o.accel[k];
+                const double build_start = now_seconds();
+                scene.build_accel();
+                if (run == 0) count.build_ms[k] = (now_seconds() - build_start) * 1e3;
+                const Timing t = time_render(scene, settings, o.size, o.size, 4, o.cpu_time);
+                count.seconds[k].push_back(t.seconds);
+                // Per-ray cost on all threads together, as a user sees it.
+                count.ns[k].push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
+                if (run > 0) continue;
+                const SphereBvh& bvh = scene.bvh;
+                const bool own = bvh.backend() == AccelBackend::own;
+                // How the SIMD lanes cast rays: the clusters a scan tests, or their tree.
+                const char* lanes = bvh.one_leaf() ? "" : !bvh.lane_tree().clusters.empty() ? ", scan"
+                                                      : !bvh.lane_tree().nodes.empty()     ? ", tree"
+                                                                                           : "";
+                count.built[k] = {o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())),
+                                  own ? std::to_string(bvh.node_count()) : "-", own ? std::to_string(bvh.depth()) : "-",
+                                  std::string(packet_kernels_names.name(packet_kernels(scene, settings))) + lanes};
+            }
+        }
+    std::vector<std::vector<double>> sweep(bvhs);  // ns per ray, per BVH, per count
     std::printf("| spheres | BVH | nodes | depth | prepare ms | build ms | median s | Mrays/s | ns/ray | ns/ray / log2 N | paths |\n");
     std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (int n : o.stress) {
-        const double prepare_start = now_seconds();
-        const RenderScene prepared = prepare_scene(parse_scene(stress_scene_json(n, 1), "stress.json").scene);
-        const double prepare_ms = (now_seconds() - prepare_start) * 1e3;
-        // One copy of the scene per BVH, timed in turn within each run, so that the ratios
-        // come from the same moments of a shared machine.
-        std::vector<RenderScene> scenes(o.accel.size(), prepared);
-        std::vector<double> build_ms(o.accel.size());
-        std::vector<std::vector<double>> seconds(o.accel.size()), ns(o.accel.size());
-        for (size_t k = 0; k < o.accel.size(); ++k) {
-            scenes[k].linear_scan = o.linear;
-            scenes[k].accel_backend = o.accel[k];
-            const double build_start = now_seconds();
-            scenes[k].build_accel();
-            build_ms[k] = (now_seconds() - build_start) * 1e3;
-        }
-        RenderSettings settings = RenderSettings::from_scene(prepared.renderer);
-        settings.target_spp = 4;
-        settings.kernels = o.kernels;
-        for (int run = 0; run < o.runs; ++run)
-            for (size_t k = 0; k < o.accel.size(); ++k) {
-                const Timing t = time_render(scenes[k], settings, o.size, o.size, 4, o.cpu_time);
-                seconds[k].push_back(t.seconds);
-                // Per-ray cost on all threads together, as a user sees it.
-                ns[k].push_back(t.rays ? t.seconds / double(t.rays) * 1e9 : 0);
-            }
-        for (size_t k = 0; k < o.accel.size(); ++k) {
-            const SphereBvh& bvh = scenes[k].bvh;
-            const bool own = bvh.backend() == AccelBackend::own;
-            const double ns_ray = median(ns[k]);
+    for (size_t c = 0; c < o.stress.size(); ++c) {
+        const int n = o.stress[c];
+        const StressCount& count = counts[c];
+        for (size_t k = 0; k < bvhs; ++k) {
+            const double ns_ray = median(count.ns[k]);
             sweep[k].push_back(ns_ray);
-            // How the SIMD lanes cast rays: the clusters a scan tests, or their tree.
-            const char* lanes = bvh.one_leaf() ? "" : !bvh.lane_tree().clusters.empty() ? ", scan"
-                                                  : !bvh.lane_tree().nodes.empty()     ? ", tree"
-                                                                                       : "";
-            std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f | %s |\n", n,
-                        o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())).c_str(),
-                        own ? std::to_string(bvh.node_count()).c_str() : "-",
-                        own ? std::to_string(bvh.depth()).c_str() : "-", prepare_ms, build_ms[k], median(seconds[k]),
-                        ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1),
-                        (std::string(packet_kernels_names.name(packet_kernels(scenes[k], settings))) + lanes).c_str());
+            const StressCount::Built& b = count.built[k];
+            std::printf("| %d | %s | %s | %s | %.0f | %.0f | %.2f | %.1f | %.1f | %.2f | %s |\n", n, b.bvh.c_str(),
+                        b.nodes.c_str(), b.depth.c_str(), count.prepare_ms, count.build_ms[k], median(count.seconds[k]),
+                        ns_ray > 0 ? 1e3 / ns_ray : 0, ns_ray, ns_ray / std::log2(double(n) + 1), b.paths.c_str());
         }
-        std::fflush(stdout);
     }
+    std::fflush(stdout);
     if (o.sweep) {
         std::printf("\nSweep of %zu counts, %d to %d (%d threads, %d runs, %d x %d at 4 spp, %s time):\n\n",
                     o.stress.size(), o.stress.front(), o.stress.back(), omp_get_max_threads(), o.runs, o.size, o.size,
