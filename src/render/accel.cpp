@@ -339,10 +339,8 @@ inline __attribute__((always_inline)) int traverse_wide(const WideBvh& tree, con
     };
     Entry stack[3 * kMaxTreeDepth + 4];
     int top = 0;
-    stack[top++] = {0, 0, ray.tmin};
-    while (top > 0) {
-        const Entry e = stack[--top];
-        if (e.t > best) continue;  // beyond the closest hit found since it was stacked
+    Entry e{0, 0, ray.tmin};  // the root; then the nearest child entered, or the stack's top
+    for (;;) {
         if (e.ref < 0) {
             const uint32_t first = uint32_t(~e.ref), end = first + e.blocks;
             for (uint32_t k = first; k < end; ++k)
@@ -350,40 +348,48 @@ inline __attribute__((always_inline)) int traverse_wide(const WideBvh& tree, con
                     t_best = best;
                     return best_id;
                 }
-            continue;
-        }
-        const WideBvh::Node& n = tree.nodes[size_t(e.ref)];
-        v4d enter = tmin, leave = splat(best);
-        for (int a = 0; a < 3; ++a) {
-            const v4d lo = load_lanes(n.lo[a]), hi = load_lanes(n.hi[a]);
-            const v4d t0 = ((near_is_hi[a] ? hi : lo) - org[a]) * inv[a];
-            const v4d t1 = ((near_is_hi[a] ? lo : hi) - org[a]) * inv[a] * kWiden;
-            enter = select(t0 > enter, t0, enter);  // NaN (0 * inf) leaves the bound unchanged
-            leave = select(t1 < leave, t1, leave);
-        }
-        const v4l entered = enter <= leave;
-        if (!any_lane(entered)) continue;
-        if constexpr (kAny) {
-            // Any hit ends the walk: no order to keep.
-            for (int k = 0; k < 4; ++k)
-                if (entered[k]) stack[top++] = {n.child[k], n.blocks[k], enter[k]};
-            continue;
-        }
-        // Stack the entered children farthest first, so the nearest is taken next.
-        int order[4], hits = 0;
-        for (int k = 0; k < 4; ++k)
-            if (entered[k]) {
-                int at = hits++;
-                while (at > 0 && enter[order[at - 1]] < enter[k]) {
-                    order[at] = order[at - 1];
-                    --at;
-                }
-                order[at] = k;
+        } else {
+            const WideBvh::Node& n = tree.nodes[size_t(e.ref)];
+            v4d enter = tmin, leave = splat(best);
+            for (int a = 0; a < 3; ++a) {
+                const v4d lo = load_lanes(n.lo[a]), hi = load_lanes(n.hi[a]);
+                const v4d t0 = ((near_is_hi[a] ? hi : lo) - org[a]) * inv[a];
+                const v4d t1 = ((near_is_hi[a] ? lo : hi) - org[a]) * inv[a] * kWiden;
+                enter = select(t0 > enter, t0, enter);  // NaN (0 * inf) leaves the bound unchanged
+                leave = select(t1 < leave, t1, leave);
             }
-        for (int h = 0; h < hits; ++h) stack[top++] = {n.child[order[h]], n.blocks[order[h]], enter[order[h]]};
+            const v4l entered = enter <= leave;
+            double t[4];
+            __builtin_memcpy(t, &enter, sizeof t);
+            // The entered children nearest last (an any-hit walk keeps no order): all but the
+            // last stacked, the last taken next.
+            int order[4], hits = 0;
+            for (int k = 0; k < 4; ++k)
+                if (entered[k]) {
+                    int at = hits++;
+                    if constexpr (!kAny)
+                        while (at > 0 && t[order[at - 1]] < t[k]) {
+                            order[at] = order[at - 1];
+                            --at;
+                        }
+                    order[at] = k;
+                }
+            if (hits > 0) {
+                for (int h = 0; h + 1 < hits; ++h) stack[top++] = {n.child[order[h]], n.blocks[order[h]], t[order[h]]};
+                const int k = order[hits - 1];
+                e = {n.child[k], n.blocks[k], t[k]};
+                continue;
+            }
+        }
+        // Next, the top of the stack that still lies before the closest hit found so far.
+        do {
+            if (top == 0) {
+                t_best = best;
+                return best_id;
+            }
+            e = stack[--top];
+        } while (e.t > best);
     }
-    t_best = best;
-    return best_id;
 }
 
 }  // namespace
