@@ -16,6 +16,7 @@
 
 #include "render/camera.h"
 #include "render/outputs.h"
+#include "render/progressive.h"
 #include "scene/load.h"
 #include "test_util.h"
 #include "viewer/edit.h"
@@ -470,6 +471,77 @@ TEST(RenderThread, ARegionsPassesCostWhatItsPixelsCost) {
     const double mean = double(inside) / (12.0 * 12.0);
     EXPECT_GE(mean, 15.0);
     EXPECT_LE(mean, 17.0);
+}
+
+// A region's passes change only its pixels' halves (the final denoiser's guides): the others'
+// stay as they were, bit for bit, however many passes go by.
+TEST(RenderThread, ARegionsPassesLeaveTheOtherPixelsHalvesAsTheyWere) {
+    const auto scene = small_scene(3, 24, 20);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    RenderState state(24, 20);
+    state.track_halves();
+    RegionHooks region;
+    const StopRule rule{16};
+    ProgressiveDriver driver(*scene, settings, state, rule, &region);
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(driver.pass(rule));
+    const RenderState::Halves before = state.halves();
+    const PixelBox box{4, 5, 13, 11};
+    region.region = box;
+    for (int i = 0; i < 10; ++i) ASSERT_TRUE(driver.pass(rule));  // planned passes among them
+    const RenderState::Halves after = state.halves();
+    int changed = 0;
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 24; ++x) {
+            const size_t i = size_t(y) * 24 + size_t(x);
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            for (int h = 0; h < 2; ++h) {
+                if (in) {
+                    changed += after.count[h][i] > before.count[h][i];
+                    continue;
+                }
+                ASSERT_EQ(after.count[h][i], before.count[h][i]) << x << "," << y;
+                ASSERT_EQ(std::memcmp(&after.mean[h].pixels[i], &before.mean[h].pixels[i], sizeof(Color)), 0) << x << "," << y;
+            }
+        }
+    EXPECT_GE(changed, 2 * 9 * 6 - 4);  // the box's pixels grew both halves
+}
+
+// The display's feature buffers within a region: its pixels are refined and are the whole
+// image's, bit for bit; the others wait until there is no region, and at kFeatureSamples
+// every pixel is feature_buffers'.
+TEST(RenderThread, DisplayFeaturesRefineARegionFirstAndEndAsSavesOwn) {
+    const auto scene = small_scene(8, 30, 24);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    const RenderJob job{1, scene, settings, StopRule{4}};
+    SurfaceLayers sums;
+    add_surface_samples(*scene, settings, 30, 24, 0, 2, sums);
+    std::vector<float> albedo2, normal2;
+    feature_buffers_from_sums(sums, 2, albedo2, normal2);
+    DisplayFeatures features;
+    features.reset(30, 24);
+    const PixelBox box{3, 2, 17, 9};
+    features.refine_to(job, 1, box);
+    features.refine_to(job, 2, box);
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 30; ++x) {
+            const size_t i = size_t(y) * 30 + size_t(x);
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            ASSERT_EQ(features.counts[i], in ? 2 : 0) << x << "," << y;
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_EQ(features.albedo[3 * i + size_t(k)], in ? albedo2[3 * i + size_t(k)] : 0.0f) << x << "," << y;
+                ASSERT_EQ(features.normal[3 * i + size_t(k)], in ? normal2[3 * i + size_t(k)] : 0.0f) << x << "," << y;
+            }
+        }
+    EXPECT_EQ(next_display_feature_samples(features), 2);
+    features.refine_to(job, 2);  // the region cleared: the other pixels catch up
+    EXPECT_EQ(features.albedo, albedo2);
+    EXPECT_EQ(features.normal, normal2);
+    features.refine_to(job, kFeatureSamples);
+    std::vector<float> albedo, normal;
+    feature_buffers(*scene, settings, 30, 24, albedo, normal);
+    EXPECT_EQ(features.albedo, albedo);
+    EXPECT_EQ(features.normal, normal);
 }
 
 // The frame schedule: the first frame, then intervals of half the image's age (at least a

@@ -23,6 +23,13 @@ struct Image {
     const Color& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
 
+// The pixels [x0, x1) x [y0, y1) of an image (a render region, a part of an image to work on).
+struct PixelBox {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool operator==(const PixelBox& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+    bool operator!=(const PixelBox& o) const { return !(*this == o); }
+};
+
 // 8-bit RGB, row-major, top row first.
 struct Rgb8Image {
     int width = 0, height = 0;

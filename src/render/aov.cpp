@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "render/material.h"
 #include "render/path.h"
@@ -83,24 +84,23 @@ SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSett
     return out;
 }
 
-void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
-                         int count, SurfaceLayers& sums) {
-    const size_t n = size_t(width) * size_t(height);
-    if (sums.albedo.size() != n || sums.normal.size() != n) {
-        sums.albedo.assign(n, Color());
-        sums.normal.assign(n, Color());
-    }
-    first = std::max(0, first);
-    count = std::clamp(count, 0, kSampleBatch);
-    if (count == 0) return;
+namespace {
+
+// Adds to `sums` the first-surface layers of the camera samples [first, first + count) of each
+// pixel of `box` whose `range` gives them (x, pixel index) -> {first, count}.
+template <class Range>
+void add_box_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                     const PixelBox& box, SurfaceLayers& sums, const Range& range) {
 #pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < height; ++y) {
+    for (int y = box.y0; y < box.y1; ++y) {
         std::optional<Sampler> samplers[kSampleBatch];
         Sampler* pointers[kSampleBatch];
         int xs[kSampleBatch], ys[kSampleBatch];
         Ray rays[kSampleBatch];
-        for (int x = 0; x < width; ++x) {
+        for (int x = box.x0; x < box.x1; ++x) {
             const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+            const auto [first, count] = range(pixel);
+            if (count <= 0) continue;
             // The pixel's camera samples first..first+count-1, made as render_pass makes them.
             for (int k = 0; k < count; ++k) {
                 const uint32_t index = uint32_t(first + k);
@@ -122,6 +122,40 @@ void add_surface_samples(const RenderScene& scene, const RenderSettings& setting
             sums.normal[pixel] = normal;
         }
     }
+}
+
+void size_sums(size_t n, SurfaceLayers& sums) {
+    if (sums.albedo.size() != n || sums.normal.size() != n) {
+        sums.albedo.assign(n, Color());
+        sums.normal.assign(n, Color());
+    }
+}
+
+}  // namespace
+
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
+                         int count, SurfaceLayers& sums) {
+    size_sums(size_t(width) * size_t(height), sums);
+    first = std::max(0, first);
+    count = std::clamp(count, 0, kSampleBatch);
+    if (count == 0) return;
+    add_box_samples(scene, settings, width, height, PixelBox{0, 0, width, height}, sums,
+                    [&](size_t) { return std::pair{first, count}; });
+}
+
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums) {
+    const size_t n = size_t(width) * size_t(height);
+    size_sums(n, sums);
+    if (counts.size() != n) counts.assign(n, 0);
+    const PixelBox inside{std::max(0, box.x0), std::max(0, box.y0), std::min(width, box.x1), std::min(height, box.y1)};
+    if (inside.x0 >= inside.x1 || inside.y0 >= inside.y1) return;
+    total = std::clamp(total, 0, kSampleBatch);
+    add_box_samples(scene, settings, width, height, inside, sums, [&](size_t pixel) {
+        const int first = counts[pixel];
+        counts[pixel] = uint8_t(std::max(first, total));  // each pixel's own entry: no race
+        return std::pair{first, total - first};
+    });
 }
 
 }  // namespace kr

@@ -209,18 +209,21 @@ Image denoised_radiance(const RenderJob& job, RenderEstimates& estimates, Displa
 }  // namespace
 
 void DisplayFeatures::reset(int w, int h) {
-    width = w, height = h, samples = 0;
+    width = w, height = h, samples = whole = 0;
     sums = {};
+    counts.clear();
     albedo.clear();
     normal.clear();
 }
 
-void DisplayFeatures::refine_to(const RenderJob& job, int total) {
-    const int count = std::min(total, kFeatureSamples) - samples;
-    if (count <= 0) return;
-    add_surface_samples(*job.scene, job.settings, width, height, samples, count, sums);
-    samples += count;
-    feature_buffers_from_sums(sums, samples, albedo, normal);
+void DisplayFeatures::refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box) {
+    total = std::min(total, kFeatureSamples);
+    if (total <= whole) return;
+    const PixelBox pixels = box.value_or(PixelBox{0, 0, width, height});
+    add_surface_samples(*job.scene, job.settings, width, height, pixels, total, counts, sums);
+    feature_buffers_from_sums(sums, counts, width, pixels, albedo, normal);
+    samples = std::max(samples, total);
+    if (!box) whole = total;
 }
 
 int next_display_feature_samples(const DisplayFeatures& features) {
@@ -455,7 +458,8 @@ void RenderWorker::run() {
             // image (guided by feature buffers refined one more step each frame) and the
             // pixel statistics.
             // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
-            if (denoise_.load()) display_features.refine_to(job, next_display_feature_samples(display_features));
+            if (denoise_.load())
+                display_features.refine_to(job, next_display_feature_samples(display_features), region.region);
             const auto start = Clock::now();
             make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame);
             if (features_.load()) {

@@ -37,12 +37,8 @@ struct RenderJob {
     std::chrono::steady_clock::time_point edited{};
 };
 
-// A render region: the image pixels [x0, x1) x [y0, y1) that full passes refine.
-struct PixelBox {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    bool operator==(const PixelBox& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
-    bool operator!=(const PixelBox& o) const { return !(*this == o); }
-};
+// A render region: the image pixels that full passes refine (core/image.h).
+using kr::PixelBox;
 
 // Narrows each full pass to a region's pixels (AND the noise rule's mask), through the
 // driver's pass hooks, before the pass is planned: the plan gives the region's pixels as many
@@ -171,16 +167,20 @@ struct FrameSchedule {
 
 // The display's feature buffers of one image (albedo and normal, render/outputs.h): refined a
 // few camera samples at a time (render/aov.h add_surface_samples), so that the first frame of
-// an edit costs one sample a pixel; at kFeatureSamples they are feature_buffers', bit for bit.
+// an edit costs one sample a pixel, and within a render region only while there is one; at
+// kFeatureSamples they are feature_buffers', bit for bit.
 struct DisplayFeatures {
     int width = 0, height = 0;
     SurfaceLayers sums;
-    int samples = 0;
+    std::vector<uint8_t> counts;  // camera samples per pixel in the sums
+    int samples = 0;              // the samples a pixel the display asked for last
+    int whole = 0;                // ... that every pixel has
     std::vector<float> albedo, normal;  // of the sums
 
     void reset(int w, int h);
-    // Refined to `total` camera samples a pixel (at most kFeatureSamples).
-    void refine_to(const RenderJob& job, int total);
+    // Refined to `total` camera samples a pixel (at most kFeatureSamples): the pixels of `box`
+    // only, where given (a render region's: the others are not refined).
+    void refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box = std::nullopt);
 };
 // The camera samples a pixel of the display's feature buffers at the next frame: the first full
 // frame of an edit traces one, the next one more (a sample costs about 1/8 of a pass;
