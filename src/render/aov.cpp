@@ -87,39 +87,50 @@ SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSett
 namespace {
 
 // Adds to `sums` the first-surface layers of the camera samples [first, first + count) of each
-// pixel of `box` whose `range` gives them (x, pixel index) -> {first, count}.
+// pixel of `box` whose `range` gives them (pixel index) -> {first, count}. A row's samples go
+// in batches of kSampleBatch (the camera rays made together, in the lanes); each pixel's are
+// added in order of their index, so the sums are the same in any number of calls.
 template <class Range>
 void add_box_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                      const PixelBox& box, SurfaceLayers& sums, const Range& range) {
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int y = box.y0; y < box.y1; ++y) {
-        std::optional<Sampler> samplers[kSampleBatch];
-        Sampler* pointers[kSampleBatch];
-        int xs[kSampleBatch], ys[kSampleBatch];
-        Ray rays[kSampleBatch];
-        for (int x = box.x0; x < box.x1; ++x) {
-            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-            const auto [first, count] = range(pixel);
-            if (count <= 0) continue;
-            // The pixel's camera samples first..first+count-1, made as render_pass makes them.
-            for (int k = 0; k < count; ++k) {
-                const uint32_t index = uint32_t(first + k);
-                pointers[k] = settings.estimator == Estimator::sobol
-                                  ? &samplers[k].emplace(Sampler::pixel_key(settings.seed, pixel), index)
-                                  : &samplers[k].emplace(settings.estimator, settings.seed, pixel, index,
-                                                         settings.target_spp);
-                xs[k] = x;
-                ys[k] = y;
+#pragma omp parallel
+    {
+        std::vector<std::optional<Sampler>> samplers(kSampleBatch);
+        std::vector<Sampler*> pointers(kSampleBatch);
+        std::vector<int> xs(kSampleBatch), ys(kSampleBatch);
+        std::vector<size_t> pixels(kSampleBatch);
+        std::vector<Ray> rays(kSampleBatch);
+        int pending = 0;
+        const auto flush = [&] {
+            if (pending == 0) return;
+            camera_rays(scene, settings, width, height, xs.data(), ys.data(), pointers.data(), pending, rays.data());
+            for (int k = 0; k < pending; ++k) {
+                const FirstSurface s = first_surface(scene, rays[size_t(k)]);
+                sums.albedo[pixels[size_t(k)]] += s.albedo;
+                sums.normal[pixels[size_t(k)]] += s.normal;
             }
-            camera_rays(scene, settings, width, height, xs, ys, pointers, count, rays);
-            Color albedo = sums.albedo[pixel], normal = sums.normal[pixel];
-            for (int k = 0; k < count; ++k) {
-                const FirstSurface s = first_surface(scene, rays[k]);
-                albedo += s.albedo;
-                normal += s.normal;
+            pending = 0;
+        };
+#pragma omp for schedule(dynamic, 4)
+        for (int y = box.y0; y < box.y1; ++y) {
+            for (int x = box.x0; x < box.x1; ++x) {
+                const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+                const auto [first, count] = range(pixel);
+                // The pixel's camera samples first..first+count-1, made as render_pass makes them.
+                for (int k = 0; k < count; ++k) {
+                    if (pending == kSampleBatch) flush();
+                    const uint32_t index = uint32_t(first + k);
+                    const size_t slot = size_t(pending++);
+                    pointers[slot] = settings.estimator == Estimator::sobol
+                                         ? &samplers[slot].emplace(Sampler::pixel_key(settings.seed, pixel), index)
+                                         : &samplers[slot].emplace(settings.estimator, settings.seed, pixel, index,
+                                                                   settings.target_spp);
+                    xs[slot] = x;
+                    ys[slot] = y;
+                    pixels[slot] = pixel;
+                }
             }
-            sums.albedo[pixel] = albedo;
-            sums.normal[pixel] = normal;
+            flush();  // a row's samples all added before the next row's (rows go to threads)
         }
     }
 }
