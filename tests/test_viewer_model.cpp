@@ -557,12 +557,26 @@ TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
     // Frames costing 0.1 s (making and drawing) come at most every 0.5 s (a fifth of the time).
     EXPECT_FALSE(s.due(0.2, 0.4, 0.1));
     EXPECT_TRUE(s.due(0.2, 0.5, 0.1));
+    // Early, at a balanced count, where the next one would come later past the interval than
+    // now is before it: 0.45 of 0.5 s with the next count 0.2 s away; not with it 0.05 s away,
+    // nor before half the interval.
+    EXPECT_TRUE(s.due(1.0, 0.45, 0.001, 0.2));
+    EXPECT_FALSE(s.due(1.0, 0.45, 0.001, 0.05));
+    EXPECT_FALSE(s.due(1.0, 0.24, 0.001, 10));
+    EXPECT_TRUE(s.due(1.0, 0.26, 0.001, 10));
     // The counts frames are made at: balanced ones, and after previews none below 4 spp.
-    for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp, false)) << spp;
-    for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp, false)) << spp;
-    EXPECT_FALSE(frame_spp(1, true));
-    EXPECT_FALSE(frame_spp(2, true));
-    EXPECT_TRUE(frame_spp(4, true));
+    for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp)) << spp;
+    for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp)) << spp;
+    EXPECT_FALSE(frame_spp(1, 2));
+    EXPECT_TRUE(frame_spp(2, 2));
+    EXPECT_FALSE(frame_spp(2, 4));
+    EXPECT_TRUE(frame_spp(4, 4));
+    EXPECT_EQ(next_frame_spp(0, 4), 4);
+    EXPECT_EQ(next_frame_spp(0, 2), 2);
+    EXPECT_EQ(next_frame_spp(4, 4), 8);
+    EXPECT_EQ(next_frame_spp(8, 4), 16);
+    EXPECT_EQ(next_frame_spp(13, 4), 16);
+    EXPECT_EQ(next_frame_spp(16, 4), 24);
 }
 
 // The status bar's elapsed time is the wall time since the edit, not the passes' time alone:

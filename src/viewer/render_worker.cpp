@@ -45,14 +45,24 @@ std::vector<int> preview_scales(int width, int height, double seconds_per_pixel,
     return scales;
 }
 
-bool FrameSchedule::due(double age, double since_last, double cost) const {
-    const double by_age = std::clamp(age_fraction * age, min_interval, max_interval);
-    return since_last >= std::max(by_age, cost / cost_share);
+bool FrameSchedule::due(double age, double since_last, double cost, double next_wait) const {
+    const double interval = std::max(std::clamp(age_fraction * age, min_interval, max_interval), cost / cost_share);
+    if (since_last >= interval) return true;
+    const double early = interval - since_last, late = since_last + next_wait - interval;
+    return since_last >= 0.5 * interval && late > early;
 }
 
-bool frame_spp(int spp, bool after_previews) {
-    if (spp < (after_previews ? kFirstFrameSpp : 1)) return false;
+bool frame_spp(int spp, int first) {
+    if (spp < first) return false;
     return spp <= 8 ? (spp & (spp - 1)) == 0 : spp % 8 == 0;
+}
+
+int first_frame_spp(const RenderScene& scene) { return scene.camera.lens_radius > 0 ? 4 : 2; }
+
+int next_frame_spp(int spp, int first) {
+    int next = std::max(spp + 1, first);
+    while (!frame_spp(next, first)) ++next;
+    return next;
 }
 
 RenderWorker::RenderWorker(std::function<void()> on_publish, SharedPasses* ranks)
@@ -440,15 +450,18 @@ void RenderWorker::run() {
             // A pass stopped early is always an edit's: the next turn starts the new job.
             else if (!driver->pass(rule, &stop_)) continue;
             // Only full passes: tiny previews are dominated by per-pass overheads.
-            seconds_per_pixel = seconds_since(start) / (double(w) * h);
+            const double pass_seconds = seconds_since(start);
+            seconds_per_pixel = pass_seconds / (double(w) * h);
             unpublished = true;
             // The frame schedule: is this pass's image worth making and drawing now?
             bool due = false;
             {
                 std::lock_guard lock(mutex_);
-                const bool by_schedule = frame_spp(state.passes, !previews.empty()) &&
+                const int first = previews.empty() ? 1 : first_frame_spp(*job.scene);
+                const bool by_schedule = frame_spp(state.passes, first) &&
                     (!full_frame_made ||
-                     schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load()));
+                     schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load(),
+                                   pass_seconds * (next_frame_spp(state.passes, first) - state.passes)));
                 due = by_schedule || paused_ || stop_reason() || (features_.load() && !(latest_ && latest_->features));
             }
             if (!due) continue;

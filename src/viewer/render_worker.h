@@ -156,13 +156,16 @@ struct Snapshot {
 // interval grows with the image's age (seconds since the edit: the image changes fast at
 // first, slowly later) up to `max_interval`, and is never so short that the frames (`cost`:
 // the render thread's time to make one plus the window's to draw it) take more than
-// `cost_share` of the time. Frames nobody could see in time are not made.
+// `cost_share` of the time. Frames nobody could see in time are not made. Frames come only at
+// balanced sample counts (frame_spp), so one is also due a little early, once half the
+// interval has passed, where waiting `next_wait` seconds for the next balanced count would
+// end further past the interval than now is short of it.
 struct FrameSchedule {
     double age_fraction = 0.5;   // interval: half the image's age (frames at ages 1, 1.5, 2.25, ...)
     double min_interval = 1.0 / 60;
     double max_interval = 1.0;
     double cost_share = 0.2;
-    bool due(double age, double since_last, double cost) const;
+    bool due(double age, double since_last, double cost, double next_wait = 0) const;
 };
 
 // The display's feature buffers of one image (albedo and normal, render/outputs.h): refined a
@@ -201,13 +204,18 @@ void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeat
                      DenoiseWorkspace& workspace, Snapshot& frame);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
-// (a stop rule met or a pause makes one at any count): after previews, from kFirstFrameSpp on
-// (fewer samples, denoised, can look worse than the last preview: the a-trous filter at 1 spp
-// speckles, and a lens's blur is noisy); and only where the samples are balanced: powers of
-// two up to 8, then multiples of 8 (a Sobol or stratified estimate between them is less even:
-// a Whitted render lost about 1 dB from 8 spp to 9).
-inline constexpr int kFirstFrameSpp = 4;
-bool frame_spp(int spp, bool after_previews);
+// (a stop rule met or a pause makes one at any count): from `first` on (after previews:
+// first_frame_spp), and only where the samples are balanced: powers of two up to 8, then
+// multiples of 8 (a Sobol or stratified estimate between them is less even: a Whitted render
+// lost about 1 dB from 8 spp to 9).
+bool frame_spp(int spp, int first = 1);
+// The first full frame after previews: fewer samples, denoised, can look worse than the last
+// preview. Through a pinhole 2 spp are already better; through a lens (its blur is noisy) 4
+// (FirstFrames over every bundled scene: the lens scene's 2 spp frame is 0.3 dB below its
+// preview at 96 px).
+int first_frame_spp(const RenderScene& scene);
+// The next count after `spp` that frame_spp allows from `first` on.
+int next_frame_spp(int spp, int first);
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
 // to full resolution. first_scale is the smallest power of two (up to 16) whose pass is
