@@ -507,6 +507,56 @@ TEST(RenderThread, ARegionsPassesLeaveTheOtherPixelsHalvesAsTheyWere) {
     EXPECT_GE(changed, 2 * 9 * 6 - 4);  // the box's pixels grew both halves
 }
 
+// A region's full frames denoise its pixels alone, over the previous frame's picture: the
+// others keep it bit for bit (their samples did not change), the box's is the estimate's
+// (close to the whole image's filter; its edges filtered as the image's borders).
+TEST(RenderThread, ARegionsFramesDenoiseItsPixelsOverThePreviousPicture) {
+    const auto scene = small_scene(3, 48, 40);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    const RenderJob job{7, scene, settings, StopRule{16}};
+    RenderState state(48, 40);
+    RegionHooks region;
+    const StopRule rule{16};
+    ProgressiveDriver driver(*scene, settings, state, rule, &region);
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(driver.pass(rule));
+    DisplayFeatures features;
+    features.reset(48, 40);
+    features.refine_to(job, 2);
+    DenoiseWorkspace workspace;
+    Snapshot first;
+    first.generation = job.generation;
+    make_full_frame(job, state, &features, workspace, first);
+    const PixelBox box{10, 6, 30, 22};
+    region.region = box;
+    for (int i = 0; i < 8; ++i) ASSERT_TRUE(driver.pass(rule));
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation), box);
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation + 1), std::nullopt);  // another job's
+    EXPECT_EQ(denoised_box(box, 48, 40, nullptr, job.generation), std::nullopt);
+    EXPECT_EQ(denoised_box(PixelBox{0, 0, 40, 30}, 48, 40, &first, job.generation), std::nullopt);  // most of it
+    EXPECT_EQ(denoised_box(PixelBox{-5, -5, 8, 9}, 48, 40, &first, job.generation), (PixelBox{0, 0, 8, 9}));
+    Snapshot boxed, whole;
+    make_full_frame(job, state, &features, workspace, boxed, &first, box);
+    make_full_frame(job, state, &features, workspace, whole);
+    double error = 0, signal = 0;
+    int changed = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 48; ++x) {
+            const size_t i = size_t(y) * 48 + size_t(x);
+            const Color a = boxed.denoised.pixels[i], b = first.denoised.pixels[i];
+            if (!(x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1)) {
+                ASSERT_EQ(std::memcmp(&a, &b, sizeof(Color)), 0) << x << "," << y;
+                continue;
+            }
+            changed += std::memcmp(&a, &b, sizeof(Color)) != 0;
+            const Color d = a - whole.denoised.pixels[i];
+            error += dot(d, d);
+            signal += dot(whole.denoised.pixels[i], whole.denoised.pixels[i]);
+        }
+    EXPECT_GT(changed, 20 * 16 * 9 / 10);
+    EXPECT_LT(error, 0.01 * signal);  // within 1 % of the whole image's filter, in energy
+}
+
 // The display's feature buffers within a region: its pixels are refined and are the whole
 // image's, bit for bit; the others wait until there is no region, and at kFeatureSamples
 // every pixel is feature_buffers'.

@@ -49,13 +49,16 @@ class RegionHooks : public PassHooks {
 public:
     std::optional<PixelBox> region;
     void before_plan(RenderState& state) override;
-    void before_pass(RenderState&) override {}
+    // The pass's rows narrowed to the region's (AND the rows a process's share sets before it):
+    // render_pass and the halves skip the others' rows whole.
+    void before_pass(RenderState& state) override;
     void after_pass(RenderState& state, bool statistics) override;
     bool any(bool stop) override { return stop; }
 
 private:
-    std::vector<uint8_t> saved_;  // the noise rule's mask while the region's is in place
-    bool applied_ = false;
+    std::vector<uint8_t> saved_;       // the noise rule's mask while the region's is in place
+    std::vector<uint8_t> saved_rows_;  // the pass's rows before the region's
+    bool applied_ = false, rows_applied_ = false;
 };
 
 // A region's hooks over a process's share of the rows (SharedPasses::hooks): a pass samples
@@ -67,7 +70,10 @@ public:
         share_.before_plan(state);
         region_.before_plan(state);
     }
-    void before_pass(RenderState& state) override { share_.before_pass(state); }
+    void before_pass(RenderState& state) override {
+        share_.before_pass(state);
+        region_.before_pass(state);
+    }
     void after_pass(RenderState& state, bool statistics) override {
         region_.after_pass(state, statistics);
         share_.after_pass(state, statistics);
@@ -199,9 +205,17 @@ inline constexpr int kPreviewFeatureSamples = 2;
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
                         Snapshot& frame);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
-// `features` (null: not denoised) and the pixel statistics.
+// `features` (null: not denoised) and the pixel statistics. With a render `region` and the
+// job's `previous` full frame, only the region's pixels are denoised (denoised_box), over the
+// previous frame's picture.
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
-                     DenoiseWorkspace& workspace, Snapshot& frame);
+                     DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous = nullptr,
+                     const std::optional<PixelBox>& region = std::nullopt);
+// The pixels a full frame denoises alone: the render region clipped to the image, where the
+// job's previous full frame (of `generation`) has a denoised picture to keep outside it; none
+// (the whole image) otherwise, or where the region is most of the image.
+std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
+                                     const Snapshot* previous, uint64_t generation);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
 // (a stop rule met or a pause makes one at any count): from `first` on (after previews:
