@@ -40,6 +40,10 @@ struct Rgb8Image {
 // combos.
 enum class ToneMap { sigmoid, linear, srgb };
 inline constexpr EnumNames<ToneMap, 3> tonemap_names{{"sigmoid", "linear", "srgb"}};
+// The default tone map: a scene's without a display block, and the one by which psnr,
+// compare and bench --convergence take an HDR image's 8-bit form. The brief's sigmoid, which
+// its references were made with.
+inline constexpr ToneMap kDefaultToneMap = ToneMap::sigmoid;
 
 // Per channel, after `exposure` (2^EV) scales radiance: sigmoid I/(1+I), or linear I/max
 // where max is the largest channel value of the whole image (one scale for all channels, so
