@@ -67,3 +67,37 @@ for scene in res/scenes/assignment_03.json res/scenes/assignment_08.json; do
       grep -E "^res|first full"
   done
 done
+echo "== at 1920x1080: each thread's CPU while the render refines (10 s of a real window, no input; the UI thread redraws only on a new frame)"
+python3 - "$exe" <<'PY'
+import json, os, subprocess, sys, tempfile, time
+exe = sys.argv[1]
+work = tempfile.mkdtemp()
+scene = json.load(open("res/scenes/assignment_03.json"))
+scene["scene"]["renderer"]["dimensions"] = [1920, 1080]
+for camera in scene["cameras"]:
+    camera["aspect"] = 1920 / 1080
+path = os.path.join(work, "assignment_03_1080p.json")
+json.dump(scene, open(path, "w"))
+viewer = subprocess.Popen(["xvfb-run", "-a", "-s", "-screen 0 2560x1440x24", exe, "view", path, "--unlimited"],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+time.sleep(5)  # past the first frames
+pid = int(subprocess.run(["pgrep", "-n", "-f", "view " + path], capture_output=True, text=True).stdout.split()[0])
+tick = os.sysconf("SC_CLK_TCK")
+def threads():
+    out = {}
+    for tid in os.listdir("/proc/%d/task" % pid):
+        stat = open("/proc/%d/task/%s/stat" % (pid, tid)).read()
+        fields = stat[stat.rindex(")") + 2:].split()
+        out[int(tid)] = (stat[stat.index("(") + 1:stat.rindex(")")], (int(fields[11]) + int(fields[12])) / tick)
+    return out
+before, start = threads(), time.monotonic()
+time.sleep(10)
+after, span = threads(), time.monotonic() - start
+viewer.terminate()
+viewer.wait()
+for tid in sorted(after):
+    if tid in before and after[tid][1] > before[tid][1]:
+        role = "UI thread" if tid == pid else after[tid][0]
+        print("  %-14s %5.1f %% of a core" % (role, 100 * (after[tid][1] - before[tid][1]) / span))
+subprocess.run(["rm", "-rf", work])
+PY

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sanitizer checks of issue 6 (docs/robustness-tooling.md): builds the `asan`
+# The sanitizer checks (docs/robustness-tooling.md): builds the `asan`
 # (AddressSanitizer + UndefinedBehaviorSanitizer + LeakSanitizer) and `tsan`
 # (ThreadSanitizer) presets of CMakePresets.json into build-asan/ and build-tsan/, runs the
 # test suite under each, then fuzzes the scene loader (fuzz_load, built by the asan preset)

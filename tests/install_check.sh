@@ -212,7 +212,8 @@ package)
   for f in ./usr/bin/keithray ./usr/share/keithray/scenes/assignment_03.json \
     ./usr/share/keithray/scenes/examples/many_spheres.json ./usr/share/keithray/references/assignment_08.ppm \
     ./usr/share/man/man1/keithray.1.gz ./usr/share/bash-completion/completions/keithray \
-    ./usr/share/applications/keithray.desktop ./usr/share/icons/hicolor/scalable/apps/keithray.svg; do
+    ./usr/share/applications/keithray.desktop ./usr/share/icons/hicolor/scalable/apps/keithray.svg \
+    ./usr/share/doc/keithray/README.md ./usr/share/doc/keithray/docs/cli.md ./usr/share/doc/keithray/docs/viewer.md; do
     grep -qx -- "$f" "$tmp/files.txt" || fail "the package lacks $f"
   done
   grep -qx './usr/lib/keithray/keithray_viewer.so' "$tmp/files.txt" || fail "the package lacks the viewer module"

@@ -152,6 +152,34 @@ TEST(Allocation, InactivePixelsGetNoSamples) {
     EXPECT_GT(sum, 100L * 48 - 48);
 }
 
+// Rows with no active pixel (a render region, the noise rule) take nothing and keep their
+// carried fractions; the plan of the active rows does not read rows beyond their neighbours.
+TEST(Allocation, RowsWithNoActivePixelTakeNothingAndKeepTheirCredit) {
+    const int w = 8, h = 8;
+    RenderState state = two_halves(w, h, kAllocationWarmup);
+    state.plan_pass(adaptive_settings());  // credits and a plan in every row
+    const std::vector<float> credit = state.buffers().sample_credit;
+    state.buffers().active.assign(size_t(w) * h, 0);
+    for (int y = 5; y < 7; ++y)
+        for (int x = 2; x < 7; ++x) state.buffers().active[size_t(y) * w + x] = 1;
+    RenderState far = state;  // rows 0-3 (not next to an active row) with other statistics
+    for (size_t i = 0; i < size_t(4 * w); ++i) far.buffers().luminance_sq_sum[i] *= 3;
+    state.plan_pass(adaptive_settings());
+    far.plan_pass(adaptive_settings());
+    EXPECT_EQ(state.pass_samples(), far.pass_samples());
+    long taken = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const size_t i = size_t(y) * w + x;
+            taken += state.pass_samples()[i];
+            if (state.buffers().active[i]) continue;
+            EXPECT_EQ(state.pass_samples()[i], 0) << x << "," << y;
+            EXPECT_EQ(state.buffers().sample_credit[i], credit[i]) << x << "," << y;
+        }
+    EXPECT_LE(taken, 10);
+    EXPECT_GT(taken, 0);
+}
+
 // Unbiased on an analytic scene: in the brief's furnace a diffuse sphere shows rho Le in
 // every pixel, the emitter around it Le exactly. Adaptive passes go to the sphere (the only
 // noise), and every pixel still converges to its known value.

@@ -76,7 +76,7 @@ TEST(FirstFrames, NeverWorseAfterAnEditOnEveryBundledScene) {
         features.reset(w, h);
         for (int spp = 1; spp <= kFullFrames; ++spp) {
             driver.pass(rule);
-            if (!frame_spp(spp, true)) continue;
+            if (!frame_spp(spp, first_frame_spp(*job.scene))) continue;
             features.refine_to(job, next_display_feature_samples(features));
             Snapshot frame;
             make_full_frame(job, state, &features, workspace, frame);

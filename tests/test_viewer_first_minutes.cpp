@@ -185,6 +185,9 @@ TEST(RunStatus, StateProgressAndTargetChanges) {
     s.render.target_spp = 64;
     EXPECT_EQ(run_status(nullptr, s, false).state, RunState::starting);
     EXPECT_EQ(run_status(nullptr, s, true).state, RunState::error);
+    // No frame of this view yet, an earlier view's on screen: the camera moves.
+    EXPECT_EQ(run_status(nullptr, s, false, true).state, RunState::moving);
+    EXPECT_EQ(run_status(nullptr, s, true, true).state, RunState::error);
     Snapshot f;
     f.spp = 16;
     f.full_seconds = 8;  // the passes' own time: 0.5 s a pass

@@ -16,6 +16,7 @@
 
 #include "render/camera.h"
 #include "render/outputs.h"
+#include "render/progressive.h"
 #include "scene/load.h"
 #include "test_util.h"
 #include "viewer/edit.h"
@@ -472,6 +473,127 @@ TEST(RenderThread, ARegionsPassesCostWhatItsPixelsCost) {
     EXPECT_LE(mean, 17.0);
 }
 
+// A region's passes change only its pixels' halves (the final denoiser's guides): the others'
+// stay as they were, bit for bit, however many passes go by.
+TEST(RenderThread, ARegionsPassesLeaveTheOtherPixelsHalvesAsTheyWere) {
+    const auto scene = small_scene(3, 24, 20);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    RenderState state(24, 20);
+    state.track_halves();
+    RegionHooks region;
+    const StopRule rule{16};
+    ProgressiveDriver driver(*scene, settings, state, rule, &region);
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(driver.pass(rule));
+    const RenderState::Halves before = state.halves();
+    const PixelBox box{4, 5, 13, 11};
+    region.region = box;
+    for (int i = 0; i < 10; ++i) ASSERT_TRUE(driver.pass(rule));  // planned passes among them
+    const RenderState::Halves after = state.halves();
+    int changed = 0;
+    for (int y = 0; y < 20; ++y)
+        for (int x = 0; x < 24; ++x) {
+            const size_t i = size_t(y) * 24 + size_t(x);
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            for (int h = 0; h < 2; ++h) {
+                if (in) {
+                    changed += after.count[h][i] > before.count[h][i];
+                    continue;
+                }
+                ASSERT_EQ(after.count[h][i], before.count[h][i]) << x << "," << y;
+                ASSERT_EQ(std::memcmp(&after.mean[h].pixels[i], &before.mean[h].pixels[i], sizeof(Color)), 0) << x << "," << y;
+            }
+        }
+    EXPECT_GE(changed, 2 * 9 * 6 - 4);  // the box's pixels grew both halves
+}
+
+// A region's full frames denoise its pixels alone, over the previous frame's picture: the
+// others keep it bit for bit (their samples did not change), the box's is the estimate's
+// (close to the whole image's filter; its edges filtered as the image's borders).
+TEST(RenderThread, ARegionsFramesDenoiseItsPixelsOverThePreviousPicture) {
+    const auto scene = small_scene(3, 48, 40);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    const RenderJob job{7, scene, settings, StopRule{16}};
+    RenderState state(48, 40);
+    RegionHooks region;
+    const StopRule rule{16};
+    ProgressiveDriver driver(*scene, settings, state, rule, &region);
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(driver.pass(rule));
+    DisplayFeatures features;
+    features.reset(48, 40);
+    features.refine_to(job, 2);
+    DenoiseWorkspace workspace;
+    Snapshot first;
+    first.generation = job.generation;
+    make_full_frame(job, state, &features, workspace, first);
+    const PixelBox box{10, 6, 30, 22};
+    region.region = box;
+    for (int i = 0; i < 8; ++i) ASSERT_TRUE(driver.pass(rule));
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation), box);
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation + 1), std::nullopt);  // another job's
+    EXPECT_EQ(denoised_box(box, 48, 40, nullptr, job.generation), std::nullopt);
+    EXPECT_EQ(denoised_box(PixelBox{0, 0, 40, 30}, 48, 40, &first, job.generation), std::nullopt);  // most of it
+    EXPECT_EQ(denoised_box(PixelBox{-5, -5, 8, 9}, 48, 40, &first, job.generation), (PixelBox{0, 0, 8, 9}));
+    Snapshot boxed, whole;
+    make_full_frame(job, state, &features, workspace, boxed, &first, box);
+    make_full_frame(job, state, &features, workspace, whole);
+    double error = 0, signal = 0;
+    int changed = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 48; ++x) {
+            const size_t i = size_t(y) * 48 + size_t(x);
+            const Color a = boxed.denoised.pixels[i], b = first.denoised.pixels[i];
+            if (!(x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1)) {
+                ASSERT_EQ(std::memcmp(&a, &b, sizeof(Color)), 0) << x << "," << y;
+                continue;
+            }
+            changed += std::memcmp(&a, &b, sizeof(Color)) != 0;
+            const Color d = a - whole.denoised.pixels[i];
+            error += dot(d, d);
+            signal += dot(whole.denoised.pixels[i], whole.denoised.pixels[i]);
+        }
+    EXPECT_GT(changed, 20 * 16 * 9 / 10);
+    EXPECT_LT(error, 0.01 * signal);  // within 1 % of the whole image's filter, in energy
+}
+
+// The display's feature buffers within a region: its pixels are refined and are the whole
+// image's, bit for bit; the others wait until there is no region, and at kFeatureSamples
+// every pixel is feature_buffers'.
+TEST(RenderThread, DisplayFeaturesRefineARegionFirstAndEndAsSavesOwn) {
+    const auto scene = small_scene(8, 30, 24);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    const RenderJob job{1, scene, settings, StopRule{4}};
+    SurfaceLayers sums;
+    add_surface_samples(*scene, settings, 30, 24, 0, 2, sums);
+    std::vector<float> albedo2, normal2;
+    feature_buffers_from_sums(sums, 2, albedo2, normal2);
+    DisplayFeatures features;
+    features.reset(30, 24);
+    const PixelBox box{3, 2, 17, 9};
+    features.refine_to(job, 1, box);
+    features.refine_to(job, 2, box);
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 30; ++x) {
+            const size_t i = size_t(y) * 30 + size_t(x);
+            const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+            ASSERT_EQ(features.counts[i], in ? 2 : 0) << x << "," << y;
+            for (int k = 0; k < 3; ++k) {
+                ASSERT_EQ(features.albedo[3 * i + size_t(k)], in ? albedo2[3 * i + size_t(k)] : 0.0f) << x << "," << y;
+                ASSERT_EQ(features.normal[3 * i + size_t(k)], in ? normal2[3 * i + size_t(k)] : 0.0f) << x << "," << y;
+            }
+        }
+    EXPECT_EQ(next_display_feature_samples(features), 2);
+    features.refine_to(job, 2);  // the region cleared: the other pixels catch up
+    EXPECT_EQ(features.albedo, albedo2);
+    EXPECT_EQ(features.normal, normal2);
+    features.refine_to(job, kFeatureSamples);
+    std::vector<float> albedo, normal;
+    feature_buffers(*scene, settings, 30, 24, albedo, normal);
+    EXPECT_EQ(features.albedo, albedo);
+    EXPECT_EQ(features.normal, normal);
+}
+
 // The frame schedule: the first frame, then intervals of half the image's age (at least a
 // display refresh, at most a second), never shorter than the frames' cost over their share.
 TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
@@ -485,12 +607,26 @@ TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
     // Frames costing 0.1 s (making and drawing) come at most every 0.5 s (a fifth of the time).
     EXPECT_FALSE(s.due(0.2, 0.4, 0.1));
     EXPECT_TRUE(s.due(0.2, 0.5, 0.1));
+    // Early, at a balanced count, where the next one would come later past the interval than
+    // now is before it: 0.45 of 0.5 s with the next count 0.2 s away; not with it 0.05 s away,
+    // nor before half the interval.
+    EXPECT_TRUE(s.due(1.0, 0.45, 0.001, 0.2));
+    EXPECT_FALSE(s.due(1.0, 0.45, 0.001, 0.05));
+    EXPECT_FALSE(s.due(1.0, 0.24, 0.001, 10));
+    EXPECT_TRUE(s.due(1.0, 0.26, 0.001, 10));
     // The counts frames are made at: balanced ones, and after previews none below 4 spp.
-    for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp, false)) << spp;
-    for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp, false)) << spp;
-    EXPECT_FALSE(frame_spp(1, true));
-    EXPECT_FALSE(frame_spp(2, true));
-    EXPECT_TRUE(frame_spp(4, true));
+    for (const int spp : {1, 2, 4, 8, 16, 24, 64}) EXPECT_TRUE(frame_spp(spp)) << spp;
+    for (const int spp : {3, 5, 7, 9, 12, 15, 17, 63}) EXPECT_FALSE(frame_spp(spp)) << spp;
+    EXPECT_FALSE(frame_spp(1, 2));
+    EXPECT_TRUE(frame_spp(2, 2));
+    EXPECT_FALSE(frame_spp(2, 4));
+    EXPECT_TRUE(frame_spp(4, 4));
+    EXPECT_EQ(next_frame_spp(0, 4), 4);
+    EXPECT_EQ(next_frame_spp(0, 2), 2);
+    EXPECT_EQ(next_frame_spp(4, 4), 8);
+    EXPECT_EQ(next_frame_spp(8, 4), 16);
+    EXPECT_EQ(next_frame_spp(13, 4), 16);
+    EXPECT_EQ(next_frame_spp(16, 4), 24);
 }
 
 // The status bar's elapsed time is the wall time since the edit, not the passes' time alone:

@@ -207,15 +207,21 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     ViewerModel m = scene3();
     const SavePaths paths = SavePaths::for_scene(m.scene());
     EXPECT_EQ(std::filesystem::path(paths.image).extension(), ".ppm");
-    EXPECT_EQ(std::filesystem::path(paths.png).extension(), ".png");
-    EXPECT_EQ(std::filesystem::path(paths.hdr).extension(), ".exr");
+    // Each format's button saves the image field under its extension, and that name is of
+    // the button's kind.
+    for (const kr::ImageFormatInfo& format : kr::kImageFormats) {
+        const std::filesystem::path path = image_save_path(format.format, paths.image);
+        EXPECT_EQ(path.extension(), format.extension);
+        EXPECT_EQ(path.stem(), std::filesystem::path(paths.image).stem());
+        EXPECT_EQ(image_save_kind(path), SaveKind(format.format));
+    }
     EXPECT_EQ(std::filesystem::path(paths.scene).filename(), "assignment_03-edited.json");
 
     // No full-resolution image yet: nothing written.
     Snapshot preview;
     preview.scale = 2;
-    EXPECT_THROW(save_output(SaveKind::ppm, dir / "a.ppm", m, &preview), std::exception);
-    EXPECT_THROW(save_output(SaveKind::png, dir / "a.png", m, nullptr), std::exception);
+    EXPECT_THROW(save_output(kr::ImageFormat::ppm, dir / "a.ppm", m, &preview), std::exception);
+    EXPECT_THROW(save_output(kr::ImageFormat::png, dir / "a.png", m, nullptr), std::exception);
     EXPECT_FALSE(std::filesystem::exists(dir / "a.ppm"));
 
     // A full-resolution frame of the current scene, with the layers Save develops.
@@ -225,22 +231,22 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     full.depth.assign(12, 1.0);
     full.sample_count.assign(12, 1);
     full.variance.assign(12, Color());
-    EXPECT_EQ(save_output(SaveKind::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
+    EXPECT_EQ(save_output(kr::ImageFormat::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
     EXPECT_EQ(read_image(dir / "a.ppm").width, 4);
     EXPECT_EQ(read_image(dir / "a-depth.ppm").width, 4);
-    save_output(SaveKind::pfm, dir / "a.pfm", m, &full);
+    save_output(kr::ImageFormat::pfm, dir / "a.pfm", m, &full);
     EXPECT_TRUE(std::filesystem::exists(dir / "a.pfm"));
     EXPECT_TRUE(std::filesystem::exists(dir / "a-depth.pfm"));
     // The kind is the name's format; a frame of an older scene is not saved.
-    EXPECT_THROW(save_output(SaveKind::png, dir / "b.ppm", m, &full), std::exception);
+    EXPECT_THROW(save_output(kr::ImageFormat::png, dir / "b.ppm", m, &full), std::exception);
     Snapshot old = full;
     --old.generation;
-    EXPECT_THROW(save_output(SaveKind::ppm, dir / "c.ppm", m, &old), std::exception);
+    EXPECT_THROW(save_output(kr::ImageFormat::ppm, dir / "c.ppm", m, &old), std::exception);
     EXPECT_FALSE(std::filesystem::exists(dir / "b.ppm") || std::filesystem::exists(dir / "c.ppm"));
-    EXPECT_EQ(save_targets(SaveKind::exr, dir / "a.exr"), std::vector<std::filesystem::path>{dir / "a.exr"});
-    EXPECT_EQ(save_targets(SaveKind::png, dir / "a.png").back(), dir / "a-depth.png");
-    EXPECT_EQ(image_save_path(SaveKind::pfm, "x/out.exr"), std::filesystem::path("x/out.pfm"));
-    EXPECT_EQ(image_save_kind("OUT.EXR"), SaveKind::exr);
+    EXPECT_EQ(save_targets(kr::ImageFormat::exr, dir / "a.exr"), std::vector<std::filesystem::path>{dir / "a.exr"});
+    EXPECT_EQ(save_targets(kr::ImageFormat::png, dir / "a.png").back(), dir / "a-depth.png");
+    EXPECT_EQ(image_save_path(kr::ImageFormat::pfm, "x/out.exr"), std::filesystem::path("x/out.pfm"));
+    EXPECT_EQ(image_save_kind("OUT.EXR"), SaveKind(kr::ImageFormat::exr));
 
     // The scene: written as saved, and the model counts as saved.
     ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; }));

@@ -388,6 +388,9 @@ TEST_F(ViewerWindow, FramesOfEachMovedCameraComeDuringADrag) {
     EXPECT_EQ(out["shown_during_drag"], "6");
     EXPECT_EQ(out["changed_during_drag"], "6");
     EXPECT_EQ(out["still_pressed"], "1");
+    // While an earlier view's frame is on screen the status bar says so, not "starting".
+    for (const char* wrong : {"starting", "rendering", "done"})
+        EXPECT_EQ(out["states_with_an_earlier_view"].find(wrong), std::string::npos) << out["states_with_an_earlier_view"];
 }
 
 TEST_F(ViewerWindow, RaisingTheTargetKeepsTheSamplesAndTheTitleShowsSpp) {

@@ -132,10 +132,13 @@ def run_test(args):
     xdotool("mousedown", 1)
     v.wait(lambda s: s.get("press") not in (None, "0"), "the press")
     shown_during, changed = 0, 0
+    earlier_states = set()  # the status bar's state while an earlier view's frame is shown
     for step in range(args.steps):
         generation = int(v.status()["generation"])
         xdotool("mousemove_relative", "--", args.step_px, 0)
         s = v.wait(lambda s, g=generation: int(s["generation"]) > g, "the move's edit")
+        if shown(s) and shown(s)[0] < int(s["generation"]):
+            earlier_states.add(s["state"])
         g = int(s["generation"])
         s = v.wait(lambda s, g=g: shown(s) and shown(s)[0] >= g, "a frame of the moved camera")
         if s.get("press") not in (None, "0"):
@@ -162,6 +165,7 @@ def run_test(args):
     print("shown_during_drag=%d" % shown_during)
     print("changed_during_drag=%d" % changed)
     print("still_pressed=%d" % (pressed not in (None, "0")))
+    print("states_with_an_earlier_view=%s" % ",".join(sorted(earlier_states)))
     print("generation=%s" % s["generation"])
     v.close()
 

@@ -65,7 +65,7 @@ InputImage load_input(const std::string& path) {
     in.name = path;
     in.hdr = file.hdr;
     in.radiance = std::move(file.radiance);
-    in.rgb8 = in.hdr ? tonemap(in.radiance.radiance(), ToneMap::sigmoid) : std::move(file.rgb8);
+    in.rgb8 = in.hdr ? tonemap(in.radiance.radiance(), kDefaultToneMap) : std::move(file.rgb8);
     return in;
 }
 

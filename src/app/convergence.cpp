@@ -260,7 +260,7 @@ Series::Point measure(const Series& s, const Reference& ref) {
         p.rmse = std::sqrt(mse);
         p.relative_rmse = signal > 0 ? std::sqrt(mse * radiance.pixels.size() / signal) : NAN;
     }
-    p.psnr = psnr(tonemap(radiance, ToneMap::sigmoid), ref.display);
+    p.psnr = psnr(tonemap(radiance, kDefaultToneMap), ref.display);
     return p;
 }
 
@@ -349,7 +349,7 @@ struct Bench {
             }
             save_cached(cache, ref);
         }
-        ref.display = tonemap(ref.radiance, ToneMap::sigmoid);
+        ref.display = tonemap(ref.radiance, kDefaultToneMap);
         return ref;
     }
 

@@ -245,7 +245,7 @@ the display \fBkeithray view\fR opens its window on
 images differ), 2 on bad usage.
 .SH "SEE ALSO"
 .BR mpirun (1);
-README.md and the docs folder of keithray's sources (docs/install.md: this layout).
+README.md and the pages it links, installed in share/doc/keithray (docs/install.md: this layout).
 )";
     return out;
 }

@@ -23,6 +23,13 @@ struct Image {
     const Color& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
 };
 
+// The pixels [x0, x1) x [y0, y1) of an image (a render region, a part of an image to work on).
+struct PixelBox {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool operator==(const PixelBox& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+    bool operator!=(const PixelBox& o) const { return !(*this == o); }
+};
+
 // 8-bit RGB, row-major, top row first.
 struct Rgb8Image {
     int width = 0, height = 0;
@@ -33,6 +40,10 @@ struct Rgb8Image {
 // combos.
 enum class ToneMap { sigmoid, linear, srgb };
 inline constexpr EnumNames<ToneMap, 3> tonemap_names{{"sigmoid", "linear", "srgb"}};
+// The default tone map: a scene's without a display block, and the one by which psnr,
+// compare and bench --convergence take an HDR image's 8-bit form. The brief's sigmoid, which
+// its references were made with.
+inline constexpr ToneMap kDefaultToneMap = ToneMap::sigmoid;
 
 // Per channel, after `exposure` (2^EV) scales radiance: sigmoid I/(1+I), or linear I/max
 // where max is the largest channel value of the whole image (one scale for all channels, so

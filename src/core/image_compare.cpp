@@ -108,8 +108,8 @@ StatisticalResult statistical_compare(const HdrImage& test, const std::string& t
     // Each pixel's variance of the mean, its sample variance raised to the mean of its 3x3
     // neighbourhood's where that is larger, over its count. Adaptive sampling gives a pixel
     // whose early samples happened to vary little fewer samples, so its own estimate stays low
-    // (measured: uniform samples, adaptive allocation, 16 spp, 4 of 20 same-scene pairs failed
-    // at alpha 0.05); its neighbours' estimates correct that. Needs the samples layer.
+    // (docs/accuracy.md, "The statistical comparison"); its neighbours' estimates correct
+    // that. Needs the samples layer.
     auto guarded_variance = [&](const HdrImage& image) {
         std::vector<double> out(image.variance.begin(), image.variance.end());
         if (image.samples.size() != n) return out;

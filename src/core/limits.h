@@ -1,6 +1,6 @@
 // The ranges of the numbers users give keithray: scene files (the loader), the flags of
 // render, view and bench, and the size of what is read. One place, so that the loader, the
-// command lines and the docs agree (README.md, "Limits").
+// command lines and the docs agree (docs/cli.md, "Limits").
 #pragma once
 
 #include <cstdint>

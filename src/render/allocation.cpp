@@ -171,7 +171,24 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
         return;
     }
     const size_t n = px_.sample_count.size(), w = size_t(width);
-    const std::vector<int> own = rows_owned(share, height), guarded = rows_guarded(share, height);
+    std::vector<int> own = rows_owned(share, height), guarded = rows_guarded(share, height);
+    // Rows with no pixel on (the noise rule's mask, a render region's) take no samples, and
+    // their zero weights would add nothing to the sums below: only the others are planned
+    // (and their neighbours read), so a region's pass plans what its pixels need.
+    std::vector<int> idle_rows;
+    if (!px_.active.empty()) {
+        std::vector<uint8_t> row_on(size_t(height), 0);
+        for (const int y : own) {
+            const uint8_t* const row = px_.active.data() + row_start(y);
+            row_on[size_t(y)] = std::any_of(row, row + w, [](uint8_t on) { return on != 0; });
+        }
+        const auto on = [&](int y) { return y >= 0 && y < height && row_on[size_t(y)]; };
+        std::vector<int> kept;
+        for (const int y : own) (on(y) ? kept : idle_rows).push_back(y);
+        own.swap(kept);
+        guarded.erase(std::remove_if(guarded.begin(), guarded.end(), [&](int y) { return !(on(y - 1) || on(y) || on(y + 1)); }),
+                      guarded.end());
+    }
     // Optimal allocation: minimising sum_i var_i / n_i for a fixed sum_i n_i gives n_i in
     // proportion to the standard deviation sigma_i. The floor keeps sampling pixels whose
     // estimate may be too low, and bounds the bias of deciding from the samples themselves.
@@ -234,6 +251,7 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     px_.pass_samples.resize(n);
     float* const credit_of = px_.sample_credit.data();
     uint8_t* const take_of = px_.pass_samples.data();
+    for (const int y : idle_rows) std::fill_n(take_of + row_start(y), w, uint8_t(0));
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <utility>
 
 #include "render/material.h"
 #include "render/path.h"
@@ -83,45 +84,89 @@ SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSett
     return out;
 }
 
-void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
-                         int count, SurfaceLayers& sums) {
-    const size_t n = size_t(width) * size_t(height);
+namespace {
+
+// Adds to `sums` the first-surface layers of the camera samples [first, first + count) of each
+// pixel of `box` whose `range` gives them (pixel index) -> {first, count}. A row's samples go
+// in batches of kSampleBatch (the camera rays made together, in the lanes); each pixel's are
+// added in order of their index, so the sums are the same in any number of calls.
+template <class Range>
+void add_box_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                     const PixelBox& box, SurfaceLayers& sums, const Range& range) {
+#pragma omp parallel
+    {
+        std::vector<std::optional<Sampler>> samplers(kSampleBatch);
+        std::vector<Sampler*> pointers(kSampleBatch);
+        std::vector<int> xs(kSampleBatch), ys(kSampleBatch);
+        std::vector<size_t> pixels(kSampleBatch);
+        std::vector<Ray> rays(kSampleBatch);
+        int pending = 0;
+        const auto flush = [&] {
+            if (pending == 0) return;
+            camera_rays(scene, settings, width, height, xs.data(), ys.data(), pointers.data(), pending, rays.data());
+            for (int k = 0; k < pending; ++k) {
+                const FirstSurface s = first_surface(scene, rays[size_t(k)]);
+                sums.albedo[pixels[size_t(k)]] += s.albedo;
+                sums.normal[pixels[size_t(k)]] += s.normal;
+            }
+            pending = 0;
+        };
+#pragma omp for schedule(dynamic, 4)
+        for (int y = box.y0; y < box.y1; ++y) {
+            for (int x = box.x0; x < box.x1; ++x) {
+                const size_t pixel = size_t(y) * size_t(width) + size_t(x);
+                const auto [first, count] = range(pixel);
+                // The pixel's camera samples first..first+count-1, made as render_pass makes them.
+                for (int k = 0; k < count; ++k) {
+                    if (pending == kSampleBatch) flush();
+                    const uint32_t index = uint32_t(first + k);
+                    const size_t slot = size_t(pending++);
+                    pointers[slot] = settings.estimator == Estimator::sobol
+                                         ? &samplers[slot].emplace(Sampler::pixel_key(settings.seed, pixel), index)
+                                         : &samplers[slot].emplace(settings.estimator, settings.seed, pixel, index,
+                                                                   settings.target_spp);
+                    xs[slot] = x;
+                    ys[slot] = y;
+                    pixels[slot] = pixel;
+                }
+            }
+            flush();  // a row's samples all added before the next row's (rows go to threads)
+        }
+    }
+}
+
+void size_sums(size_t n, SurfaceLayers& sums) {
     if (sums.albedo.size() != n || sums.normal.size() != n) {
         sums.albedo.assign(n, Color());
         sums.normal.assign(n, Color());
     }
+}
+
+}  // namespace
+
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
+                         int count, SurfaceLayers& sums) {
+    size_sums(size_t(width) * size_t(height), sums);
     first = std::max(0, first);
     count = std::clamp(count, 0, kSampleBatch);
     if (count == 0) return;
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < height; ++y) {
-        std::optional<Sampler> samplers[kSampleBatch];
-        Sampler* pointers[kSampleBatch];
-        int xs[kSampleBatch], ys[kSampleBatch];
-        Ray rays[kSampleBatch];
-        for (int x = 0; x < width; ++x) {
-            const size_t pixel = size_t(y) * size_t(width) + size_t(x);
-            // The pixel's camera samples first..first+count-1, made as render_pass makes them.
-            for (int k = 0; k < count; ++k) {
-                const uint32_t index = uint32_t(first + k);
-                pointers[k] = settings.estimator == Estimator::sobol
-                                  ? &samplers[k].emplace(Sampler::pixel_key(settings.seed, pixel), index)
-                                  : &samplers[k].emplace(settings.estimator, settings.seed, pixel, index,
-                                                         settings.target_spp);
-                xs[k] = x;
-                ys[k] = y;
-            }
-            camera_rays(scene, settings, width, height, xs, ys, pointers, count, rays);
-            Color albedo = sums.albedo[pixel], normal = sums.normal[pixel];
-            for (int k = 0; k < count; ++k) {
-                const FirstSurface s = first_surface(scene, rays[k]);
-                albedo += s.albedo;
-                normal += s.normal;
-            }
-            sums.albedo[pixel] = albedo;
-            sums.normal[pixel] = normal;
-        }
-    }
+    add_box_samples(scene, settings, width, height, PixelBox{0, 0, width, height}, sums,
+                    [&](size_t) { return std::pair{first, count}; });
+}
+
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums) {
+    const size_t n = size_t(width) * size_t(height);
+    size_sums(n, sums);
+    if (counts.size() != n) counts.assign(n, 0);
+    const PixelBox inside{std::max(0, box.x0), std::max(0, box.y0), std::min(width, box.x1), std::min(height, box.y1)};
+    if (inside.x0 >= inside.x1 || inside.y0 >= inside.y1) return;
+    total = std::clamp(total, 0, kSampleBatch);
+    add_box_samples(scene, settings, width, height, inside, sums, [&](size_t pixel) {
+        const int first = counts[pixel];
+        counts[pixel] = uint8_t(std::max(first, total));  // each pixel's own entry: no race
+        return std::pair{first, total - first};
+    });
 }
 
 }  // namespace kr

@@ -3,8 +3,10 @@
 // state (render/outputs.h).
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
+#include "core/image.h"
 #include "core/math.h"
 #include "render/render_scene.h"
 #include "render/settings.h"
@@ -44,5 +46,11 @@ SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSett
 // any number of calls, divided by n, are averaged_surface_layers(n) bit for bit.
 void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height, int first,
                          int count, SurfaceLayers& sums);
+// The same for the pixels of `box` only (clipped to the image), each refined from its own
+// count of samples (`counts`, one per pixel, sized and zeroed here on the first call) to
+// `total`: a render region's pixels first, the others when they are asked for. Once every
+// pixel is at n, the sums are those of samples 0..n-1, bit for bit.
+void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums);
 
 }  // namespace kr

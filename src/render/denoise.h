@@ -45,36 +45,69 @@ struct AtrousParams {
     float fade_error = 0.01f;      // relative standard error at which the result is half raw (0: never fade)
 };
 
-// The edge-avoiding a-trous wavelet filter (Dammertz et al. 2010, with SVGF's variance-scaled
-// luminance stop, Schied et al. 2017): the albedo divided out, `iterations` passes of a 3x3
-// B-spline with holes weighted by edge stops on normal, depth and luminance (scaled by the
-// filtered standard deviation, propagated through the passes), the albedo multiplied back,
-// then blended towards the raw radiance as a pixel's relative standard error drops, so a
-// converged image is left as it is. Parallel over rows (OpenMP); the inner loops run along
-// rows over planes of floats, which the compiler vectorises.
-// The filter's working planes, one per channel and feature so that a tap's loop along a row
-// reads each contiguously. A caller that denoises often (the viewer's render thread) keeps
-// one between calls: fresh memory's page faults cost about as much as the filter.
+// The filters' working planes, one per channel and feature so that a tap's loop along a row
+// reads each contiguously: every member of the three structs below is one float plane of
+// w x h (plane_count counts them).
+// What both filters prepare from their input (denoise_common.cpp), in the filter's unit of
+// radiance (DenoiseWorkspace::unit).
+struct DenoiseBasePlanes {
+    std::vector<float> radiance[3];     // the demodulated radiance (the a-trous pass's input)
+    std::vector<float> albedo[3];       // the albedo plus a floor, which demodulation divides out
+    std::vector<float> feature[4];      // unit feature vector: the normal and coverage by nothing
+    std::vector<float> variance;        // the variance of the demodulated luminance (of the mean)
+    std::vector<float> raw_variance;    // the variance of the raw radiance's luminance
+    std::vector<float> depth, depth_gradient;  // the depth and its local gradient (per pixel step)
+    std::vector<float> luminance, raw_luminance;  // of the demodulated radiance, of the raw one
+    std::vector<float> scratch;         // a plane each step borrows (a prefiltered variance)
+};
+// The a-trous filter's own: the next pass's demodulated radiance, variance and luminance.
+struct DenoiseAtrousPlanes {
+    std::vector<float> radiance[3], variance, luminance;
+};
+// The final filter's own, per half of the samples (g) or per strength (s).
+struct DenoiseNlmPlanes {
+    std::vector<float> half_radiance[2][3];  // [g][channel]: the demodulated radiance, a guide
+    std::vector<float> half_variance[2][3];  // [g][channel]: its mean's variance, 3x3-prefiltered
+    std::vector<float> distance[2];          // [g]: the patch distances of one offset, summed along rows
+    std::vector<float> sums[2][4];           // [g]: the filtered sums of the three channels and of the weights
+    std::vector<float> own_variance[2];      // [g]: the pixel's own variance, summed over the channels
+    std::vector<float> candidate[2][4];      // [s]: the filtered image, then its relative gain (box mean)
+    std::vector<float> own_gain[2];          // [s]: the pixel's own estimate of that gain
+};
+// The float planes per pixel of one of the structs above.
+template <class Planes>
+constexpr uint64_t plane_count() {
+    static_assert(sizeof(Planes) % sizeof(std::vector<float>) == 0, "a plane struct holds float planes only");
+    return sizeof(Planes) / sizeof(std::vector<float>);
+}
+
+// A caller that denoises often (the viewer's render thread) keeps one between calls: fresh
+// memory's page faults cost about as much as the filter.
 struct DenoiseWorkspace {
     int w = 0, h = 0;
     // The unit of radiance the planes hold (a robust scale of the image, so that the result
     // is proportional to the light's power) and the factor from the input's variance to the
     // planes' (one over the unit's square).
     double unit = 1, var_scale = 1;
-    std::vector<float> c[3], c2[3];  // demodulated radiance (and the next pass's)
-    std::vector<float> var, var2;    // variance of its luminance (of the mean)
-    std::vector<float> demod[3];     // albedo + floor
-    std::vector<float> f[4];         // unit feature: normal and coverage by nothing
-    std::vector<float> z, zgrad;     // depth and its local gradient (per pixel step)
-    std::vector<float> raw_var;      // variance of the raw radiance's luminance
-    std::vector<float> lum, lum2, lum_raw, var_blur;  // luminance of c (of c2), of the raw radiance; scratch
-    // The final filter's: per half, the demodulated radiance and its variance, the patch
-    // distances of one offset (summed along rows), the filtered sums and weights; per half the
-    // pixel's own variance (not prefiltered, summed over the channels); per candidate the
-    // pixel's own estimate of what filtering gains.
-    std::vector<float> u[2][3], v[2][3], hbox[2], acc[2][4], cand[3][4], own_var[2], own_gain[2];
-    std::vector<uint8_t> clamped;  // per pixel: a half was clamped (a firefly)
+    DenoiseBasePlanes base;
+    DenoiseAtrousPlanes atrous;
+    DenoiseNlmPlanes nlm;
+    std::vector<uint8_t> clamped;  // the final filter's, per pixel: a half was clamped (a firefly)
+
+    // What a workspace holds per pixel once both filters have run in it.
+    static constexpr uint64_t kBytesPerPixel =
+        sizeof(float) * (plane_count<DenoiseBasePlanes>() + plane_count<DenoiseAtrousPlanes>() +
+                         plane_count<DenoiseNlmPlanes>()) +
+        sizeof(uint8_t);
 };
+
+// The edge-avoiding a-trous wavelet filter (Dammertz et al. 2010, with SVGF's variance-scaled
+// luminance stop, Schied et al. 2017): the albedo divided out, `iterations` passes of a 3x3
+// B-spline with holes weighted by edge stops on normal, depth and luminance (scaled by the
+// filtered standard deviation, propagated through the passes), the albedo multiplied back,
+// then blended towards the raw radiance as a pixel's relative standard error drops, so a
+// converged image is left as it is. Parallel over rows (OpenMP); the inner loops run along
+// rows over planes of floats, which the compiler vectorises (denoise_atrous.cpp).
 Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
 
 // The final filter's parameters (docs/denoising.md says how they were chosen).
@@ -102,13 +135,15 @@ struct NlmParams {
 // decisive (docs/denoising.md). The halves are
 // averaged, the albedo multiplied back, and the result faded towards the raw radiance as a
 // pixel converges, as denoise_atrous does. Parallel over rows (OpenMP); the result does not
-// depend on the thread count.
+// depend on the thread count (denoise_nlmeans.cpp).
 Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, DenoiseWorkspace* workspace = nullptr);
 
-// Working memory of the filter and its feature buffers, per pixel (render_memory_bytes).
-// The final filter's planes (DenoiseWorkspace::u ...) and its halves (two Images and counts).
-// The estimates' variance is in double while the filter runs (3 floats more than its layer).
-inline constexpr uint64_t kDenoiseBytesPerPixel =
-    (39 + 38 + 3) * sizeof(float) + 1 + 3 * sizeof(Color) + 2 * sizeof(uint32_t);
+// Working memory of the filters, per pixel (render_memory_bytes): the workspace, the feature
+// buffers (albedo and normal), the estimates' variance in double while the filter runs (3
+// floats more than its layer), the final filter's halves (two Images and their counts) and
+// the denoised Image.
+inline constexpr uint64_t kDenoiseBytesPerPixel = DenoiseWorkspace::kBytesPerPixel + 2 * 3 * sizeof(float) +
+                                                  3 * sizeof(float) + 2 * (sizeof(Color) + sizeof(uint32_t)) +
+                                                  sizeof(Color);
 
 }  // namespace kr

@@ -12,11 +12,6 @@ Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo) {
     return m.rho * vertex::lambert<OnePath>(dot(sp.ns(), wo));
 }
 
-double pdf_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo) {
-    if (!has_smooth_lobe(m)) return 0;
-    return vertex::cosine_pdf<OnePath>(dot(sp.ns(), wo));
-}
-
 DielectricSplit split_dielectric(const Material& m, const SurfacePoint& sp, const Vec3& wi) {
     const Vec3 ns = sp.ns();
     const double wi_n = dot(wi, ns);

@@ -58,7 +58,6 @@ inline bool uses_direction_sample(const Material& m) {
 
 // f(wi, wo) * |cos(wo)| of the smooth lobe, for wo a unit direction away from the surface.
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
-double pdf_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
 
 // Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface),
 // from uniform numbers: `u_lobe` picks reflection or transmission, `u` the direction.

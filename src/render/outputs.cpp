@@ -55,17 +55,39 @@ void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, i
     feature_buffers_from_sums(sums, kFeatureSamples, albedo, normal);
 }
 
+namespace {
+
+// Pixel i's feature buffers: its sums over `samples` camera samples, averaged as
+// averaged_surface_layers averages them (times the reciprocal).
+void feature_pixel(const SurfaceLayers& sums, size_t i, int samples, std::vector<float>& albedo,
+                   std::vector<float>& normal) {
+    const double inverse = 1.0 / double(std::max(1, samples));
+    for (int k = 0; k < 3; ++k) {
+        albedo[3 * i + size_t(k)] = stored_float(sums.albedo[i][k] * inverse);
+        normal[3 * i + size_t(k)] = stored_float(sums.normal[i][k] * inverse);
+    }
+}
+
+}  // namespace
+
 void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vector<float>& albedo,
                                std::vector<float>& normal) {
-    // As averaged_surface_layers divides: times the reciprocal.
-    const double inverse = 1.0 / double(std::max(1, samples));
     const size_t n = sums.albedo.size();
     albedo.resize(3 * n);
     normal.resize(3 * n);
-    for (size_t i = 0; i < n; ++i)
-        for (int k = 0; k < 3; ++k) {
-            albedo[3 * i + size_t(k)] = stored_float(sums.albedo[i][k] * inverse);
-            normal[3 * i + size_t(k)] = stored_float(sums.normal[i][k] * inverse);
+    for (size_t i = 0; i < n; ++i) feature_pixel(sums, i, samples, albedo, normal);
+}
+
+void feature_buffers_from_sums(const SurfaceLayers& sums, const std::vector<uint8_t>& counts, int width,
+                               const PixelBox& box, std::vector<float>& albedo, std::vector<float>& normal) {
+    const size_t n = sums.albedo.size();
+    albedo.resize(3 * n);
+    normal.resize(3 * n);
+    const int height = width > 0 ? int(n / size_t(width)) : 0;
+    for (int y = std::max(0, box.y0); y < std::min(height, box.y1); ++y)
+        for (int x = std::max(0, box.x0); x < std::min(width, box.x1); ++x) {
+            const size_t i = size_t(y) * size_t(width) + size_t(x);
+            feature_pixel(sums, i, counts[i], albedo, normal);
         }
 }
 

@@ -69,6 +69,10 @@ void feature_buffers(const RenderScene& scene, const RenderSettings& sampling, i
 // add_surface_samples): of kFeatureSamples, what feature_buffers makes, bit for bit.
 void feature_buffers_from_sums(const SurfaceLayers& sums, int samples, std::vector<float>& albedo,
                                std::vector<float>& normal);
+// The same for the pixels of `box` of a `width`-wide image, each of its own count of samples
+// (render/aov.h add_surface_samples over a box); the others keep their entries (zero when new).
+void feature_buffers_from_sums(const SurfaceLayers& sums, const std::vector<uint8_t>& counts, int width,
+                               const PixelBox& box, std::vector<float>& albedo, std::vector<float>& normal);
 // What the denoiser reads of `estimates` (their feature buffers filled) for the image
 // `radiance` (the mean, or its blurred picture), with the halves where `with_halves`.
 DenoiseInput denoise_input(const RenderEstimates& estimates, const Image& radiance, bool with_halves);

@@ -10,8 +10,8 @@
 namespace kr {
 
 // A ray leaving hit point `hit` along `dir`, written field by field into `r`: copying a
-// whole Ray just after its fields were stored stalls on store forwarding (measured: a
-// tenth of the path loop's time).
+// whole Ray just after its fields were stored stalls on store forwarding
+// (docs/performance.md, "Design choices and their figures").
 // Inline: it runs once per ray, and both tracers call it from their own files.
 inline void respawn(Ray& r, const Hit& hit, const Vec3& dir, double tmax = kInfinity, int to_sphere = -1) {
     r.o = hit.p;

@@ -247,9 +247,9 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         else
             rs.area_lights[i - rs.point_lights.size()].select_prob = prob;
     }
-    // The BVH depends on the spheres alone. At 100,000 spheres its build is most of the
-    // viewer's latency after a camera edit (about 80 of 140 ms). The gap check depends on
-    // the spheres and the lights (about 440 ms at 100,000 under --accel own).
+    // The BVH depends on the spheres alone, and at many spheres its build is most of the
+    // viewer's latency after a camera edit; the gap check depends on the spheres and the
+    // lights (docs/performance.md, "Design choices and their figures").
     if (previous && previous->accel_backend == rs.accel_backend && previous->spheres == rs.spheres) {
         rs.bvh = previous->bvh;
         rs.float_gaps_resolved = same_light_geometry(*previous, rs) ? previous->float_gaps_resolved

@@ -45,11 +45,24 @@ void RenderState::track_halves() {
 
 void RenderState::add_sums_to_half(int sign) {
     if (!tracks_halves()) return;
-    const long n = long(px_.half_sum.size());
+    // Only the pixels the pass samples (its rows, the noise rule's mask and the plan:
+    // render_pass skips the others), whose sums are the only ones it changes: a region's or an
+    // adaptive pass costs what its pixels cost, and the others' halves stay as they are, bit
+    // for bit.
+    const size_t w = size_t(width);
+    const long rows = long(px_.half_sum.size() / std::max<size_t>(1, w));
+    const uint8_t* const rows_on = px_.active_rows.empty() ? nullptr : px_.active_rows.data();
+    const uint8_t* const active = px_.active.empty() ? nullptr : px_.active.data();
+    const uint8_t* const planned = px_.pass_samples.empty() ? nullptr : px_.pass_samples.data();
 #pragma omp parallel for schedule(static)
-    for (long i = 0; i < n; ++i) {
-        px_.half_sum[size_t(i)] += double(sign) * (px_.radiance_sum[size_t(i)] + px_.radiance_compensation[size_t(i)]);
-        px_.half_count[size_t(i)] += uint32_t(sign) * px_.sample_count[size_t(i)];  // modulo 2^32, exact
+    for (long r = 0; r < rows; ++r) {
+        const size_t y = held_.empty() ? size_t(r) : size_t(held_[size_t(r)]);
+        if (rows_on && !rows_on[y]) continue;
+        for (size_t i = size_t(r) * w; i < size_t(r + 1) * w; ++i) {
+            if ((active && !active[i]) || (planned && !planned[i])) continue;
+            px_.half_sum[i] += double(sign) * (px_.radiance_sum[i] + px_.radiance_compensation[i]);
+            px_.half_count[i] += uint32_t(sign) * px_.sample_count[i];  // modulo 2^32, exact
+        }
     }
 }
 

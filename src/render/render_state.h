@@ -204,11 +204,6 @@ public:
 
     // Keeps the two halves of each pixel's samples from the next pass on (PixelBuffers::half_sum).
     void track_halves();
-    // Forgets them (a render whose halves would not be kept up to date).
-    void untrack_halves() {
-        px_.half_sum.clear();
-        px_.half_count.clear();
-    }
     bool tracks_halves() const { return !px_.half_sum.empty(); }
     // Around a pass (ProgressiveDriver): the samples of a pass after an odd number of passes
     // go to the half, as the difference of the sums after and before it. A no-op unless

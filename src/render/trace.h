@@ -19,10 +19,8 @@ inline constexpr double kMissDepth = 1e6;
 
 // The camera's image coordinates in [0,1]^2 of a point (x, y) of the raster, where pixel
 // (i, j) spans [i, i+1) x [j, j+1), top row first. The brief's references put each pixel half
-// a pixel left of and half a pixel below that square (measured on all eight scenes: the
-// discs of scene 5's lights sit 0.5 px right of and 0.5 px above ours, and shifting our
-// renders so raised PSNR by 1.2 to 4 dB everywhere; docs/fidelity.md), so the camera sees
-// (x - 1/2, y + 1/2).
+// a pixel left of and half a pixel below that square (docs/fidelity.md, "The references'
+// pixel grid"), so the camera sees (x - 1/2, y + 1/2).
 inline Vec2 raster_to_camera(double x, double y, int width, int height) {
     return {(x - 0.5) / width, (y + 0.5) / height};
 }
@@ -49,8 +47,7 @@ void camera_rays(const RenderScene& scene, const RenderSettings& settings, int w
 // in double, as packet_kernels() below says), a lane starting the next sample as its path
 // ends, where the scene is one leaf of our BVH; anything else goes one by one through
 // trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less time
-// lanes idle at the batch's end (128 against 64: sixteen lanes 3 to 7 % less task-clock on
-// scenes 3 and 8; 512 against 128: 4 to 5 % less user time; docs/performance.md).
+// lanes idle at the batch's end (docs/performance.md, "Design choices and their figures").
 inline constexpr int kSampleBatch = 512;
 void trace_samples(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                    int count, SampleResult* results);

@@ -1,4 +1,4 @@
-// Strict scene loading from the JSON format the README describes (the brief's format, with
+// Strict scene loading from the JSON format of docs/scene-format.md (the brief's format, with
 // the translucent material and the optional display block).
 #pragma once
 

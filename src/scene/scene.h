@@ -116,7 +116,7 @@ struct RendererSettings {
 // in stops (EV): radiance is scaled by 2^exposure before the tone map, so 0 leaves it as is.
 inline constexpr double kMaxExposureStops = 10;
 struct DisplaySettings {
-    ToneMap tonemap = ToneMap::sigmoid;
+    ToneMap tonemap = kDefaultToneMap;
     double exposure = 0;  // EV, in [-kMaxExposureStops, kMaxExposureStops]
     double exposure_scale() const { return std::exp2(exposure); }
 };

@@ -87,7 +87,6 @@ void Display::upload(const Image& radiance) {
     gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, radiance.width, radiance.height, 0, GL_RGB, GL_FLOAT,
                    texels.data());
     tex_width_ = radiance.width;
-    tex_height_ = radiance.height;
     inv_max_ = linear_tonemap_scale(radiance);
 }
 

@@ -21,8 +21,6 @@ public:
     // the linear tone map's scale from it.
     void upload(const Image& radiance);
     bool has_image() const { return tex_width_ > 0; }
-    int image_width() const { return tex_width_; }
-    int image_height() const { return tex_height_; }
 
     // An 8-bit picture shown as it is (image B, an error or noise map) by draw_bytes.
     void upload_bytes(const Rgb8Image& picture);
@@ -47,7 +45,7 @@ private:
     GLuint program_ = 0, texture_ = 0, bytes_texture_ = 0, vertex_array_ = 0;
     int bytes_width_ = 0;
     GLint rect_loc_ = -1, op_loc_ = -1, exposure_loc_ = -1, inv_max_loc_ = -1, sampler_loc_ = -1;
-    int tex_width_ = 0, tex_height_ = 0;
+    int tex_width_ = 0;
     double inv_max_ = 0;
     bool smooth_ = false;
 };

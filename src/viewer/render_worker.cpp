@@ -45,14 +45,24 @@ std::vector<int> preview_scales(int width, int height, double seconds_per_pixel,
     return scales;
 }
 
-bool FrameSchedule::due(double age, double since_last, double cost) const {
-    const double by_age = std::clamp(age_fraction * age, min_interval, max_interval);
-    return since_last >= std::max(by_age, cost / cost_share);
+bool FrameSchedule::due(double age, double since_last, double cost, double next_wait) const {
+    const double interval = std::max(std::clamp(age_fraction * age, min_interval, max_interval), cost / cost_share);
+    if (since_last >= interval) return true;
+    const double early = interval - since_last, late = since_last + next_wait - interval;
+    return since_last >= 0.5 * interval && late > early;
 }
 
-bool frame_spp(int spp, bool after_previews) {
-    if (spp < (after_previews ? kFirstFrameSpp : 1)) return false;
+bool frame_spp(int spp, int first) {
+    if (spp < first) return false;
     return spp <= 8 ? (spp & (spp - 1)) == 0 : spp % 8 == 0;
+}
+
+int first_frame_spp(const RenderScene& scene) { return scene.camera.lens_radius > 0 ? 4 : 2; }
+
+int next_frame_spp(int spp, int first) {
+    int next = std::max(spp + 1, first);
+    while (!frame_spp(next, first)) ++next;
+    return next;
 }
 
 RenderWorker::RenderWorker(std::function<void()> on_publish, SharedPasses* ranks)
@@ -120,10 +130,23 @@ void RegionHooks::before_plan(RenderState& state) {
     applied_ = true;
 }
 
+void RegionHooks::before_pass(RenderState& state) {
+    rows_applied_ = false;
+    if (!applied_) return;
+    std::vector<uint8_t>& rows = state.buffers().active_rows;
+    saved_rows_ = rows;  // empty: every row
+    if (rows.empty()) rows.assign(size_t(state.height), 1);
+    for (int y = 0; y < state.height; ++y)
+        if (y < region->y0 || y >= region->y1) rows[size_t(y)] = 0;
+    rows_applied_ = true;
+}
+
 void RegionHooks::after_pass(RenderState& state, bool) {
     if (applied_) state.buffers().active.swap(saved_);
+    if (rows_applied_) state.buffers().active_rows.swap(saved_rows_);
     saved_.clear();
-    applied_ = false;
+    saved_rows_.clear();
+    applied_ = rows_applied_ = false;
 }
 
 void RenderWorker::set_region(std::optional<PixelBox> region) {
@@ -206,21 +229,68 @@ Image denoised_radiance(const RenderJob& job, RenderEstimates& estimates, Displa
     return out;
 }
 
+// The same within `box` only, over `base` (the job's previous denoised picture): the box is
+// filtered as an image of its own, its edges as the image's borders, and the pixels outside it,
+// whose samples a region's passes leave as they were, keep their picture.
+Image denoised_radiance_in(const RenderJob& job, const RenderEstimates& estimates, const DisplayFeatures& features,
+                           const PixelBox& box, const Image& base, DenoiseWorkspace& workspace) {
+    const int w = estimates.radiance.width, bw = box.x1 - box.x0, bh = box.y1 - box.y0;
+    RenderEstimates crop;
+    crop.radiance = Image(bw, bh);
+    crop.depth.resize(size_t(bw) * bh);
+    crop.variance.resize(size_t(bw) * bh);
+    if (!estimates.samples.empty()) crop.samples.resize(size_t(bw) * bh);
+    DisplayFeatures crop_features;
+    crop_features.albedo.resize(3 * size_t(bw) * bh);
+    crop_features.normal.resize(3 * size_t(bw) * bh);
+    for (int y = 0; y < bh; ++y) {
+        const size_t from = size_t(box.y0 + y) * size_t(w) + size_t(box.x0), to = size_t(y) * size_t(bw);
+        std::copy_n(estimates.radiance.pixels.begin() + long(from), bw, crop.radiance.pixels.begin() + long(to));
+        std::copy_n(estimates.depth.begin() + long(from), bw, crop.depth.begin() + long(to));
+        std::copy_n(estimates.variance.begin() + long(from), bw, crop.variance.begin() + long(to));
+        if (!crop.samples.empty()) std::copy_n(estimates.samples.begin() + long(from), bw, crop.samples.begin() + long(to));
+        std::copy_n(features.albedo.begin() + long(3 * from), 3 * bw, crop_features.albedo.begin() + long(3 * to));
+        std::copy_n(features.normal.begin() + long(3 * from), 3 * bw, crop_features.normal.begin() + long(3 * to));
+    }
+    const Image filtered = denoised_radiance(job, crop, crop_features, workspace);
+    Image out = base;
+    for (int y = 0; y < bh; ++y)
+        std::copy_n(filtered.pixels.begin() + long(y) * bw, bw,
+                    out.pixels.begin() + long(size_t(box.y0 + y) * size_t(w) + size_t(box.x0)));
+    return out;
+}
+
 }  // namespace
 
+std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
+                                     const Snapshot* previous, uint64_t generation) {
+    if (!region || !previous || previous->generation != generation || previous->scale != 1 ||
+        previous->denoised.width != width || previous->denoised.height != height)
+        return std::nullopt;
+    const PixelBox box{std::max(0, region->x0), std::max(0, region->y0), std::min(width, region->x1),
+                       std::min(height, region->y1)};
+    // An empty box, or one of most of the image: the whole image, as cheap and seamless.
+    if (box.x0 >= box.x1 || box.y0 >= box.y1 || 2 * double(box.x1 - box.x0) * (box.y1 - box.y0) > double(width) * height)
+        return std::nullopt;
+    return box;
+}
+
 void DisplayFeatures::reset(int w, int h) {
-    width = w, height = h, samples = 0;
+    width = w, height = h, samples = whole = 0;
     sums = {};
+    counts.clear();
     albedo.clear();
     normal.clear();
 }
 
-void DisplayFeatures::refine_to(const RenderJob& job, int total) {
-    const int count = std::min(total, kFeatureSamples) - samples;
-    if (count <= 0) return;
-    add_surface_samples(*job.scene, job.settings, width, height, samples, count, sums);
-    samples += count;
-    feature_buffers_from_sums(sums, samples, albedo, normal);
+void DisplayFeatures::refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box) {
+    total = std::min(total, kFeatureSamples);
+    if (total <= whole) return;
+    const PixelBox pixels = box.value_or(PixelBox{0, 0, width, height});
+    add_surface_samples(*job.scene, job.settings, width, height, pixels, total, counts, sums);
+    feature_buffers_from_sums(sums, counts, width, pixels, albedo, normal);
+    samples = std::max(samples, total);
+    if (!box) whole = total;
 }
 
 int next_display_feature_samples(const DisplayFeatures& features) {
@@ -259,9 +329,12 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
 }
 
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
-                     DenoiseWorkspace& workspace, Snapshot& frame) {
+                     DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous,
+                     const std::optional<PixelBox>& region) {
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
-    if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
+    const std::optional<PixelBox> box = denoised_box(region, state.width, state.height, previous, job.generation);
+    if (features && box) frame.denoised = denoised_radiance_in(job, estimates, *features, *box, previous->denoised, workspace);
+    else if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
     frame.radiance = std::move(estimates.radiance);
     record_pixel_statistics(state, std::move(estimates), frame);
 }
@@ -298,6 +371,7 @@ void RenderWorker::run() {
     DisplayFeatures display_features;  // of `job` at full resolution, for the display's filter
     std::shared_ptr<const FeatureBuffers> features;  // the feature views' (complete), made once
     DenoiseWorkspace denoise_planes;    // kept between frames
+    std::shared_ptr<const Snapshot> last_full;  // the newest full frame made (a region's frames build on it)
     // The full-resolution passes of `job` not yet in a frame, when the last frame was made and
     // what making it cost (seconds, smoothed).
     bool unpublished = false;
@@ -437,15 +511,18 @@ void RenderWorker::run() {
             // A pass stopped early is always an edit's: the next turn starts the new job.
             else if (!driver->pass(rule, &stop_)) continue;
             // Only full passes: tiny previews are dominated by per-pass overheads.
-            seconds_per_pixel = seconds_since(start) / (double(w) * h);
+            const double pass_seconds = seconds_since(start);
+            seconds_per_pixel = pass_seconds / (double(w) * h);
             unpublished = true;
             // The frame schedule: is this pass's image worth making and drawing now?
             bool due = false;
             {
                 std::lock_guard lock(mutex_);
-                const bool by_schedule = frame_spp(state.passes, !previews.empty()) &&
+                const int first = previews.empty() ? 1 : first_frame_spp(*job.scene);
+                const bool by_schedule = frame_spp(state.passes, first) &&
                     (!full_frame_made ||
-                     schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load()));
+                     schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load(),
+                                   pass_seconds * (next_frame_spp(state.passes, first) - state.passes)));
                 due = by_schedule || paused_ || stop_reason() || (features_.load() && !(latest_ && latest_->features));
             }
             if (!due) continue;
@@ -455,9 +532,11 @@ void RenderWorker::run() {
             // image (guided by feature buffers refined one more step each frame) and the
             // pixel statistics.
             // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
-            if (denoise_.load()) display_features.refine_to(job, next_display_feature_samples(display_features));
+            if (denoise_.load())
+                display_features.refine_to(job, next_display_feature_samples(display_features), region.region);
             const auto start = Clock::now();
-            make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame);
+            make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame,
+                            last_full.get(), region.region);
             if (features_.load()) {
                 frame->features = full_features();
                 frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
@@ -493,6 +572,7 @@ void RenderWorker::run() {
             frame->stopped_by = stop_reason();
             frame->finished = frame->stopped_by.has_value();
         }
+        if (frame->scale == 1) last_full = frame;
         publish(std::move(frame));
     }
 }

@@ -37,12 +37,8 @@ struct RenderJob {
     std::chrono::steady_clock::time_point edited{};
 };
 
-// A render region: the image pixels [x0, x1) x [y0, y1) that full passes refine.
-struct PixelBox {
-    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-    bool operator==(const PixelBox& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
-    bool operator!=(const PixelBox& o) const { return !(*this == o); }
-};
+// A render region: the image pixels that full passes refine (core/image.h).
+using kr::PixelBox;
 
 // Narrows each full pass to a region's pixels (AND the noise rule's mask), through the
 // driver's pass hooks, before the pass is planned: the plan gives the region's pixels as many
@@ -53,13 +49,16 @@ class RegionHooks : public PassHooks {
 public:
     std::optional<PixelBox> region;
     void before_plan(RenderState& state) override;
-    void before_pass(RenderState&) override {}
+    // The pass's rows narrowed to the region's (AND the rows a process's share sets before it):
+    // render_pass and the halves skip the others' rows whole.
+    void before_pass(RenderState& state) override;
     void after_pass(RenderState& state, bool statistics) override;
     bool any(bool stop) override { return stop; }
 
 private:
-    std::vector<uint8_t> saved_;  // the noise rule's mask while the region's is in place
-    bool applied_ = false;
+    std::vector<uint8_t> saved_;       // the noise rule's mask while the region's is in place
+    std::vector<uint8_t> saved_rows_;  // the pass's rows before the region's
+    bool applied_ = false, rows_applied_ = false;
 };
 
 // A region's hooks over a process's share of the rows (SharedPasses::hooks): a pass samples
@@ -71,7 +70,10 @@ public:
         share_.before_plan(state);
         region_.before_plan(state);
     }
-    void before_pass(RenderState& state) override { share_.before_pass(state); }
+    void before_pass(RenderState& state) override {
+        share_.before_pass(state);
+        region_.before_pass(state);
+    }
     void after_pass(RenderState& state, bool statistics) override {
         region_.after_pass(state, statistics);
         share_.after_pass(state, statistics);
@@ -160,27 +162,34 @@ struct Snapshot {
 // interval grows with the image's age (seconds since the edit: the image changes fast at
 // first, slowly later) up to `max_interval`, and is never so short that the frames (`cost`:
 // the render thread's time to make one plus the window's to draw it) take more than
-// `cost_share` of the time. Frames nobody could see in time are not made.
+// `cost_share` of the time. Frames nobody could see in time are not made. Frames come only at
+// balanced sample counts (frame_spp), so one is also due a little early, once half the
+// interval has passed, where waiting `next_wait` seconds for the next balanced count would
+// end further past the interval than now is short of it.
 struct FrameSchedule {
     double age_fraction = 0.5;   // interval: half the image's age (frames at ages 1, 1.5, 2.25, ...)
     double min_interval = 1.0 / 60;
     double max_interval = 1.0;
     double cost_share = 0.2;
-    bool due(double age, double since_last, double cost) const;
+    bool due(double age, double since_last, double cost, double next_wait = 0) const;
 };
 
 // The display's feature buffers of one image (albedo and normal, render/outputs.h): refined a
 // few camera samples at a time (render/aov.h add_surface_samples), so that the first frame of
-// an edit costs one sample a pixel; at kFeatureSamples they are feature_buffers', bit for bit.
+// an edit costs one sample a pixel, and within a render region only while there is one; at
+// kFeatureSamples they are feature_buffers', bit for bit.
 struct DisplayFeatures {
     int width = 0, height = 0;
     SurfaceLayers sums;
-    int samples = 0;
+    std::vector<uint8_t> counts;  // camera samples per pixel in the sums
+    int samples = 0;              // the samples a pixel the display asked for last
+    int whole = 0;                // ... that every pixel has
     std::vector<float> albedo, normal;  // of the sums
 
     void reset(int w, int h);
-    // Refined to `total` camera samples a pixel (at most kFeatureSamples).
-    void refine_to(const RenderJob& job, int total);
+    // Refined to `total` camera samples a pixel (at most kFeatureSamples): the pixels of `box`
+    // only, where given (a render region's: the others are not refined).
+    void refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box = std::nullopt);
 };
 // The camera samples a pixel of the display's feature buffers at the next frame: the first full
 // frame of an edit traces one, the next one more (a sample costs about 1/8 of a pass;
@@ -196,18 +205,31 @@ inline constexpr int kPreviewFeatureSamples = 2;
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
                         Snapshot& frame);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
-// `features` (null: not denoised) and the pixel statistics.
+// `features` (null: not denoised) and the pixel statistics. With a render `region` and the
+// job's `previous` full frame, only the region's pixels are denoised (denoised_box), over the
+// previous frame's picture.
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
-                     DenoiseWorkspace& workspace, Snapshot& frame);
+                     DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous = nullptr,
+                     const std::optional<PixelBox>& region = std::nullopt);
+// The pixels a full frame denoises alone: the render region clipped to the image, where the
+// job's previous full frame (of `generation`) has a denoised picture to keep outside it; none
+// (the whole image) otherwise, or where the region is most of the image.
+std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
+                                     const Snapshot* previous, uint64_t generation);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
-// (a stop rule met or a pause makes one at any count): after previews, from kFirstFrameSpp on
-// (fewer samples, denoised, can look worse than the last preview: the a-trous filter at 1 spp
-// speckles, and a lens's blur is noisy); and only where the samples are balanced: powers of
-// two up to 8, then multiples of 8 (a Sobol or stratified estimate between them is less even:
-// a Whitted render lost about 1 dB from 8 spp to 9).
-inline constexpr int kFirstFrameSpp = 4;
-bool frame_spp(int spp, bool after_previews);
+// (a stop rule met or a pause makes one at any count): from `first` on (after previews:
+// first_frame_spp), and only where the samples are balanced: powers of two up to 8, then
+// multiples of 8 (a Sobol or stratified estimate between them is less even: a Whitted render
+// lost about 1 dB from 8 spp to 9).
+bool frame_spp(int spp, int first = 1);
+// The first full frame after previews: fewer samples, denoised, can look worse than the last
+// preview. Through a pinhole 2 spp are already better; through a lens (its blur is noisy) 4
+// (FirstFrames over every bundled scene: the lens scene's 2 spp frame is 0.3 dB below its
+// preview at 96 px).
+int first_frame_spp(const RenderScene& scene);
+// The next count after `spp` that frame_spp allows from `first` on.
+int next_frame_spp(int spp, int first);
 
 // Preview resolutions for the first passes after an edit: 1/first_scale, then halving up
 // to full resolution. first_scale is the smallest power of two (up to 16) whose pass is

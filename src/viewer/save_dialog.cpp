@@ -15,23 +15,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr SaveKind kImageKinds[] = {SaveKind::ppm, SaveKind::png, SaveKind::exr, SaveKind::pfm};
-
-bool is_image(SaveKind kind) {
-    return kind != SaveKind::scene && kind != SaveKind::scene_copy && kind != SaveKind::convergence;
-}
-
-ImageFormat image_format(SaveKind kind) {
-    switch (kind) {
-    case SaveKind::png: return ImageFormat::png;
-    case SaveKind::exr: return ImageFormat::exr;
-    case SaveKind::pfm: return ImageFormat::pfm;
-    default: return ImageFormat::ppm;
-    }
-}
-
-std::string extension(SaveKind kind) { return format_info(image_format(kind)).extension; }
-
 // Writes the shown frame as `render -o path` writes a render: its estimates developed and
 // encoded by render/outputs.h, every file committed together.
 void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, const Snapshot* shown) {
@@ -42,9 +25,11 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
     const size_t n = shown->radiance.pixels.size();
     if (shown->depth.size() != n || shown->sample_count.size() != n || shown->variance.size() != n)
         throw std::runtime_error("no full-resolution image yet");
-    if (image_save_kind(path) != kind)
-        throw std::invalid_argument(quoted_path(path) + ": a " + format_info(image_format(kind)).name +
-                                    " image needs a name ending in " + extension(kind));
+    if (image_save_kind(path) != kind) {
+        const ImageFormatInfo& format = format_info(kind.format);
+        throw std::invalid_argument(quoted_path(path) + ": a " + format.name + " image needs a name ending in " +
+                                    format.extension);
+    }
     RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance, {}, {}, shown->halves};
     OutputRequest request;
     request.path = path;
@@ -67,9 +52,7 @@ SavePaths SavePaths::for_scene(const Scene& scene, bool read_only) {
     SavePaths paths;
     fs::path image = scene.output_path();
     if (image.empty()) image = "keithray.ppm";
-    paths.image = image_save_path(SaveKind::ppm, image).string();
-    paths.png = image_save_path(SaveKind::png, image).string();
-    paths.hdr = image_save_path(SaveKind::exr, image).string();
+    paths.image = image.string();
     paths.convergence = (image.parent_path() / (image.stem().string() + "-convergence.csv")).string();
     const fs::path source = scene.source_file.empty() ? fs::path("scene.json") : scene.source_file;
     paths.scene = read_only ? source.filename().string()
@@ -77,28 +60,23 @@ SavePaths SavePaths::for_scene(const Scene& scene, bool read_only) {
     return paths;
 }
 
-SaveKind image_save_kind(const fs::path& path) {
-    const ImageFormat format = output_format(path).format;
-    for (SaveKind kind : kImageKinds)
-        if (image_format(kind) == format) return kind;
-    return SaveKind::ppm;
-}
+SaveKind image_save_kind(const fs::path& path) { return output_format(path).format; }
 
-fs::path image_save_path(SaveKind kind, const fs::path& path) {
-    return fs::path(path).replace_extension(extension(kind));
+fs::path image_save_path(ImageFormat format, const fs::path& path) {
+    return fs::path(path).replace_extension(format_info(format).extension);
 }
 
 std::vector<fs::path> save_targets(SaveKind kind, const fs::path& path) {
-    return is_image(kind) ? output_file_paths(path) : std::vector<fs::path>{path};
+    return kind.what == SaveKind::image ? output_file_paths(path) : std::vector<fs::path>{path};
 }
 
 std::string save_output(SaveKind kind, const fs::path& path, ViewerModel& model, const Snapshot* shown,
                         const std::string& convergence_csv) {
-    if (kind == SaveKind::convergence) {
+    if (kind.what == SaveKind::convergence) {
         write_file_atomic(path, convergence_csv);
-    } else if (kind == SaveKind::scene || kind == SaveKind::scene_copy) {
-        model.save_scene_to(path, kind == SaveKind::scene);
-        if (kind == SaveKind::scene_copy) return "saved a copy as " + show_user_text(path.string());
+    } else if (kind.what == SaveKind::scene || kind.what == SaveKind::scene_copy) {
+        model.save_scene_to(path, kind.what == SaveKind::scene);
+        if (kind.what == SaveKind::scene_copy) return "saved a copy as " + show_user_text(path.string());
     } else {
         save_image(kind, path, model, shown);
     }

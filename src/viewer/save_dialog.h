@@ -17,16 +17,26 @@
 
 namespace kr::viewer {
 
-// scene: Save As (the file becomes the scene's); scene_copy: a copy, the scene's file stays.
-enum class SaveKind { ppm, png, exr, pfm, scene, scene_copy, convergence };
+// What a Save writes: an image in one of the formats of core/image_formats.h (kImageFormats:
+// the panel has a button for each), the scene (Save As: the file becomes the scene's), a
+// copy of it (the scene's file stays) or the convergence log.
+struct SaveKind {
+    enum What { image, scene, scene_copy, convergence };
+    What what = image;
+    ImageFormat format = ImageFormat::ppm;  // an image's
+
+    constexpr SaveKind(What w) : what(w) {}
+    constexpr SaveKind(ImageFormat f) : format(f) {}
+    bool operator==(const SaveKind&) const = default;
+};
 
 // The panel's path fields, edited by the user.
 struct SavePaths {
-    std::string image, png, hdr, scene, convergence;
+    std::string image, scene, convergence;
 
-    // The defaults for `scene`: its "output" (else keithray.ppm) as .ppm, .png and .exr, and
-    // the scene itself beside its file as NAME-edited.json, the convergence log as
-    // OUTPUT-convergence.csv.
+    // The defaults for `scene`: its "output" (else keithray.ppm) for an image (each format's
+    // button sets the extension), the scene itself beside its file as NAME-edited.json, the
+    // convergence log as OUTPUT-convergence.csv.
     // A `read_only` scene's (scene_file_read_only) is saved as NAME.json in the current folder.
     static SavePaths for_scene(const Scene& scene, bool read_only = false);
 };
@@ -37,8 +47,8 @@ bool scene_file_read_only(const std::filesystem::path& file, const std::optional
 
 // The image kind an output named `path` is (its format, core/image_formats.h).
 SaveKind image_save_kind(const std::filesystem::path& path);
-// `path` with the extension of image kind `kind` (what the panel's image buttons save to).
-std::filesystem::path image_save_path(SaveKind kind, const std::filesystem::path& path);
+// `path` with the extension of image format `format` (what the panel's image buttons save to).
+std::filesystem::path image_save_path(ImageFormat format, const std::filesystem::path& path);
 // Every file saving `kind` to `path` writes: an image's depth file too (output_file_paths).
 std::vector<std::filesystem::path> save_targets(SaveKind kind, const std::filesystem::path& path);
 

@@ -6,12 +6,12 @@
 
 namespace kr::viewer {
 
-RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error) {
+RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error, bool earlier_view) {
     RunStatus st;
     st.target = settings.render.target_spp;
     st.unlimited = settings.unlimited;
     if (!frame) {
-        st.state = has_error ? RunState::error : RunState::starting;
+        st.state = has_error ? RunState::error : earlier_view ? RunState::moving : RunState::starting;
         return st;
     }
     st.spp = frame->spp;

@@ -14,8 +14,10 @@
 
 namespace kr::viewer {
 
-enum class RunState { starting, rendering, paused, done, error };
-inline constexpr EnumNames<RunState, 5> run_state_names{{"starting", "rendering", "paused", "done", "error"}};
+// moving: no frame of the current view yet, while the window shows an earlier view's as the
+// camera moves (a drag, the keys).
+enum class RunState { starting, moving, rendering, paused, done, error };
+inline constexpr EnumNames<RunState, 6> run_state_names{{"starting", "moving", "rendering", "paused", "done", "error"}};
 
 struct RunStatus {
     RunState state = RunState::starting;
@@ -32,7 +34,8 @@ struct RunStatus {
 
 // `frame`: the newest snapshot of the current generation (null before the first).
 // `has_error`: a load or edit failure is being shown (the last good image stays).
-RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error);
+// `earlier_view`: with no frame, one of an earlier view is on screen (the camera moves).
+RunStatus run_status(const Snapshot* frame, const ViewerSettings& settings, bool has_error, bool earlier_view = false);
 
 // While a render region is set, the spp, the stop rules and the noise estimate count the
 // whole image; the status bar adds the region's own figures from a full-resolution frame:

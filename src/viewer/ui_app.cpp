@@ -280,7 +280,8 @@ bool ViewerApp::animating() const {
 }
 
 void ViewerApp::update_title() {
-    const RunStatus status = run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene());
+    const RunStatus status = run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene(),
+                                        ctx_.shows_earlier_view());
     const std::string name = ui_.files.watch.file().filename().string();
     std::string title = window_title(name, status, model_.dirty());
     if (title != title_) {
@@ -432,7 +433,8 @@ bool ViewerApp::draw_frame() {
     // After the inspector: the status line is the frame drawn, its pointer's readout included
     // (written before it, the readout of a frame that came while idle would stay a frame old).
     if (options_.status_file)
-        write_status_file(run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene()));
+        write_status_file(run_status(ctx_.frame(), model_.settings(), !messages_.error.empty() && !model_.has_scene(),
+                                     ctx_.shows_earlier_view()));
     // Scripted runs read the image region back here: what the shader drew, before
     // the panels are drawn over anything.
     const auto read = [this](const PixelRect& r) { return read_image_region(r); };

@@ -26,6 +26,10 @@ const Snapshot* PanelContext::frame() const {
     return ui.shown && ui.shown->generation == model.generation() ? ui.shown.get() : nullptr;
 }
 
+bool PanelContext::shows_earlier_view() const {
+    return ui.shown && ui.shown->generation != model.generation() && ui.shown->generation >= model.view_base_generation();
+}
+
 const Snapshot* PanelContext::full_frame() const {
     const Snapshot* f = frame();
     return f && f->scale == 1 ? f : nullptr;

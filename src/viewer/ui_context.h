@@ -161,6 +161,9 @@ struct PanelContext {
     const Snapshot* frame() const;
     // ... and only when it is at full resolution.
     const Snapshot* full_frame() const;
+    // Whether, with no frame of the current generation, the window shows one of an earlier
+    // view of the same scene (the camera moves: ViewerModel::view_base_generation).
+    bool shows_earlier_view() const;
     double status_bar_height() const;  // framebuffer pixels
     PixelRect view_area() const;       // the free area left of the panel, above the status bar
     PixelRect image_rect() const;      // where the image is drawn in it (zoom and pan)

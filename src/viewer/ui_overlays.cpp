@@ -68,11 +68,12 @@ void draw_status_bar(PanelContext& ctx) {
                  ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoSavedSettings |
                      ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoBringToFrontOnFocus);
     const Snapshot* current = ctx.frame();
-    const RunStatus st = run_status(current, ctx.model.settings(), !ctx.model.has_scene());
+    const RunStatus st = run_status(current, ctx.model.settings(), !ctx.model.has_scene(), ctx.shows_earlier_view());
     // Line 1: state, spp, progress with ETA, elapsed, Mrays/s, noise. Fixed-width fields, so
     // nothing moves as the figures change.
-    static const ImVec4 kStateColours[] = {{0.8f, 0.8f, 0.8f, 1}, {0.5f, 0.8f, 1, 1}, {1, 0.8f, 0.3f, 1},
-                                           {0.4f, 0.9f, 0.4f, 1}, {1, 0.4f, 0.4f, 1}};
+    static const ImVec4 kStateColours[] = {{0.8f, 0.8f, 0.8f, 1}, {0.5f, 0.8f, 1, 1}, {0.5f, 0.8f, 1, 1},
+                                           {1, 0.8f, 0.3f, 1},     {0.4f, 0.9f, 0.4f, 1}, {1, 0.4f, 0.4f, 1}};
+    static_assert(std::size(kStateColours) == run_state_names.names.size());
     ImGui::AlignTextToFramePadding();
     ImGui::TextColored(kStateColours[size_t(st.state)], "%-9s", std::string(run_state_names.name(st.state)).c_str());
     ImGui::SameLine(90);
@@ -85,6 +86,8 @@ void draw_status_bar(PanelContext& ctx) {
         if (st.state == RunState::done) std::snprintf(overlay, sizeof overlay, "done (%s)", st.rule.c_str());
         else if (st.eta >= 0) std::snprintf(overlay, sizeof overlay, "ETA %s (%s)", format_duration(st.eta).c_str(), st.rule.c_str());
         else std::snprintf(overlay, sizeof overlay, "%s", st.rule.c_str());
+    } else if (st.state == RunState::moving) {
+        std::snprintf(overlay, sizeof overlay, "an earlier view");  // the camera moves: its frame is coming
     } else if (!st.unlimited) {
         std::snprintf(overlay, sizeof overlay, "starting (spp)");  // no frame yet: towards the target
     } else {

@@ -16,21 +16,15 @@ void panel_save(PanelContext& ctx) {
     if (!ImGui::CollapsingHeader("Save", ImGuiTreeNodeFlags_DefaultOpen)) return;
     SavePaths& paths = ctx.ui.save.paths;
     const bool full = ctx.full_frame() != nullptr;
+    // The image as `render -o` writes it, in each format of the table (core/image_formats.h),
+    // the path's extension set to match.
     ImGui::InputText("image", &paths.image);
     ImGui::BeginDisabled(!full);
-    // Each image as `render -o` writes it, the path's extension set to match.
-    if (ImGui::Button("Save PPM")) request_save(ctx, SaveKind::ppm, image_save_path(SaveKind::ppm, paths.image));
-    ImGui::EndDisabled();
-    ImGui::InputText("png", &paths.png);
-    ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save PNG")) request_save(ctx, SaveKind::png, image_save_path(SaveKind::png, paths.png));
-    ImGui::EndDisabled();
-    // The radiance as floats: OpenEXR (with every layer) or PFM (and the depth beside it).
-    ImGui::InputText("hdr", &paths.hdr);
-    ImGui::BeginDisabled(!full);
-    if (ImGui::Button("Save EXR")) request_save(ctx, SaveKind::exr, image_save_path(SaveKind::exr, paths.hdr));
-    ImGui::SameLine();
-    if (ImGui::Button("Save PFM")) request_save(ctx, SaveKind::pfm, image_save_path(SaveKind::pfm, paths.hdr));
+    for (const ImageFormatInfo& format : kImageFormats) {
+        if (&format != &kImageFormats.front()) ImGui::SameLine();
+        if (ImGui::Button((std::string("Save ") + format.name).c_str()))
+            request_save(ctx, format.format, image_save_path(format.format, paths.image));
+    }
     ImGui::EndDisabled();
     ImGui::InputText("scene", &paths.scene);
     // Save As: the file becomes the scene's (watched, in the title, saved); a copy leaves it.
@@ -51,8 +45,8 @@ void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
         // watches the new file.
         std::error_code ec;
         FileWatch& watch = ctx.ui.files.watch;
-        if (kind == SaveKind::scene_copy && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
-        if (kind == SaveKind::scene) {
+        if (kind.what == SaveKind::scene_copy && fs::equivalent(path, watch.file(), ec)) watch.acknowledge();
+        if (kind.what == SaveKind::scene) {
             watch.watch(path);
             ctx.ui.save.read_only = false;
         }
