@@ -93,7 +93,7 @@ def threads():
 before, start = threads(), time.monotonic()
 time.sleep(10)
 after, span = threads(), time.monotonic() - start
-viewer.terminate()
+os.kill(pid, 15)  # the viewer itself (xvfb-run ends with it)
 viewer.wait()
 for tid in sorted(after):
     if tid in before and after[tid][1] > before[tid][1]:

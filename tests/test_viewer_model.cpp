@@ -530,11 +530,17 @@ TEST(RenderThread, ARegionsFramesDenoiseItsPixelsOverThePreviousPicture) {
     const PixelBox box{10, 6, 30, 22};
     region.region = box;
     for (int i = 0; i < 8; ++i) ASSERT_TRUE(driver.pass(rule));
-    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation), box);
-    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation + 1), std::nullopt);  // another job's
-    EXPECT_EQ(denoised_box(box, 48, 40, nullptr, job.generation), std::nullopt);
-    EXPECT_EQ(denoised_box(PixelBox{0, 0, 40, 30}, 48, 40, &first, job.generation), std::nullopt);  // most of it
-    EXPECT_EQ(denoised_box(PixelBox{-5, -5, 8, 9}, 48, 40, &first, job.generation), (PixelBox{0, 0, 8, 9}));
+    const std::vector<uint32_t>& samples = state.sample_count();
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation, samples), box);
+    // Another job's frame, or none, while the other pixels have samples: the whole image.
+    EXPECT_EQ(denoised_box(box, 48, 40, &first, job.generation + 1, samples), std::nullopt);
+    EXPECT_EQ(denoised_box(box, 48, 40, nullptr, job.generation, samples), std::nullopt);
+    // ... but with no sample outside the box (a job started with a region), the box alone.
+    std::vector<uint32_t> only_inside(samples.size(), 0);
+    only_inside[size_t(box.y0) * 48 + size_t(box.x0)] = 3;
+    EXPECT_EQ(denoised_box(box, 48, 40, nullptr, job.generation, only_inside), box);
+    EXPECT_EQ(denoised_box(PixelBox{0, 0, 40, 30}, 48, 40, &first, job.generation, samples), std::nullopt);  // most of it
+    EXPECT_EQ(denoised_box(PixelBox{-5, -5, 8, 9}, 48, 40, &first, job.generation, samples), (PixelBox{0, 0, 8, 9}));
     Snapshot boxed, whole;
     make_full_frame(job, state, &features, workspace, boxed, &first, box);
     make_full_frame(job, state, &features, workspace, whole);

@@ -263,15 +263,22 @@ Image denoised_radiance_in(const RenderJob& job, const RenderEstimates& estimate
 }  // namespace
 
 std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
-                                     const Snapshot* previous, uint64_t generation) {
-    if (!region || !previous || previous->generation != generation || previous->scale != 1 ||
-        previous->denoised.width != width || previous->denoised.height != height)
-        return std::nullopt;
+                                     const Snapshot* previous, uint64_t generation, const std::vector<uint32_t>& samples) {
+    if (!region) return std::nullopt;
     const PixelBox box{std::max(0, region->x0), std::max(0, region->y0), std::min(width, region->x1),
                        std::min(height, region->y1)};
     // An empty box, or one of most of the image: the whole image, as cheap and seamless.
     if (box.x0 >= box.x1 || box.y0 >= box.y1 || 2 * double(box.x1 - box.x0) * (box.y1 - box.y0) > double(width) * height)
         return std::nullopt;
+    if (previous && previous->generation == generation && previous->scale == 1 && previous->denoised.width == width &&
+        previous->denoised.height == height)
+        return box;
+    // No earlier picture: only where no pixel outside the box has a sample yet (a job started
+    // with a region), whose picture is then the raw radiance (black), as a filter would leave it.
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            if ((x < box.x0 || x >= box.x1 || y < box.y0 || y >= box.y1) && samples[size_t(y) * size_t(width) + size_t(x)])
+                return std::nullopt;
     return box;
 }
 
@@ -332,8 +339,12 @@ void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeat
                      DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous,
                      const std::optional<PixelBox>& region) {
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
-    const std::optional<PixelBox> box = denoised_box(region, state.width, state.height, previous, job.generation);
-    if (features && box) frame.denoised = denoised_radiance_in(job, estimates, *features, *box, previous->denoised, workspace);
+    const std::optional<PixelBox> box =
+        features ? denoised_box(region, state.width, state.height, previous, job.generation, estimates.samples) : std::nullopt;
+    const bool previous_picture = box && previous && previous->generation == job.generation;
+    if (box)
+        frame.denoised = denoised_radiance_in(job, estimates, *features, *box,
+                                              previous_picture ? previous->denoised : estimates.radiance, workspace);
     else if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
     frame.radiance = std::move(estimates.radiance);
     record_pixel_statistics(state, std::move(estimates), frame);

@@ -205,17 +205,19 @@ inline constexpr int kPreviewFeatureSamples = 2;
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
                         Snapshot& frame);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
-// `features` (null: not denoised) and the pixel statistics. With a render `region` and the
-// job's `previous` full frame, only the region's pixels are denoised (denoised_box), over the
-// previous frame's picture.
+// `features` (null: not denoised) and the pixel statistics. With a render `region`, only the
+// region's pixels are denoised where denoised_box says so, over the job's `previous` full
+// frame's picture (or the raw one, black, where no other pixel has a sample).
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
                      DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous = nullptr,
                      const std::optional<PixelBox>& region = std::nullopt);
 // The pixels a full frame denoises alone: the render region clipped to the image, where the
-// job's previous full frame (of `generation`) has a denoised picture to keep outside it; none
-// (the whole image) otherwise, or where the region is most of the image.
+// job's previous full frame (of `generation`) has a denoised picture to keep outside it, or
+// where no pixel outside it has a sample yet (`samples`: per pixel; the raw radiance, black,
+// is then the picture there); none (the whole image) otherwise, or where the region is most
+// of the image.
 std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
-                                     const Snapshot* previous, uint64_t generation);
+                                     const Snapshot* previous, uint64_t generation, const std::vector<uint32_t>& samples);
 
 // The sample counts at which the render thread makes a full-resolution frame by its schedule
 // (a stop rule met or a pause makes one at any count): from `first` on (after previews:
