@@ -216,7 +216,7 @@ TEST(Compare, SlotsKeepSnapshotsAndBPicksThem) {
     EXPECT_EQ(s1, 1);
     c.settings.b = s1;
     ASSERT_NE(c.b(), nullptr);
-    EXPECT_EQ(c.b()->name, "slot 2 (32 spp)");
+    EXPECT_EQ(c.b()->name, "slot 2 (32 spp, raw)");
     EXPECT_TRUE(c.b()->hdr());
     // B tone maps a snapshot as the render is shown.
     ToneSettings tone;
@@ -299,6 +299,7 @@ TEST(StatsJson, HoldsWhatTheWindowShows) {
     s.noise = 0.05;
     s.reference = "assignment_03.ppm";
     s.figures = CompareFigures{25.5, 0.05};
+    s.image = "denoised";
     PixelProbe p;
     p.x = 3;
     p.samples = 8;
@@ -310,6 +311,7 @@ TEST(StatsJson, HoldsWhatTheWindowShows) {
     EXPECT_EQ(j["noise"], 0.05);
     EXPECT_EQ(j["psnr"], 25.5);
     EXPECT_EQ(j["rmse"], 0.05);
+    EXPECT_EQ(j["image"], "denoised");  // image A, of which psnr and rmse are figures
     EXPECT_EQ(j["probe"]["x"], 3);
     EXPECT_TRUE(j["probe"]["standard_error"].is_null());
     s.noise = -1;
