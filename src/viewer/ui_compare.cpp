@@ -47,7 +47,7 @@ std::optional<PixelProbe> probe(const PanelContext& ctx, int x, int y) {
     const ViewerModel& model = ctx.model;
     if (!shown || !model.has_scene()) return std::nullopt;
     return probe_pixel(*shown, model.scene().renderer.width, model.scene().renderer.height, x, y,
-                       model.settings().tone, ctx.ui.compare.linear_scale);
+                       model.settings().tone, ctx.ui.compare.linear_scale, model.settings().denoise);
 }
 
 StatsFigures stats_figures(const PanelContext& ctx) {
@@ -84,14 +84,15 @@ void update_pictures(PanelContext& ctx, Display& display) {
                   static_cast<const void*>(b));
     if (tool.picture_key == key) return;
     tool.picture_key = key;
-    tool.linear_scale = tonemap_scale(shown->radiance, tone.tonemap, tone.exposure_scale());
+    // Image A at the frame's resolution (a preview's blocks unscaled).
+    const Image shown_image = shown_radiance(*shown, view);
+    tool.linear_scale = tonemap_scale(shown_image, tone.tonemap, tone.exposure_scale());
     const bool full = shown->scale == 1;
 
     // Image A is the render as the window shows it (denoised when the display is): its figures
     // against B, the error view and the reference's figures for the log.
     Rgb8Image a;
-    if (full && (b || tool.comparison.reference()))
-        a = displayed_picture(*shown, view, model.scene().renderer.width, model.scene().renderer.height, tone);
+    if (full && (b || tool.comparison.reference())) a = tonemap(shown_image, tone.tonemap, tone.exposure_scale());
     Rgb8Image b_bytes = b ? b->display(tone) : Rgb8Image{};
     tool.figures.reset();
     tool.figures_note.clear();
