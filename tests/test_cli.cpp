@@ -44,6 +44,18 @@ protected:
 })";
         return file;
     }
+    // write_scene's scene with a display block `block` (a JSON object's text).
+    fs::path write_scene_with_display(const std::string& name, const std::string& block) {
+        std::string text = read_file(write_scene(name));
+        text.insert(text.find("\"renderer\""), "\"display\": " + block + ", ");
+        return write(name, text);
+    }
+    // The bytes `render SCENE --spp 2 FLAGS -o dir/OUT` writes (a failure is reported here).
+    std::string render_bytes(const fs::path& scene, const std::string& flags, const std::string& out) {
+        const CliRun r = cli("render '" + scene.string() + "' --spp 2 " + flags + " -q -o '" + (dir / out).string() + "'");
+        EXPECT_EQ(r.status, 0) << r.err;
+        return read_file(dir / out);
+    }
 };
 
 }  // namespace
@@ -131,15 +143,9 @@ TEST_F(Cli, SameSeedSameImageAndFlagsOverride) {
 // a scene saved from the viewer renders headless to the image the window showed.
 TEST_F(Cli, DisplayBlockAppliesAndFlagsOverrideIt) {
     const fs::path plain = write_scene("plain.json");
-    std::string text = read_file(plain);
-    const size_t at = text.find("\"renderer\"");
-    ASSERT_NE(at, std::string::npos);
-    text.insert(at, R"("display": {"exposure": 1.5}, )");
-    const fs::path brighter = write("brighter.json", text);
+    const fs::path brighter = write_scene_with_display("brighter.json", R"({"exposure": 1.5})");
     const auto render = [&](const fs::path& scene, const std::string& flags, const std::string& out) {
-        const CliRun r = cli("render '" + scene.string() + "' --spp 2 " + flags + " -q -o '" + (dir / out).string() + "'");
-        EXPECT_EQ(r.status, 0) << r.err;
-        return read_file(dir / out);
+        return render_bytes(scene, flags, out);
     };
     const std::string base = render(plain, "", "base.ppm");
     const std::string from_file = render(brighter, "", "file.ppm");
@@ -156,6 +162,33 @@ TEST_F(Cli, DisplayBlockAppliesAndFlagsOverrideIt) {
     int worst = 0;
     for (size_t i = 0; i < got.bytes.size(); ++i) worst = std::max(worst, std::abs(int(got.bytes[i]) - int(expected.bytes[i])));
     EXPECT_LE(worst, 1);  // float radiance in the EXR: at most one step where rounding lands on a boundary
+}
+
+// The display block's denoise mode is read by `render` as its tone map is, and --denoise
+// overrides it; a file without it renders raw, as before the field existed.
+TEST_F(Cli, DisplayBlockDenoiseModeAppliesAndTheFlagOverridesIt) {
+    const fs::path plain = write_scene("plain.json");
+    const fs::path on = write_scene_with_display("on.json", R"({"denoise": "on"})");
+    const fs::path off = write_scene_with_display("off.json", R"({"denoise": "off"})");
+    // Path tracing: a noisy estimate, which the denoiser changes.
+    const auto render = [&](const fs::path& scene, const std::string& flags, const std::string& out) {
+        return render_bytes(scene, "--integrator pt " + flags, out);
+    };
+    const std::string raw = render(plain, "", "raw.ppm");
+    const std::string denoised = render(plain, "--denoise on", "denoised.ppm");
+    EXPECT_NE(raw, denoised);
+    EXPECT_EQ(render(plain, "--denoise off", "raw2.ppm"), raw);
+    EXPECT_EQ(render(on, "", "on.ppm"), denoised);
+    EXPECT_EQ(render(off, "", "off.ppm"), raw);
+    EXPECT_EQ(render(on, "--denoise off", "on_flag_off.ppm"), raw);
+    EXPECT_EQ(render(off, "--denoise on", "off_flag_on.ppm"), denoised);
+    // A bad mode is one line naming the file and the JSON path.
+    const fs::path bad_scene = write_scene_with_display("bad.json", R"({"denoise": "yes"})");
+    const CliRun bad = cli("render '" + bad_scene.string() + "' --spp 1 -q -o '" + (dir / "bad.ppm").string() + "'");
+    EXPECT_EQ(bad.status, 1);
+    EXPECT_NE(bad.err.find("bad.json"), std::string::npos) << bad.err;
+    EXPECT_NE(bad.err.find("/scene/display/denoise"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.ppm"));
 }
 
 TEST_F(Cli, BadSceneGivesOneMessageAndNoOutput) {

@@ -8,7 +8,11 @@
 #include <fstream>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
+#include "scene/display_fields.h"
 #include "scene/load.h"
+#include "scene/save.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -343,6 +347,35 @@ TEST_F(LoadErrors, DisplayBlockIsOptionalAndStrict) {
     expect_error(with_display(R"({"exposure": "bright"})"), "/scene/display/exposure", "expected a number");
     expect_error(with_display(R"({"gamma": 2.2})"), "/scene/display/gamma", "unknown key \"gamma\"");
     expect_error(with_display("3"), "/scene/display", "display settings");
+    // The denoise mode: absent unless given ("on" or "off"), then as strict as the tone map.
+    EXPECT_FALSE(plain.scene.display.denoise.has_value());
+    EXPECT_EQ(load_ok(with_display(R"({"denoise": "on"})")).scene.display.denoise, Denoise::on);
+    EXPECT_EQ(load_ok(with_display(R"({"denoise": "off"})")).scene.display.denoise, Denoise::off);
+    expect_error(with_display(R"({"denoise": "nlmeans"})"), "/scene/display/denoise",
+                 "unknown denoise mode \"nlmeans\"; expected \"off\" or \"on\"");
+    expect_error(with_display(R"({"denoise": true})"), "/scene/display/denoise",
+                 "expected a denoise mode (a string), got");
+}
+
+// The saver writes the display block from the loader's table: each field round-trips, and a
+// denoise mode never set is left out (the file then renders as one without it).
+TEST_F(LoadErrors, DisplayBlockRoundTripsThroughTheSaver) {
+    Scene scene = load_ok(kBaseScene).scene;
+    const std::string unset = scene_to_json(scene);
+    EXPECT_EQ(unset.find("\"denoise\""), std::string::npos) << unset;
+    EXPECT_FALSE(load_ok(unset).scene.display.denoise.has_value());
+    for (const Denoise mode : {Denoise::on, Denoise::off}) {
+        scene.display = {ToneMap::srgb, -2.25, mode};
+        const DisplaySettings back = load_ok(scene_to_json(scene)).scene.display;
+        EXPECT_EQ(back.tonemap, ToneMap::srgb);
+        EXPECT_EQ(back.exposure, -2.25);
+        EXPECT_EQ(back.denoise, mode);
+    }
+    // Every field of the table is written, and only those.
+    const nlohmann::ordered_json saved = nlohmann::ordered_json::parse(scene_to_json(scene));
+    const auto& block = saved["scene"]["display"];
+    ASSERT_EQ(block.size(), display_fields().size());
+    for (const DisplayField& field : display_fields()) EXPECT_TRUE(block.contains(std::string(field.key))) << field.key;
 }
 
 TEST_F(LoadErrors, DanglingMaterialId) {

@@ -88,6 +88,36 @@ TEST(PixelInspector, NumbersAreTheRenderStates) {
     EXPECT_FALSE(probe_pixel(r.frame, 24, 24, 0, -1, ToneSettings{}, 1));
 }
 
+// The probe's displayed value is image A's pixel: the image the window shows under the
+// denoiser's view (raw, denoised, or split at the middle column), as the display draws it;
+// its mean stays the raw estimate's.
+TEST(PixelInspector, DisplayedValueIsOfTheImageShown) {
+    Snapshot frame;
+    frame.radiance = Image(4, 2);
+    frame.denoised = Image(4, 2);
+    for (int y = 0; y < 2; ++y)
+        for (int x = 0; x < 4; ++x) {
+            frame.radiance.at(x, y) = Color(0.1 * (x + 1), 0.2, 0.05 * (y + 1));
+            frame.denoised.at(x, y) = Color(0.9, 0.1 * (x + 1), 0.3);
+        }
+    const ToneSettings tone;
+    for (const DenoiseView view : {DenoiseView::off, DenoiseView::on, DenoiseView::split}) {
+        const Rgb8Image shown = displayed_picture(frame, view, 4, 2, tone);
+        for (int y = 0; y < 2; ++y)
+            for (int x = 0; x < 4; ++x) {
+                const auto p = probe_pixel(frame, 4, 2, x, y, tone, 1, view);
+                ASSERT_TRUE(p);
+                EXPECT_EQ(p->mean, frame.radiance.at(x, y));
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_EQ(p->displayed[size_t(k)], shown.bytes[(size_t(y) * 4 + size_t(x)) * 3 + size_t(k)])
+                        << int(view) << " " << x << "," << y;
+            }
+    }
+    // The denoised and raw values differ, so the views above tell them apart.
+    EXPECT_NE(probe_pixel(frame, 4, 2, 0, 0, tone, 1, DenoiseView::on)->displayed,
+              probe_pixel(frame, 4, 2, 0, 0, tone, 1, DenoiseView::off)->displayed);
+}
+
 TEST(PixelInspector, PreviewHasNoStatisticsAndCoversBlocks) {
     Snapshot preview;
     preview.scale = 4;
@@ -216,7 +246,7 @@ TEST(Compare, SlotsKeepSnapshotsAndBPicksThem) {
     EXPECT_EQ(s1, 1);
     c.settings.b = s1;
     ASSERT_NE(c.b(), nullptr);
-    EXPECT_EQ(c.b()->name, "slot 2 (32 spp)");
+    EXPECT_EQ(c.b()->name, "slot 2 (32 spp, raw)");
     EXPECT_TRUE(c.b()->hdr());
     // B tone maps a snapshot as the render is shown.
     ToneSettings tone;
@@ -299,6 +329,7 @@ TEST(StatsJson, HoldsWhatTheWindowShows) {
     s.noise = 0.05;
     s.reference = "assignment_03.ppm";
     s.figures = CompareFigures{25.5, 0.05};
+    s.image = "denoised";
     PixelProbe p;
     p.x = 3;
     p.samples = 8;
@@ -310,6 +341,7 @@ TEST(StatsJson, HoldsWhatTheWindowShows) {
     EXPECT_EQ(j["noise"], 0.05);
     EXPECT_EQ(j["psnr"], 25.5);
     EXPECT_EQ(j["rmse"], 0.05);
+    EXPECT_EQ(j["image"], "denoised");  // image A, of which psnr and rmse are figures
     EXPECT_EQ(j["probe"]["x"], 3);
     EXPECT_TRUE(j["probe"]["standard_error"].is_null());
     s.noise = -1;

@@ -161,6 +161,42 @@ TEST(ResetRule, SavedSceneCarriesRendererSettings) {
     EXPECT_EQ(saved.renderer.samples, 7);
 }
 
+// The display block's denoise mode is the view's: the file's when it has one (the command
+// line's over it), the view as it was when it has none; the saved scene records what the
+// window shows (the split view saves denoised, as Save does).
+TEST(ResetRule, DenoiseModeComesFromTheFileAndIsSaved) {
+    ViewerModel m = test::brief_model(3);  // the brief's scene has no denoise field
+    EXPECT_EQ(m.settings().denoise, DenoiseView::on);
+    EXPECT_EQ(m.scene_for_saving().display.denoise, Denoise::on);
+    ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) { s.denoise = DenoiseView::split; }));
+    EXPECT_EQ(m.scene_for_saving().display.denoise, Denoise::on);
+    ASSERT_TRUE(m.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) { s.denoise = DenoiseView::off; }));
+    EXPECT_TRUE(m.dirty());
+    Scene saved = m.scene_for_saving();
+    EXPECT_EQ(saved.display.denoise, Denoise::off);
+
+    ViewerModel back;  // starts denoised, as the window does
+    back.set_scene(saved);
+    EXPECT_EQ(back.settings().denoise, DenoiseView::off);
+    EXPECT_FALSE(back.settings().tone.denoise.has_value());  // one place holds the mode: the view
+    saved.display.denoise = Denoise::on;
+    back.set_scene(saved);
+    EXPECT_EQ(back.settings().denoise, DenoiseView::on);
+    // Without the field the view stays as it is.
+    ASSERT_TRUE(back.edit(Edit::tone_map, [](Scene&, ViewerSettings& s) { s.denoise = DenoiseView::split; }));
+    saved.display.denoise.reset();
+    back.set_scene(saved);
+    EXPECT_EQ(back.settings().denoise, DenoiseView::split);
+    // The command line's --denoise over the file's.
+    ViewerModel flagged;
+    RenderOptions flags;
+    flags.denoise = Denoise::off;
+    flagged.set_overrides(flags);
+    saved.display.denoise = Denoise::on;
+    flagged.set_scene(saved);
+    EXPECT_EQ(flagged.settings().denoise, DenoiseView::off);
+}
+
 TEST(Navigation, OrbitKeepsDistanceAndTarget) {
     Camera c;
     c.position = {0, 0, -15};

@@ -162,6 +162,46 @@ TEST_F(ViewerWindow, SaveImageWritesWhatRenderWritesForTheSameName) {
                  exr.variance.empty());
 }
 
+// Image A is the image the window shows, denoised by default. With no --denoise flag:
+// `view --save-image` writes what `render --denoise on` writes, byte for byte; the saved
+// scene records the mode in its display block, so a plain `render` of it writes those bytes
+// too; and the stats JSON's PSNR is that of the window's own screenshot against B.
+TEST_F(ViewerWindow, DenoisedDisplayIsWhatSaveTheSavedSceneAndThePsnrUse) {
+    const fs::path ref = dir / "ref.ppm", saved = dir / "saved.ppm", saved_scene = dir / "saved.json",
+                   shot = dir / "shot.ppm", stats = dir / "stats.json";
+    const std::string flags = " --spp 2 --seed 5";
+    ASSERT_EQ(keithray("render '" + scene(6) + "' --spp 16 -q -o '" + ref.string() + "'", false).status, 0);
+    // Not through keithray(), which asks for the raw display.
+    const ViewRun v = kr::test::run_command(
+        xvfb_run() + "'" + KEITHRAY_EXE + "' view '" + scene(6) + "'" + flags + " --frames 2 --reference '" +
+            ref.string() + "' --save-image '" + saved.string() + "' --save-scene '" + saved_scene.string() +
+            "' --screenshot '" + shot.string() + "' --stats-json '" + stats.string() + "' --timeout 300",
+        dir);
+    ASSERT_EQ(v.status, 0) << v.out << v.err;
+    const auto render = [&](const std::string& what, const std::string& render_flags, const std::string& out) {
+        const ViewRun r = keithray("render '" + what + "'" + render_flags + " -q -o '" + (dir / out).string() + "'", false);
+        EXPECT_EQ(r.status, 0) << r.err;
+        return kr::test::read_file(dir / out);
+    };
+    const std::string bytes = kr::test::read_file(saved);
+    EXPECT_TRUE(bytes == render(scene(6), flags + " --denoise on", "denoised.ppm"));
+    EXPECT_FALSE(bytes == render(scene(6), flags, "raw.ppm"));
+    // The saved scene says "denoise": "on", and render reads it as it reads the tone map.
+    EXPECT_EQ(nlohmann::json::parse(kr::test::read_file(saved_scene))["scene"]["display"]["denoise"], "on");
+    EXPECT_TRUE(bytes == render(saved_scene.string(), " --seed 5", "from_scene.ppm"));
+
+    // The live PSNR is of the image on screen (the interactive filter's denoised picture), and
+    // the JSON says which image that is.
+    const nlohmann::json j = nlohmann::json::parse(kr::test::read_file(stats));
+    ASSERT_TRUE(j.contains("psnr")) << j.dump();
+    EXPECT_EQ(j["image"], "denoised");
+    const double shown = kr::psnr(kr::read_ppm(shot), kr::read_ppm(ref));
+    const double raw = kr::psnr(kr::read_ppm(dir / "raw.ppm"), kr::read_ppm(ref));
+    ASSERT_GT(std::abs(shown - raw), 1.0) << "the denoised and raw images must differ for this test to mean anything";
+    // The screenshot is the display shader's picture: within one step of kr::tonemap per channel.
+    EXPECT_NEAR(j["psnr"].get<double>(), shown, 0.25) << "raw: " << raw;
+}
+
 // Tone map options go to the display shader only; the screenshot follows kr::tonemap.
 TEST_F(ViewerWindow, LinearToneMapScreenshotMatchesHeadless) {
     const fs::path shot = dir / "shot.ppm", headless = dir / "headless.ppm";
@@ -366,6 +406,40 @@ TEST_F(ViewerWindow, ClickWithOnePixelJitterLeavesTheImage) {
     r = drive(dir, "drag", 3);
     ASSERT_EQ(r.count("error"), 0u) << r["error"];
     EXPECT_NE(r["generation_after"], r["generation_before"]);
+}
+
+// K keeps what is on screen: with the default denoised display, image B is the denoised
+// image (A against B: identical, where the raw estimate differs by the noise the denoiser
+// removed), and the split view shows it right of the divider as the render view showed it.
+TEST_F(ViewerWindow, KeepTakesTheDenoisedImageOnScreen) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "keep_shown", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["psnr"], "99.0000");  // kr::psnr's figure for identical images
+    // The image's corner in the window and its scale: "X,Y,fitS" or "X,Y,S".
+    std::smatch m;
+    const std::string image = r["image"];
+    ASSERT_TRUE(std::regex_match(image, m, std::regex("([0-9.]+),([0-9.]+),(fit)?([0-9.e+-]+)"))) << image;
+    const double x0 = std::stod(m[1]), y0 = std::stod(m[2]), scale = std::stod(m[4]);
+    const kr::Rgb8Image before = kr::read_ppm(dir / "render_view.ppm"), split = kr::read_ppm(dir / "split_view.ppm");
+    ASSERT_EQ(before.width, split.width);
+    ASSERT_EQ(before.height, split.height);
+    // B's side of the divider, clear of the divider, the label and the window's edges.
+    const kr::Scene full = kr::load_scene_file(kr::test::brief_scene_file(3)).scene;
+    const int xa = int(x0 + 0.6 * full.renderer.width * scale), xb = int(x0 + 0.9 * full.renderer.width * scale);
+    const int ya = int(y0 + 0.3 * full.renderer.height * scale), yb = int(y0 + 0.8 * full.renderer.height * scale);
+    ASSERT_TRUE(xa >= 0 && ya >= 0 && xb <= before.width && yb <= before.height && xb > xa + 10 && yb > ya + 10)
+        << image << " in " << before.width << "x" << before.height;
+    double sum = 0;
+    int n = 0;
+    for (int y = ya; y < yb; ++y)
+        for (int x = xa; x < xb; ++x)
+            for (int k = 0; k < 3; ++k, ++n) {
+                const size_t i = (size_t(y) * before.width + x) * 3 + k;
+                sum += std::abs(int(before.bytes[i]) - int(split.bytes[i]));
+            }
+    // The shader's tone map and kr::tonemap's bytes differ by at most one step.
+    EXPECT_LT(sum / n, 0.5) << "mean difference of B's half from the render view";
 }
 
 // An orbit drag with the button held: after each move of the pointer the window shows a

@@ -175,6 +175,23 @@ zoom_probe)
     xdotool key k
     wait_for 'b=slot1' || exit 1
     ;;
+keep_shown)
+    # K keeps image A as the window shows it (denoised by default): B is then the image on
+    # screen (A against B: identical), and the split view's B half is what the render view
+    # showed. Each window shot follows a frame that saw the pointer move: the view was drawn.
+    wait_for 'view=render' || exit 1
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/render_view.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool key k
+    wait_for 'b=slot1' || exit 1
+    wait_for 'psnr=[0-9]' || exit 1
+    echo "psnr=$(field psnr)"
+    xdotool key v v
+    wait_for 'view=split' || exit 1
+    xdotool mousemove --window "$wid" 251 330
+    wait_for 'pointer=251,330' || exit 1
+    echo "image=$(field image)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/split_view.ppm" || { echo "error=no window shot"; exit 1; }
+    ;;
 first_orbit)
     # The first orbit a user makes: a 120-pixel left drag to the right, in steps as a hand
     # moves; then the render finishes and the camera is in no sphere.

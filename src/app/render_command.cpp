@@ -340,7 +340,8 @@ private:
         return true;
     }
 
-    Denoise denoise() const { return opt_.render.denoise.value_or(Denoise::off); }
+    // --denoise, else the scene's display block, else raw (apply_render_options put the flag over the block).
+    Denoise denoise() const { return loaded_.scene.display.denoise.value_or(Denoise::off); }
 
     void set_stop_rule() {
         rule_ = render_stop_rule(opt_.render, settings_);

@@ -9,15 +9,11 @@
 #include <span>
 #include <vector>
 
+#include "core/denoise_mode.h"
 #include "core/enum_names.h"
 #include "core/image.h"
 
 namespace kr {
-
-// off: the raw estimate; on: denoised (render and the viewer's Save: the final filter,
-// denoise_nlmeans; the viewer's live display: the interactive one, denoise_atrous).
-enum class Denoise { off, on };
-inline constexpr EnumNames<Denoise, 2> denoise_names{{"off", "on"}};
 
 // What a denoiser reads, all width x height, row-major.
 struct DenoiseInput {

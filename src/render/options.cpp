@@ -84,8 +84,8 @@ const std::array kFlags{
         "--denoise", "%r: denoise the image, guided by albedo, normal and depth: render and the viewer's Save run "
                      "non-local means over the two halves of the samples, the viewer's display the faster a-trous "
                      "filter (biased: compare --statistical tests raw images; an .exr keeps the raw radiance as "
-                     "raw.R/G/B; docs/denoising.md); given alone (last, or before a flag or a .json): on (default: off "
-                     "for render, on for view's display)",
+                     "raw.R/G/B; docs/denoising.md); given alone (last, or before a flag or a .json): on (default: the "
+                     "scene's \"display\" block, else off for render, on for view's display)",
         "on"),
 };
 
@@ -163,6 +163,7 @@ RenderSettings apply_render_options(const RenderOptions& options, Scene& scene) 
     if (options.light_sampling) settings.light_sampling = *options.light_sampling;
     if (options.tonemap) scene.display.tonemap = *options.tonemap;
     if (options.exposure) scene.display.exposure = *options.exposure;
+    if (options.denoise) scene.display.denoise = *options.denoise;
     return settings;
 }
 

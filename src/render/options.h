@@ -67,8 +67,8 @@ bool read_shared_flag(ArgCursor& args, RenderOptions& options);
 std::string shared_flags_help();
 
 // One apply for both commands: the settings a render of `scene` starts from (its renderer
-// block) with the flags over them; the flags' tone map and exposure go into the scene's
-// display block.
+// block) with the flags over them; the flags' tone map, exposure and denoise mode go into
+// the scene's display block.
 RenderSettings apply_render_options(const RenderOptions& options, Scene& scene);
 
 // `keithray render`'s stop rule: --time and --noise, with --spp (or the file's samples) as the

@@ -22,6 +22,7 @@
 #include "core/limits.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "scene/display_fields.h"
 #include "scene/json_reader.h"
 
 namespace kr {
@@ -516,25 +517,22 @@ void Loader::read_scene(const Json& j, const std::string& pointer) {
           [&](const Json& v, const std::string& p) { read_display(v, p); }, false}});
 }
 
-// Optional: how the image is tone mapped, as `render` writes it and the viewer shows it.
+// Optional: how the image is tone mapped and whether it is denoised, as `render` writes it
+// and the viewer shows it. The fields are those of the table the saver writes from.
 void Loader::read_display(const Json& j, const std::string& pointer) {
     DisplaySettings& d = out_.scene.display;
     const Owner owner{Category::scene, 0};
     require_object(j, pointer, "display settings");
-    const std::string stops = "a number of stops in [-" + std::to_string(int(kMaxExposureStops)) + ", " +
-                              std::to_string(int(kMaxExposureStops)) + "]";
-    read_fields(
-        j, pointer,
-        {{"tonemap", tonemap_names.list(),
-          [&](const Json& v, const std::string& p) { d.tonemap = read_enum(v, p, tonemap_names, "tone map"); },
-          false},
-         {"exposure", stops,
-          [&](const Json& v, const std::string& p) {
-              const double ev = number(v, p);
-              if (std::abs(ev) > kMaxExposureStops) range_problem(owner, p, "expected " + stops + ", got " + number_text(v));
-              d.exposure = std::clamp(ev, -kMaxExposureStops, kMaxExposureStops);
-          },
-          false}});
+    std::vector<Field> fields;
+    for (const DisplayField& field : display_fields())
+        fields.push_back({std::string(field.key), field.expected,
+                          [&](const Json& v, const std::string& p) {
+                              DisplayFieldRead r = field.read(v, d);
+                              if (r.problem == DisplayFieldRead::Problem::wrong) fail(p, r.message);
+                              if (r.problem == DisplayFieldRead::Problem::range) range_problem(owner, p, std::move(r.message));
+                          },
+                          false});
+    read_fields(j, pointer, fields);
 }
 
 // Which objects the scene block uses: the active camera, the active lights, the

@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/file_write.h"
+#include "scene/display_fields.h"
 #include "scene/json_reader.h"
 
 namespace kr {
@@ -110,8 +111,8 @@ std::string scene_to_json(const Scene& scene) {
     renderer["output"] = r.output;
     block["renderer"] = renderer;
     Json display;
-    display["tonemap"] = tonemap_names.name(scene.display.tonemap);
-    display["exposure"] = scene.display.exposure;
+    for (const DisplayField& field : display_fields())
+        if (std::optional<Json> value = field.write(scene.display)) display[std::string(field.key)] = std::move(*value);
     block["display"] = display;
     root["scene"] = std::move(block);
     // nlohmann prints doubles in their shortest round-trip form, so values load back equal.

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/denoise_mode.h"
 #include "core/enum_names.h"
 #include "core/image.h"   // ToneMap
 #include "core/limits.h"  // kMaxDepth, kMaxDimension, kMaxSamples
@@ -118,6 +119,9 @@ inline constexpr double kMaxExposureStops = 10;
 struct DisplaySettings {
     ToneMap tonemap = kDefaultToneMap;
     double exposure = 0;  // EV, in [-kMaxExposureStops, kMaxExposureStops]
+    // Whether the image is developed denoised; absent: as each command does by default
+    // (render: the raw estimate; the viewer: denoised).
+    std::optional<Denoise> denoise;
     double exposure_scale() const { return std::exp2(exposure); }
 };
 

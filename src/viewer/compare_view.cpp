@@ -55,14 +55,14 @@ std::vector<float> pixel_errors(const Rgb8Image& a, const Rgb8Image& b, ErrorMet
     return error;
 }
 
-int Comparison::keep(const Image& radiance, int spp) {
+int Comparison::keep(const Image& radiance, int spp, std::string_view shown) {
     int slot = -1;
     for (int i = 0; i < kSnapshotSlots && slot < 0; ++i)
         if (!slots_[size_t(i)]) slot = i;
     if (slot < 0) slot = next_slot_;  // all full: the oldest goes
     next_slot_ = (slot + 1) % kSnapshotSlots;
     CompareImage image;
-    image.name = "slot " + std::to_string(slot + 1) + " (" + std::to_string(spp) + " spp)";
+    image.name = "slot " + std::to_string(slot + 1) + " (" + std::to_string(spp) + " spp, " + std::string(shown) + ")";
     image.radiance = radiance;
     slots_[size_t(slot)] = std::move(image);
     return slot;

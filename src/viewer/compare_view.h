@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/enum_names.h"
@@ -32,7 +33,7 @@ inline constexpr EnumNames<ErrorMetric, 2> error_metric_names{{"absolute", "rela
 
 // Image B: a reference read from a file or a snapshot of the render kept in a slot.
 struct CompareImage {
-    std::string name;  // the file name, or "slot 2 (64 spp)"
+    std::string name;  // the file name, or "slot 2 (64 spp, denoised)"
     Image radiance;    // an HDR file or a snapshot: tone mapped as the render is
     Rgb8Image bytes;   // an 8-bit file (PPM, PNG): shown as stored
     bool hdr() const { return !radiance.pixels.empty(); }
@@ -77,8 +78,9 @@ public:
     void set_reference(CompareImage image) { reference_ = std::move(image); }
     void clear_reference() { reference_.reset(); }
     const std::optional<CompareImage>& reference() const { return reference_; }
-    // Keeps `radiance` in a free slot (the oldest is replaced when all are full); its index.
-    int keep(const Image& radiance, int spp);
+    // Keeps `radiance` (image A as shown, `shown` naming it: "raw", "denoised", "split") in a
+    // free slot (the oldest is replaced when all are full); its index.
+    int keep(const Image& radiance, int spp, std::string_view shown = "raw");
     void drop(int slot);
     const std::vector<std::optional<CompareImage>>& slots() const { return slots_; }
     // Image B as settings.b picks it (null when that is empty).

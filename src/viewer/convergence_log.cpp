@@ -52,6 +52,8 @@ std::string stats_json(const StatsFigures& s) {
     j["elapsed_seconds"] = s.elapsed;
     j["mrays_per_second"] = s.mrays_per_second;
     j["noise"] = s.noise >= 0 && std::isfinite(s.noise) ? nlohmann::ordered_json(s.noise) : nlohmann::ordered_json();
+    // Image A, of which psnr and rmse are figures: the image the window shows.
+    if (!s.image.empty()) j["image"] = s.image;
     if (s.reference) j["reference"] = utf8_escaped(*s.reference);  // a file name need not be UTF-8
     if (s.figures) {
         j["psnr"] = s.figures->psnr;

@@ -43,6 +43,7 @@ struct StatsFigures {
     double elapsed = 0, mrays_per_second = 0;
     double noise = -1;  // estimated relative error, -1 before 2 spp
     std::string state;
+    std::string image;                      // image A, as shown: "raw", "denoised" or "split" (status.h shown_word)
     std::optional<std::string> reference;  // image B's name when one is loaded
     std::optional<CompareFigures> figures;
     std::optional<PixelProbe> probe;

@@ -26,7 +26,7 @@ void record_pixel_statistics(const RenderState& totals, RenderEstimates estimate
 }
 
 std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int height, int x, int y,
-                                      const ToneSettings& tone, double linear_scale) {
+                                      const ToneSettings& tone, double linear_scale, DenoiseView view) {
     if (x < 0 || y < 0 || x >= width || y >= height || frame.radiance.width <= 0) return std::nullopt;
     PixelProbe p;
     p.x = x;
@@ -36,7 +36,11 @@ std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int heig
     const int py = std::min(y / frame.scale, frame.radiance.height - 1);
     p.mean = frame.radiance.at(px, py);
     const double scale = tone.tonemap == ToneMap::linear ? linear_scale : tone.exposure_scale();
-    p.displayed = tonemap_color(p.mean, tone.tonemap, scale);
+    // The pixel of image A, as shown_radiance composes it: denoised in the "on" view, and in
+    // the split view right of the middle column.
+    const bool denoised = view != DenoiseView::off && frame.denoised.pixels.size() == frame.radiance.pixels.size() &&
+                          (view == DenoiseView::on || px >= frame.radiance.width / 2);
+    p.displayed = tonemap_color(denoised ? frame.denoised.at(px, py) : p.mean, tone.tonemap, scale);
     const size_t i = size_t(py) * size_t(frame.radiance.width) + size_t(px);
     p.preview = frame.scale != 1 || i >= frame.sample_count.size();
     if (!p.preview) {

@@ -14,6 +14,7 @@
 #include "render/progressive.h"
 #include "viewer/compare_view.h"
 #include "viewer/edit.h"
+#include "viewer/model.h"  // DenoiseView
 #include "viewer/render_worker.h"
 
 namespace kr::viewer {
@@ -30,16 +31,20 @@ void record_pixel_statistics(const RenderState& totals, RenderEstimates estimate
 struct PixelProbe {
     int x = 0, y = 0;                  // image pixel, origin top-left
     Color mean;                        // mean radiance
-    std::array<uint8_t, 3> displayed{};  // the 8-bit value the display shows (tone map, exposure)
+    std::array<uint8_t, 3> displayed{};  // the 8-bit value the display shows: image A's pixel
+                                         // (denoised where the view shows it), tone mapped
     uint32_t samples = 0;              // samples accumulated (0 in a preview)
     double standard_error = 0;         // of the mean luminance; infinite below two samples
     bool preview = false;              // the frame is a low-resolution preview: no statistics
 };
 
 // The pixel (x, y) of `frame` (full-resolution coordinates; a preview's pixel covering it),
-// or nothing outside the image. `linear_scale` is tonemap_scale() of the frame's radiance.
+// or nothing outside the image. Its mean is the raw estimate's; its displayed value is that
+// of the image shown under `view` (status.h shown_radiance). `linear_scale` is
+// tonemap_scale() of that image.
 std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int height, int x, int y,
-                                      const ToneSettings& tone, double linear_scale);
+                                      const ToneSettings& tone, double linear_scale,
+                                      DenoiseView view = DenoiseView::off);
 
 // The noise view: per pixel the standard error of the mean luminance, in false colour from 0
 // to `scale` (pixels below two samples saturate); and the samples per pixel, from 0 to

@@ -99,6 +99,10 @@ void ViewerModel::set_scene(Scene scene, std::vector<std::string> warnings) {
     // The file's renderer and display blocks with the command line over them, as render does.
     settings.render = apply_render_options(overrides_, scene);
     settings.tone = scene.display;
+    // The denoise mode is the view's (ViewerSettings::denoise, the one place the window reads):
+    // the file's or the command line's when given, else the view as it was (denoised at start).
+    if (settings.tone.denoise) settings.denoise = *settings.tone.denoise == Denoise::on ? DenoiseView::on : DenoiseView::off;
+    settings.tone.denoise.reset();
     file_cameras_ = scene.cameras;
     file_resolution_ = {scene.renderer.width, scene.renderer.height};
     file_camera_ = scene.camera;
@@ -255,6 +259,8 @@ Scene ViewerModel::scene_for_saving() const {
     scene.renderer.depth = r.max_depth;
     scene.renderer.samples = r.target_spp;
     scene.display = settings_.tone;
+    // What the window shows, as `render` reads it back: the split view saves denoised, as Save does.
+    scene.display.denoise = settings_.denoise != DenoiseView::off ? Denoise::on : Denoise::off;
     return scene;
 }
 

@@ -303,6 +303,9 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (tool.locked_probe) std::snprintf(probe, sizeof probe, "%d,%d", tool.locked_probe->first, tool.locked_probe->second);
     if (tool.comparison.b())
         std::snprintf(b, sizeof b, tool.comparison.settings.b < 0 ? "reference" : "slot%d", tool.comparison.settings.b + 1);
+    // psnr: image A (as shown) against B, as the compare panel shows it ("none" without figures).
+    char psnr[32] = "none";
+    if (tool.figures) std::snprintf(psnr, sizeof psnr, "%.4f", tool.figures->psnr);
     // inside: the sphere the camera is in ("none"); fly: the navigation mode.
     std::string inside = ui_.inside_sphere ? *ui_.inside_sphere : "none";
     std::replace(inside.begin(), inside.end(), ' ', '_');
@@ -328,14 +331,14 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     char line[900];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s psnr=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
                   "feature=%s draft=%s question=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), shown, int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
-                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, int(ui_.nav.fly),
+                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, psnr, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
                   feature.c_str(), draft, open_question());
     if (line == status_line_ || status_file_failed_) return;

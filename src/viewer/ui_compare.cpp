@@ -11,6 +11,7 @@
 #include "core/image_compare.h"
 #include "core/text.h"
 #include "viewer/scene_edit.h"
+#include "viewer/status.h"
 #include "viewer/ui_compare.h"
 
 namespace kr::viewer {
@@ -31,7 +32,11 @@ void load_reference(PanelContext& ctx, const fs::path& file, bool automatic) {
 
 void keep_image_b(PanelContext& ctx, const Snapshot& frame) {
     CompareTool& tool = ctx.ui.compare;
-    tool.comparison.settings.b = tool.comparison.keep(frame.radiance, frame.spp);
+    // Image A as the window shows it (denoised when the display is), not the raw estimate.
+    const DenoiseView view = ctx.model.settings().denoise;
+    const RendererSettings& image = ctx.model.scene().renderer;
+    tool.comparison.settings.b = tool.comparison.keep(shown_radiance(frame, view, image.width, image.height), frame.spp,
+                                                      shown_word(frame, view));
     tool.picture_key.clear();
     ctx.messages.show_status("kept the image as " + tool.comparison.slots()[size_t(tool.comparison.settings.b)]->name +
                              " (image B)");
@@ -42,7 +47,7 @@ std::optional<PixelProbe> probe(const PanelContext& ctx, int x, int y) {
     const ViewerModel& model = ctx.model;
     if (!shown || !model.has_scene()) return std::nullopt;
     return probe_pixel(*shown, model.scene().renderer.width, model.scene().renderer.height, x, y,
-                       model.settings().tone, ctx.ui.compare.linear_scale);
+                       model.settings().tone, ctx.ui.compare.linear_scale, model.settings().denoise);
 }
 
 StatsFigures stats_figures(const PanelContext& ctx) {
@@ -56,6 +61,7 @@ StatsFigures stats_figures(const PanelContext& ctx) {
     f.mrays_per_second = st.mrays_per_second;
     f.noise = st.noise;
     if (const CompareImage* b = tool.comparison.b()) f.reference = b->name;
+    if (const Snapshot* shown = ctx.ui.shown.get()) f.image = std::string(shown_word(*shown, ctx.model.settings().denoise));
     f.figures = tool.figures;
     if (tool.locked_probe) f.probe = probe(ctx, tool.locked_probe->first, tool.locked_probe->second);
     return f;
@@ -72,17 +78,21 @@ void update_pictures(PanelContext& ctx, Display& display) {
     // Everything below follows from these (a new reference or slot clears the key);
     // recomputed only when one changes.
     char key[256];
-    std::snprintf(key, sizeof key, "%llu %d %.17g %d %d %d %.17g %p", static_cast<unsigned long long>(ctx.ui.shown_serial),
-                  int(tone.tonemap), tone.exposure, int(cs.mode), int(cs.metric), cs.b, cs.error_scale,
+    const DenoiseView view = model.settings().denoise;
+    std::snprintf(key, sizeof key, "%llu %d %.17g %d %d %d %d %.17g %p", static_cast<unsigned long long>(ctx.ui.shown_serial),
+                  int(tone.tonemap), tone.exposure, int(view), int(cs.mode), int(cs.metric), cs.b, cs.error_scale,
                   static_cast<const void*>(b));
     if (tool.picture_key == key) return;
     tool.picture_key = key;
-    tool.linear_scale = tonemap_scale(shown->radiance, tone.tonemap, tone.exposure_scale());
+    // Image A at the frame's resolution (a preview's blocks unscaled).
+    const Image shown_image = shown_radiance(*shown, view);
+    tool.linear_scale = tonemap_scale(shown_image, tone.tonemap, tone.exposure_scale());
     const bool full = shown->scale == 1;
 
-    // A (the render as displayed) against B: the figures, and the reference's for the log.
+    // Image A is the render as the window shows it (denoised when the display is): its figures
+    // against B, the error view and the reference's figures for the log.
     Rgb8Image a;
-    if (full && (b || tool.comparison.reference())) a = tonemap(shown->radiance, tone.tonemap, tone.exposure_scale());
+    if (full && (b || tool.comparison.reference())) a = tonemap(shown_image, tone.tonemap, tone.exposure_scale());
     Rgb8Image b_bytes = b ? b->display(tone) : Rgb8Image{};
     tool.figures.reset();
     tool.figures_note.clear();

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <string>
 
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
 #include "core/image_compare.h"
+#include "viewer/status.h"
 #include "viewer/ui_compare.h"
 #include "viewer/ui_panels.h"
 
@@ -148,7 +150,11 @@ void panel_compare(PanelContext& ctx) {
     ImGui::BeginDisabled(!full);
     if (ImGui::Button("keep this image as B (K)")) keep_image_b(ctx, *full);
     ImGui::EndDisabled();
-    if (tool.figures) ImGui::Text("A vs B: PSNR %.2f dB, RMSE %.4g", tool.figures->psnr, tool.figures->rmse);
+    // A is the image shown: the panel names which (raw, denoised or split), as the stats JSON does.
+    if (tool.figures && ctx.ui.shown)
+        ImGui::Text("A (%s) vs B: PSNR %.2f dB, RMSE %.4g",
+                    std::string(shown_word(*ctx.ui.shown, ctx.model.settings().denoise)).c_str(), tool.figures->psnr,
+                    tool.figures->rmse);
     else if (!tool.figures_note.empty()) ImGui::TextDisabled("A vs B: %s", tool.figures_note.c_str());
 
     // The locked probe.
