@@ -260,6 +260,13 @@ Image denoised_radiance_in(const RenderJob& job, const RenderEstimates& estimate
     return out;
 }
 
+// The job's earlier denoised picture of the whole image, where `previous` is one (null if not).
+const Image* earlier_picture(const Snapshot* previous, uint64_t generation, int width, int height) {
+    const bool same = previous && previous->generation == generation && previous->scale == 1 &&
+                      previous->denoised.width == width && previous->denoised.height == height;
+    return same ? &previous->denoised : nullptr;
+}
+
 }  // namespace
 
 std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int width, int height,
@@ -270,9 +277,7 @@ std::optional<PixelBox> denoised_box(const std::optional<PixelBox>& region, int 
     // An empty box, or one of most of the image: the whole image, as cheap and seamless.
     if (box.x0 >= box.x1 || box.y0 >= box.y1 || 2 * double(box.x1 - box.x0) * (box.y1 - box.y0) > double(width) * height)
         return std::nullopt;
-    if (previous && previous->generation == generation && previous->scale == 1 && previous->denoised.width == width &&
-        previous->denoised.height == height)
-        return box;
+    if (earlier_picture(previous, generation, width, height)) return box;
     // No earlier picture: only where no pixel outside the box has a sample yet (a job started
     // with a region), whose picture is then the raw radiance (black), as a filter would leave it.
     for (int y = 0; y < height; ++y)
@@ -341,10 +346,11 @@ void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeat
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
     const std::optional<PixelBox> box =
         features ? denoised_box(region, state.width, state.height, previous, job.generation, estimates.samples) : std::nullopt;
-    const bool previous_picture = box && previous && previous->generation == job.generation;
-    if (box)
-        frame.denoised = denoised_radiance_in(job, estimates, *features, *box,
-                                              previous_picture ? previous->denoised : estimates.radiance, workspace);
+    if (box) {
+        const Image* earlier = earlier_picture(previous, job.generation, state.width, state.height);
+        frame.denoised = denoised_radiance_in(job, estimates, *features, *box, earlier ? *earlier : estimates.radiance,
+                                              workspace);
+    }
     else if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
     frame.radiance = std::move(estimates.radiance);
     record_pixel_statistics(state, std::move(estimates), frame);
