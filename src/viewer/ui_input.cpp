@@ -72,7 +72,7 @@ int InputState::pressed_bits() const {
 
 bool InputState::moving() const {
     const ImGuiIO& io = ImGui::GetIO();
-    return io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || motion_keys_held || grab;
+    return io.MouseDown[0] || io.MouseDown[1] || io.MouseDown[2] || motion_keys_held;
 }
 
 namespace {
@@ -524,8 +524,9 @@ WindowRequests handle_input(PanelContext& ctx, InputState& in) {
     handle_keys(ctx, in, requests);
     in.key_presses.clear();
     in.key_mods.clear();
-    // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
-    if (!in.moving() && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
+    // One drag, one held key, one move (M) or one field's edit is one undo step: seal it
+    // once nothing is held. (A move redraws only as the pointer moves: it is not `moving`.)
+    if (!in.moving() && !in.grab && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
     return requests;
 }
 

@@ -76,7 +76,7 @@ struct InputState {
         Camera last;                 // the camera as the arrows last left it
     };
     std::optional<KeyOrbit> key_orbit;
-    // A held button, camera key or a move (M): the window redraws at its frame rate.
+    // A held button or camera key: the window redraws at its frame rate.
     bool moving() const;
 };
 
