@@ -258,6 +258,15 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
             draw->AddRect(ImVec2(float(rect.x + box->x0 * scale) * to_points, float(rect.y + box->y0 * scale) * to_points),
                           ImVec2(float(rect.x + box->x1 * scale) * to_points, float(rect.y + box->y1 * scale) * to_points),
                           colour, 0.0f, 0, 1.0f);
+    // A move (M): what it does, at the image's bottom left while it lasts.
+    if (!ctx.ui.move_hint.empty()) {
+        const PixelRect view = ctx.view_area();
+        const ImVec2 size = ImGui::CalcTextSize(ctx.ui.move_hint.c_str());
+        const float bottom = float(std::min(rect.y + rect.height, view.y + view.height)) * to_points;
+        const ImVec2 at(float(std::max(rect.x, view.x) + 6) * to_points, bottom - size.y - 8);
+        draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 170));
+        draw->AddText(at, IM_COL32(255, 190, 80, 255), ctx.ui.move_hint.c_str());
+    }
     // Which view the image shows, on the image (the render needs no label).
     const ViewMode mode = tool.comparison.settings.mode;
     if (mode != ViewMode::render) {

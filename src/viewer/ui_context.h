@@ -143,6 +143,7 @@ struct UiState {
         int primitive = -1, cols = 0, rows = 0;
         std::vector<unsigned char> cells;
     } selection_tint;
+    std::string move_hint;                   // a move (M) is on: what it does, shown on the image
     bool drawing_region = false;             // B: the next left drag draws the render region
     std::optional<PixelBox> region;          // only these image pixels refine (none: all)
     std::optional<PixelBox> region_draft;    // the box being drawn

@@ -86,6 +86,15 @@ PixelBox region_box(double ax, double ay, double bx, double by, const PixelRect&
 
 constexpr const char* kGrabGroup = "grab";  // the undo step of one move (M)
 
+// What the move does, on the image for as long as it lasts.
+void set_move_hint(PanelContext& ctx, const InputState& in) {
+    const Scene& s = ctx.model.scene();
+    const int axis = in.grab->axis;
+    ctx.ui.move_hint = "moving " + s.primitives[size_t(in.grab->primitive)].id +
+                       (axis < 0 ? std::string(" (view plane)") : std::string(" (along ") + "xyz"[axis] + ")") +
+                       "\nclick / Return: place   Esc / right click: put back   X Y Z: axis";
+}
+
 // M: the selection starts following the pointer.
 void start_grab(PanelContext& ctx, InputState& in) {
     const auto sel = ctx.selection();
@@ -103,8 +112,7 @@ void start_grab(PanelContext& ctx, InputState& in) {
     g.axis = ctx.ui.axis_lock;
     in.grab = g;
     ctx.model.seal_undo_step();  // the move is one undo step of its own
-    ctx.messages.show_status("moving " + s.primitives[size_t(*sel)].id +
-                             ": move the pointer; click or Return places it, Esc or right click puts it back; X, Y, Z: one axis");
+    set_move_hint(ctx, in);
 }
 
 // Ends the move: placed where it is (`keep`), or back where it was (its edit undone, no redo left).
@@ -112,8 +120,9 @@ void end_grab(PanelContext& ctx, InputState& in, bool keep) {
     if (!in.grab) return;
     if (!keep && in.grab->moved) ctx.model.cancel_step(kGrabGroup);
     ctx.model.seal_undo_step();
-    ctx.messages.show_status(keep ? "placed" : "move cancelled");
+    ctx.messages.show_status(keep ? "placed" : "move cancelled: put back");
     in.grab.reset();
+    ctx.ui.move_hint.clear();
 }
 
 // One frame of the move: the selection at the pointer's offset from where the move began,
@@ -123,6 +132,7 @@ void grab_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     InputState::Grab& g = *in.grab;
     if (ctx.selection() != g.primitive || !model.prepared()) {
         in.grab.reset();  // the selection went (undo, delete): nothing to move
+        ctx.ui.move_hint.clear();
         return;
     }
     for (int b = 0; b < 3; ++b) in.drags[b].release();  // a click here places, never orbits or selects
@@ -147,8 +157,7 @@ void grab_keys(PanelContext& ctx, InputState& in) {
         const int axis = key == GLFW_KEY_X ? 0 : key == GLFW_KEY_Y ? 1 : key == GLFW_KEY_Z ? 2 : -1;
         if (axis >= 0) {
             in.grab->axis = in.grab->axis == axis ? -1 : axis;
-            ctx.messages.show_status(in.grab->axis < 0 ? std::string("moving in the view plane")
-                                                       : std::string("moving along ") + "xyz"[axis] + " only");
+            set_move_hint(ctx, in);
         } else if (key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) {
             end_grab(ctx, in, true);
         }
