@@ -4,6 +4,7 @@
 // text events reach the widgets a frame's worth at a time, every press seen as down.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -164,6 +165,22 @@ TEST(SelectionVisible, WallIsTintedWhereItIsSeen) {
     EXPECT_GT(covered, cols * rows / 10);  // the far wall fills much of the view
     EXPECT_LT(covered, cols * rows);
     EXPECT_EQ(agree, cols * rows);
+}
+
+// B0: a selection behind the camera has no outline on the image and no cell that sees it
+// (the window then names it on the image instead).
+TEST(SelectionVisible, SphereBehindTheCameraCoversNothing) {
+    ViewerModel m = test::brief_model(3);
+    ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) {
+        Camera& c = s.cameras[size_t(s.camera)];
+        c.target = Vec3(0, 0, -30);  // looking away from the room's inside, at the near wall's gap
+    }));
+    const Scene& s = m.scene();
+    const int ball = primitive_named(s, "sphere 01");
+    const Shape& bs = s.shapes[size_t(s.primitives[size_t(ball)].shape)];
+    EXPECT_FALSE(outline_on_image(sphere_outline(m.prepared()->camera, bs.centre, bs.radius, 64)));
+    const auto cells = sphere_coverage(*m.prepared(), bs.centre, bs.radius, 16, 16);
+    EXPECT_EQ(std::count(cells.begin(), cells.end(), 1), 0);
 }
 
 namespace {

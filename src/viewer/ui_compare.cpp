@@ -225,6 +225,7 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
             const int cols = std::clamp((w + 3) / 4, 1, 160), rows = std::clamp((h + 3) / 4, 1, 160);
             if (tint.generation != model.generation() || tint.primitive != *sel || tint.cols != cols || tint.rows != rows) {
                 tint.cells = sphere_coverage(*model.prepared(), shape.centre, shape.radius, cols, rows);
+                tint.any = std::find(tint.cells.begin(), tint.cells.end(), 1) != tint.cells.end();
                 tint.generation = model.generation();
                 tint.primitive = *sel;
                 tint.cols = cols;
@@ -246,6 +247,15 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
                         colour);
                     x = end;
                 }
+            if (!tint.any) {
+                // Nowhere on the image (behind the camera, out of the view, hidden): said at its top right.
+                const std::string label = "selected: " + s.primitives[size_t(*sel)].id + " (not seen from here)";
+                const ImVec2 size = ImGui::CalcTextSize(label.c_str());
+                const float right = float(std::min(rect.x + rect.width, view.x + view.width)) * to_points;
+                const ImVec2 at(right - size.x - 9, float(std::max(rect.y, view.y) + 6) * to_points);
+                draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 170));
+                draw->AddText(at, IM_COL32(255, 160, 0, 255), label.c_str());
+            }
         }
         if (!points.empty())
             draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);

@@ -142,6 +142,7 @@ struct UiState {
         uint64_t generation = 0;
         int primitive = -1, cols = 0, rows = 0;
         std::vector<unsigned char> cells;
+        bool any = false;  // some cell sees it
     } selection_tint;
     std::string move_hint;                   // a move (M) is on: what it does, shown on the image
     bool drawing_region = false;             // B: the next left drag draws the render region
