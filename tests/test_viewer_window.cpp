@@ -592,8 +592,8 @@ TEST_F(ViewerWindow, BrokenStartingSceneKeepsTheKeys) {
 }
 
 // Missing item 1, with real input: a click selects the sphere under the pointer, Delete
-// removes it, Ctrl+Z brings it back, Ctrl+D duplicates it, a drag from the selection moves it
-// (not the camera), Esc clears the selection.
+// removes it, Ctrl+Z brings it back, Ctrl+D duplicates it, M moves it with the pointer and a
+// click places it (not the camera), Esc clears the selection.
 TEST_F(ViewerWindow, ClickSelectsDeleteUndoDuplicateAndMove) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
     auto r = drive(dir, "select_edit", 3);
@@ -609,6 +609,90 @@ TEST_F(ViewerWindow, ClickSelectsDeleteUndoDuplicateAndMove) {
     EXPECT_EQ(r["selected_copy"], std::to_string(n));  // the copy, last in the list
     EXPECT_EQ(r["selected_after_move"], r["selected_again"]);
     EXPECT_NE(r["generation_after"], r["generation_before_move"]);  // the move changed the image
+}
+
+// Issue 47 B0, with real input on scene 3: a click on the far wall selects it, and the wall
+// shows as selected on the image (its outline is off the image: a tint over the pixels that
+// see it, as sphere_coverage finds them, and nowhere else); a left drag from it orbits and
+// moves the view, not the wall; M moves it, Esc puts it back (the scene saved then has the
+// wall where it was and the orbited camera); M and a click place it, Ctrl+Z undoes that
+// (the saved state again); Esc then clears the selection (the window stays).
+TEST_F(ViewerWindow, WallSelectionShowsAndADragFromItOrbits) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path copy = dir / "scene3.json";
+    fs::copy_file(scene(3), copy);
+    auto r = drive(dir, "wall_select", 3, copy);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    const kr::viewer::ViewerModel m = kr::test::brief_model(3);
+    const kr::Scene& s = m.scene();
+    ASSERT_NE(r["selected"], "none");
+    const int wall = std::stoi(r["selected"]);
+    EXPECT_EQ(s.primitives[size_t(wall)].id, "far wall");
+    EXPECT_EQ(r["camera_moved"], "1");
+    EXPECT_EQ(r["selected_after_drag"], r["selected"]);
+    EXPECT_EQ(r["selected_after_cancel"], r["selected"]);
+    const kr::Scene saved = kr::load_scene_file(copy).scene;
+    auto centre = [&](const kr::Scene& sc) { return sc.shapes[size_t(sc.primitives[size_t(wall)].shape)].centre; };
+    EXPECT_EQ(centre(saved), centre(s));  // neither the drag nor the cancelled move moved it
+    EXPECT_NE(saved.cameras[size_t(saved.camera)].position, m.camera().position);  // the drag orbited
+    EXPECT_EQ(r["dirty_after_place"], "1");
+    EXPECT_EQ(r["running_after_esc"], "1");
+    // The tint: over the cells that see the wall (4x4 image pixels each, as the window draws
+    // them), the window's pixels are blended with orange (255, 160, 0) at alpha 72/255;
+    // elsewhere they stay. Cells whose neighbours all agree (the edges left out).
+    std::smatch match;
+    const std::string image = r["image"];
+    ASSERT_TRUE(std::regex_match(image, match, std::regex("([0-9.]+),([0-9.]+),(fit)?([0-9.]+)"))) << image;
+    const double left = std::stod(match[1]), top = std::stod(match[2]), scale = std::stod(match[4]);
+    const kr::Rgb8Image before = kr::read_ppm(dir / "unselected.ppm"), after = kr::read_ppm(dir / "selected.ppm");
+    ASSERT_EQ(before.width, after.width);
+    const kr::Shape& ws = s.shapes[size_t(s.primitives[size_t(wall)].shape)];
+    const int cols = 128, rows = 128;
+    const auto cells = kr::viewer::sphere_coverage(*m.prepared(), ws.centre, ws.radius, cols, rows);
+    auto at = [&](const kr::Rgb8Image& img, int x, int y, int k) { return int(img.bytes[(size_t(y) * img.width + size_t(x)) * 3 + k]); };
+    int tinted = 0, tinted_ok = 0, plain = 0, plain_ok = 0;
+    for (int cy = 1; cy + 1 < rows; ++cy)
+        for (int cx = 1; cx + 1 < cols; ++cx) {
+            const unsigned char c = cells[size_t(cy * cols + cx)];
+            bool uniform = true;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) uniform &= cells[size_t((cy + dy) * cols + cx + dx)] == c;
+            if (!uniform) continue;
+            const int x = int(left + (cx + 0.5) * 4 * scale), y = int(top + (cy + 0.5) * 4 * scale);
+            if (x < 0 || y < 0 || x >= before.width || y >= before.height) continue;
+            // Tinted: the pixel blended with orange at alpha 72/255 (within rounding); else as it was.
+            int off_tint = 0, off_plain = 0;
+            constexpr int kOrange[3] = {255, 160, 0};
+            for (int k = 0; k < 3; ++k) {
+                const double blended = at(before, x, y, k) + 72.0 / 255 * (kOrange[k] - at(before, x, y, k));
+                off_tint = std::max(off_tint, int(std::lround(std::abs(at(after, x, y, k) - blended))));
+                off_plain = std::max(off_plain, std::abs(at(after, x, y, k) - at(before, x, y, k)));
+            }
+            if (c) tinted++, tinted_ok += off_tint <= 3;
+            else plain++, plain_ok += off_plain <= 1;
+        }
+    EXPECT_GT(tinted, 1000);
+    EXPECT_EQ(tinted_ok, tinted);
+    EXPECT_GT(plain, 1000);
+    EXPECT_EQ(plain_ok, plain);
+}
+
+// Issue 47 B2, with real input: the same 12-step 120-pixel left drag (an orbit about the far
+// wall, stopped at surfaces) and right drag (a pan) from the file's view, with a frame after
+// each move, with the moves sent at once, and with them all queued for one frame, end on the
+// same camera, to the last digit the status line gives.
+TEST_F(ViewerWindow, SameGestureSameCameraWhateverTheFrames) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "same_gesture", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    for (const std::string b : {"1", "3"}) {
+        SCOPED_TRACE("button " + b);
+        const std::string paced = r["camera_" + b + "_paced"];
+        ASSERT_FALSE(paced.empty());
+        EXPECT_NE(paced, r["camera_home"]);
+        EXPECT_EQ(r["camera_" + b + "_burst"], paced);
+        EXPECT_EQ(r["camera_" + b + "_stopped"], paced);
+    }
 }
 
 // The command line's edits apply in an interactive run as in a scripted one (they were

@@ -82,12 +82,23 @@ start_edits)
     ;;
 save_where)
     # Ctrl+S on a read-only scene (a bundled one of the install tree): the window asks where
-    # to save; Return saves at the name it offers (NAME.json in the current folder), which
-    # becomes the scene's file: a second Ctrl+S saves there without asking.
+    # to save (NAME.json in the current folder offered); the name typed over it is where
+    # Return saves, and it becomes the scene's file: a second Ctrl+S saves there without asking.
     xdotool key ctrl+s
     wait_for 'question=save-where' || exit 1
     echo "asked=save-where"
+    # End: the offered name is no longer all selected (a frame sees End before the pointer's
+    # move). Then Ctrl+A, the name and Return reach one frame (the viewer stopped while X
+    # queues them, as a quick hand on a busy machine sends them): the name replaces the
+    # field's whole text (a Ctrl+A lost would append it) and Return saves there.
+    xdotool key End
+    xdotool mousemove --window "$wid" 251 330
+    wait_for 'pointer=251,330' || exit 1
+    kill -STOP $pid
+    xdotool key ctrl+a
+    xdotool type assignment_03.json
     xdotool key Return
+    kill -CONT $pid
     wait_for 'question=none' || exit 1
     xdotool key ctrl+s
     xdotool key F1
@@ -265,22 +276,120 @@ select_edit)
     wait_for "primitives=$((n + 1))\b" || exit 1
     echo "selected_copy=$(field selected)"
     echo "primitives_duplicated=$(field primitives)"
-    # The copy sits beside the original: a click selects the original again, then drag it.
+    # The copy sits beside the original: a click selects the original again, then M moves
+    # it with the pointer and a click places it.
     xdotool click 1
     wait_for "selected=$sel0 " || exit 1
     echo "selected_again=$(field selected)"
     echo "generation_before_move=$(field generation)"
-    xdotool mousedown 1
-    wait_for "press=1 pointer=$x,$y" || exit 1
+    xdotool key m
+    wait_for 'grab=1' || exit 1
     xdotool mousemove --window "$wid" $((x + 30)) $y
     wait_for "pointer=$((x + 30)),$y" || exit 1
-    xdotool mouseup 1
-    wait_for 'press=0' || exit 1
+    xdotool click 1
+    wait_for 'grab=0' || exit 1
     echo "selected_after_move=$(field selected)"
     xdotool key Escape
     wait_for 'selected=none' || exit 1
     xdotool key F1
     wait_for 'help=1' || exit 1
+    ;;
+wall_select)
+    # Scene 3's far wall (image point 150, 180; SCENE a copy): a click selects it, and its
+    # tint shows it (its outline is off the image); a left drag from it then orbits; M moves
+    # it, Esc puts it back; Ctrl+S saves (the wall where it was); M and a click place it,
+    # Ctrl+Z undoes that; Esc clears the selection. Window shots before and after the click.
+    img=$(field image)
+    echo "image=$img"
+    read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 150.5 * s, $2 + 180.5 * s}')
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/unselected.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    echo "selected=$(field selected)"
+    # A one-pixel move and back: frames after the click's are drawn before the shot.
+    xdotool mousemove --window "$wid" $((x + 1)) $y
+    wait_for "pointer=$((x + 1)),$y" || exit 1
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/selected.ppm" || { echo "error=no window shot"; exit 1; }
+    camera0=$(field camera)
+    xdotool mousedown 1
+    wait_for 'press=1' || exit 1
+    for i in 1 2 3 4 5 6; do
+        xdotool mousemove --window "$wid" $((x + 20 * i)) $y
+        wait_for "pointer=$((x + 20 * i)),$y" || exit 1
+    done
+    xdotool mouseup 1
+    wait_for 'press=0' || exit 1
+    echo "camera_moved=$([[ $(field camera) != "$camera0" ]] && echo 1 || echo 0)"
+    echo "selected_after_drag=$(field selected)"
+    generation=$(field generation)
+    xdotool key m
+    wait_for 'grab=1' || exit 1
+    xdotool mousemove --window "$wid" $((x + 80)) $((y + 20))
+    wait_changed generation "$generation" || exit 1  # the wall moved with the pointer
+    xdotool key Escape
+    wait_for 'grab=0' || exit 1
+    echo "selected_after_cancel=$(field selected)"
+    # Saved (a copy of the scene in the work folder): the test reads where the wall is.
+    xdotool key ctrl+s
+    wait_for 'dirty=0' || exit 1
+    xdotool key m
+    wait_for 'grab=1' || exit 1
+    xdotool mousemove --window "$wid" $((x + 120)) $((y + 20))
+    wait_for 'dirty=1' || exit 1
+    xdotool click 1
+    wait_for 'grab=0' || exit 1
+    echo "dirty_after_place=$(field dirty)"
+    echo "selected_after_place=$(field selected)"
+    xdotool key ctrl+z
+    wait_for 'dirty=0' || exit 1
+    xdotool key Escape
+    wait_for 'selected=none' || exit 1
+    echo "running_after_esc=$(kill -0 $pid 2>/dev/null && echo 1 || echo 0)"
+    ;;
+same_gesture)
+    # The same 12-step 120-pixel left drag (then right drag) from the file's view, three
+    # ways: a frame after each move; the moves sent at once; the moves queued while the
+    # viewer is stopped (one frame sees them all). Home between: the file's camera again.
+    img=$(field image)
+    read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 150.5 * s, $2 + 180.5 * s}')
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    home=$(field camera)
+    echo "camera_home=$home"
+    for b in 1 3; do
+        for way in paced burst stopped; do
+            moves=()
+            for i in $(seq 1 12); do moves+=(mousemove --window "$wid" $((x + 10 * i)) $y); done
+            case $way in
+            paced)
+                xdotool mousedown $b
+                wait_for "press=[1-9]" || exit 1
+                for i in $(seq 1 12); do
+                    xdotool mousemove --window "$wid" $((x + 10 * i)) $y
+                    wait_for "pointer=$((x + 10 * i)),$y" || exit 1
+                done
+                xdotool mouseup $b
+                ;;
+            burst) xdotool mousedown $b "${moves[@]}" mouseup $b ;;
+            stopped)
+                kill -STOP $pid
+                xdotool mousedown $b "${moves[@]}" mouseup $b
+                kill -CONT $pid
+                ;;
+            esac
+            wait_changed camera "$home" || exit 1
+            wait_for "press=0 pointer=$((x + 120)),$y" || exit 1
+            echo "camera_${b}_$way=$(field camera)"
+            xdotool mousemove --window "$wid" $x $y
+            wait_for "pointer=$x,$y" || exit 1
+            xdotool key Home
+            wait_for "camera=$home" || exit 1
+        done
+    done
     ;;
 bookmarks)
     # Orbit with a held arrow key, Ctrl+2 stores the view, Home resets it, Shift+2 recalls

@@ -190,6 +190,15 @@ void ViewerModel::restore(State& state, std::vector<State>& push_to) {
     open_group_.clear();
 }
 
+bool ViewerModel::cancel_step(std::string_view group) {
+    if (group.empty() || open_group_ != group || undo_.empty()) return false;
+    std::vector<State> dropped;
+    State state = std::move(undo_.back());
+    undo_.pop_back();
+    restore(state, dropped);  // the state left is dropped, not kept for redo
+    return true;
+}
+
 bool ViewerModel::undo() {
     if (undo_.empty()) return false;
     State state = std::move(undo_.back());

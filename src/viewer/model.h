@@ -89,6 +89,9 @@ public:
               std::string* error = nullptr, std::string_view field = {}, std::string_view group = {});
     // Ends the open undo group: the next edit starts a new step.
     void seal_undo_step() { open_group_.clear(); }
+    // Takes back the open undo step of `group` as if it never happened (a cancelled move:
+    // nothing to redo); false when that group's step is not the open one.
+    bool cancel_step(std::string_view group);
 
     // Undo / redo of scene and settings edits (the pause state stays as it is).
     bool can_undo() const { return !undo_.empty(); }

@@ -147,11 +147,39 @@ void orbit_drag(Camera& camera, double dx_pixels, double dy_pixels, const Vec3& 
     orbit_about(camera, pivot, -dx_pixels * kOrbitDegreesPerPixel, dy_pixels * kOrbitDegreesPerPixel);
 }
 
-Camera orbit_step(const Scene& scene, const Camera& start, const Camera& current, const Vec3& pivot, double dx_pixels,
-                  double dy_pixels, bool stop_at_surfaces) {
+Camera orbit_step(const Scene& scene, const Camera& start, const Vec3& pivot, double dx_pixels, double dy_pixels,
+                  bool stop_at_surfaces) {
     Camera cam = start;
-    orbit_drag(cam, dx_pixels, dy_pixels, pivot);
-    if (stop_at_surfaces) keep_outside(scene, current, cam, &pivot);
+    if (!stop_at_surfaces) {
+        orbit_drag(cam, dx_pixels, dy_pixels, pivot);
+        return cam;
+    }
+    // Every position a step can reach lies in the ball about the pivot through the start
+    // (an orbit keeps the distance to the pivot, stopping draws the camera towards it, and
+    // each stop is on a segment between two such points): only the spheres that meet that
+    // ball can stop it.
+    const double reach = length(start.position - pivot);
+    Scene near;
+    for (const Primitive& p : scene.primitives) {
+        if (p.shape < 0) continue;
+        const Shape& s = scene.shapes[size_t(p.shape)];
+        if (length(s.centre - pivot) > reach + s.radius + 1e-9 * (1 + reach)) continue;
+        near.shapes.push_back(s);
+        Primitive q;
+        q.shape = int(near.shapes.size()) - 1;
+        near.primitives.push_back(q);
+    }
+    // (Less a hair, so an offset summed from held-key frames, a rounding off a whole step,
+    // takes the same steps.)
+    const int steps =
+        std::clamp(int(std::ceil(std::hypot(dx_pixels, dy_pixels) / kOrbitStepPixels - 1e-9)), 1, kMaxOrbitSteps);
+    for (int i = 1; i <= steps; ++i) {
+        const double f = double(i) / steps;
+        Camera next = start;
+        orbit_drag(next, dx_pixels * f, dy_pixels * f, pivot);
+        keep_outside(near, cam, next, &pivot);
+        cam = next;
+    }
     return cam;
 }
 
@@ -185,15 +213,16 @@ void DragGesture::press(double x, double y) {
     press_y = y;
 }
 
-bool DragGesture::move(double x, double y, const Camera& camera, double& dx, double& dy) {
+bool DragGesture::move(double x, double y, const Camera& camera, double& dx, double& dy,
+                       const std::optional<std::pair<double, double>>& started_at) {
     if (!pressed) return false;
     last_x = x;
     last_y = y;
     if (!dragging) {
-        if (std::hypot(x - press_x, y - press_y) <= kDragThresholdPixels) return false;
+        if (!started_at && std::hypot(x - press_x, y - press_y) <= kDragThresholdPixels) return false;
         dragging = true;
-        start_x = x;
-        start_y = y;
+        start_x = started_at ? started_at->first : x;
+        start_y = started_at ? started_at->second : y;
         start_camera = camera;
     }
     dx = x - start_x;
@@ -217,6 +246,14 @@ void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int
     const double pan_pixels = kKeyPanPixelsPerSecond * seconds;
     if (keys.pan_x || keys.pan_y) pan_drag(camera, keys.pan_x * pan_pixels, keys.pan_y * pan_pixels, image_height);
     if (keys.dolly) dolly(camera, std::exp(keys.dolly * kKeyDollyPerSecond * seconds));
+}
+
+Camera KeyOrbitGesture::hold(const Scene& scene, int orbit_x, int orbit_y, double seconds, const NavigationSettings& nav) {
+    // apply_key_motion's rate, as drag pixels (an arrow turns the view as a drag does).
+    const double pixels = kKeyOrbitDegreesPerSecond / kOrbitDegreesPerPixel * seconds * nav.speed;
+    dx += orbit_x * pixels;
+    dy += orbit_y * pixels;
+    return orbit_step(scene, start, start.target, dx, dy, nav.stop_at_surfaces);
 }
 
 std::optional<std::string> sphere_containing(const Scene& scene, const Vec3& point) {

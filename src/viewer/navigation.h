@@ -3,6 +3,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "render/render_scene.h"
 #include "scene/scene.h"
@@ -52,11 +53,17 @@ std::optional<double> first_crossing(const Scene& scene, const Vec3& from, const
 // instead of stopping. The view direction is kept. True when the move was changed.
 bool keep_outside(const Scene& scene, const Camera& before, Camera& moved, const Vec3* pivot = nullptr);
 
-// One frame of an orbit drag: `start` (the camera when the drag started) orbited by the
-// drag's whole offset about `pivot`, stopped at surfaces on its way from `current` (the
-// camera on screen). The window and the tests go through this.
-Camera orbit_step(const Scene& scene, const Camera& start, const Camera& current, const Vec3& pivot, double dx_pixels,
-                  double dy_pixels, bool stop_at_surfaces);
+// An orbit drag's camera for its whole offset (dx, dy) from where it started: `start` (the
+// camera when the drag started) orbited about `pivot`. With stop_at_surfaces the orbit is
+// walked from the start along the straight line to (dx, dy) in fixed steps of at most
+// kOrbitStepPixels (at most kMaxOrbitSteps of them), each stopped at surfaces (sliding along
+// a wall towards the pivot) from the step before: the result is a function of the offset
+// alone, never of how many frames the pointer's moves reached. The window, the held arrow
+// keys, the scripted --orbit and the tests go through this.
+inline constexpr double kOrbitStepPixels = 2;
+inline constexpr int kMaxOrbitSteps = 256;
+Camera orbit_step(const Scene& scene, const Camera& start, const Vec3& pivot, double dx_pixels, double dy_pixels,
+                  bool stop_at_surfaces);
 
 // The surface point seen through image point (fx, fy) by the pinhole ray, if any.
 std::optional<Vec3> surface_point(const RenderScene& scene, double fx, double fy);
@@ -75,8 +82,11 @@ struct DragGesture {
 
     void press(double x, double y);
     // The pointer is at (x, y): true while dragging, with the offset from the drag's start.
-    // `camera` is recorded as start_camera when the drag starts.
-    bool move(double x, double y, const Camera& camera, double& dx, double& dy);
+    // `camera` is recorded as start_camera when the drag starts. `started_at`, where the
+    // pointer's events first went past the threshold (the window knows it), starts the drag
+    // there, so its start does not depend on which of the events a frame saw.
+    bool move(double x, double y, const Camera& camera, double& dx, double& dy,
+              const std::optional<std::pair<double, double>>& started_at = std::nullopt);
     void release() { pressed = dragging = false; }
 };
 
@@ -91,6 +101,15 @@ struct KeyMotion {
 inline constexpr double kKeyOrbitDegreesPerSecond = 60;
 inline constexpr double kKeyPanPixelsPerSecond = 240;
 inline constexpr double kKeyDollyPerSecond = 0.8;  // the distance shrinks by e^-0.8 per second
+// Held arrow keys (orbit mode) as one orbit gesture about the target, as a drag is: the
+// whole turn since they went down, from the camera then (orbit_step), so stopping at a wall
+// slides the camera the same however the hold is cut into frames, and turning back undoes
+// the slide. `hold` adds `seconds` with the arrows (orbit_x, orbit_y) held and gives the camera.
+struct KeyOrbitGesture {
+    Camera start;
+    double dx = 0, dy = 0;  // the turn so far, in drag pixels
+    Camera hold(const Scene& scene, int orbit_x, int orbit_y, double seconds, const NavigationSettings& nav);
+};
 // In fly mode the same keys fly (W/S forward, A/D strafe, Q/E down/up) and the arrows look.
 void apply_key_motion(Camera& camera, const KeyMotion& keys, double seconds, int image_height,
                       const NavigationSettings& nav = {});

@@ -90,6 +90,34 @@ std::vector<std::pair<double, double>> sphere_outline(const CameraModel& camera,
     return out;
 }
 
+bool outline_on_image(const std::vector<std::pair<double, double>>& outline) {
+    if (outline.empty()) return false;
+    for (const auto& [fx, fy] : outline)
+        if (!(fx >= 0 && fx <= 1 && fy >= 0 && fy <= 1)) return false;
+    return true;
+}
+
+std::vector<unsigned char> sphere_coverage(const RenderScene& scene, const Vec3& centre, double radius, int cols,
+                                           int rows) {
+    std::vector<unsigned char> cells(size_t(std::max(0, cols)) * size_t(std::max(0, rows)), 0);
+    CameraModel pinhole = scene.camera;
+    pinhole.lens_radius = 0;  // the ray through the lens centre, as picking casts it
+    for (int y = 0; y < rows; ++y)
+        for (int x = 0; x < cols; ++x) {
+            const CameraRay cr = pinhole.generate((x + 0.5) / cols, (y + 0.5) / rows, 0.5, 0.5);
+            Ray ray;
+            ray.o = cr.origin;
+            ray.d = cr.direction;
+            Hit hit;
+            if (!scene.intersects(ray, hit) || hit.sphere < 0) continue;
+            // The render scene merges repeated primitives: the sphere seen is the selection's
+            // when it is the same sphere.
+            const SphereGeom& s = scene.spheres[size_t(hit.sphere)];
+            cells[size_t(y) * size_t(cols) + size_t(x)] = s.centre == centre && s.radius == radius;
+        }
+    return cells;
+}
+
 Vec3 drag_offset(const CameraModel& camera, const Vec3& centre, double dx_pixels, double dy_pixels, int image_height,
                  int axis) {
     const double depth = std::max(1e-9, dot(centre - camera.position, camera.forward));

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "render/camera.h"
+#include "render/render_scene.h"
 #include "scene/scene.h"
 
 namespace kr::viewer {
@@ -31,6 +32,14 @@ std::optional<ImageCircle> project_sphere(const CameraModel& camera, const Vec3&
 // it (an ellipse off the axis): the selection's outline. Empty when any is behind the camera.
 std::vector<std::pair<double, double>> sphere_outline(const CameraModel& camera, const Vec3& centre, double radius,
                                                       int n);
+
+// Whether the outline lies wholly on the image ([0,1]^2): where it does not (a wall, a
+// sphere around the camera or cut by the image's edge), the selection is shown by its tint.
+bool outline_on_image(const std::vector<std::pair<double, double>>& outline);
+// The cells of a cols x rows grid over the image (row-major) whose centre's pinhole ray
+// first meets the sphere (centre, radius): where the selection is seen, for its tint.
+std::vector<unsigned char> sphere_coverage(const RenderScene& scene, const Vec3& centre, double radius, int cols,
+                                           int rows);
 
 // A drag of (dx, dy) image pixels moving a point at `centre` in the view plane (right, up),
 // the point following the pointer at its depth; `axis` 0, 1, 2 keeps only the motion along

@@ -27,7 +27,7 @@ bool apply_script_edits(const ViewOptions& options, ViewerModel& model, const Ed
         edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             // The window's drag about the target, stopped at surfaces as it is there.
             Camera& cam = s.cameras[size_t(s.camera)];
-            cam = orbit_step(s, cam, cam, cam.target, options.orbit->first, options.orbit->second, true);
+            cam = orbit_step(s, cam, cam.target, options.orbit->first, options.orbit->second, true);
         });
     if (options.click_focus) {
         // The centre of the pixel, as a click on it gives.

@@ -23,6 +23,12 @@
 
 namespace kr::viewer {
 
+static_assert(KeyEventQueue::kRelease == GLFW_RELEASE && KeyEventQueue::kPress == GLFW_PRESS &&
+              KeyEventQueue::kRepeat == GLFW_REPEAT && KeyEventQueue::kModCtrl == GLFW_MOD_CONTROL &&
+              KeyEventQueue::kModAlt == GLFW_MOD_ALT && KeyEventQueue::kModSuper == GLFW_MOD_SUPER &&
+              KeyEventQueue::kFirstNonText == GLFW_KEY_ESCAPE && KeyEventQueue::kFirstModifier == GLFW_KEY_LEFT_SHIFT &&
+              KeyEventQueue::kLastModifier == GLFW_KEY_RIGHT_SUPER);
+
 namespace {
 
 constexpr double kFrameInterval = 1.0 / 60;  // UI frame cap where there is no vsync (Xvfb)
@@ -123,6 +129,13 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini litter in the working directory
     ImGui_ImplGlfw_InitForOpenGL(window_, true);
+    // Keys and text reach ImGui through the queue (key_queue.h), not as GLFW reports them:
+    // a press and its release between two frames would otherwise never show as pressed.
+    // ImGui's callbacks, called when the queue hands an event over, chain to note_key.
+    glfwSetKeyCallback(window_, [](GLFWwindow* win, int key, int scancode, int action, int mods) {
+        app_of(win)->queue_key({false, key, scancode, action, mods, 0});
+    });
+    glfwSetCharCallback(window_, [](GLFWwindow* win, unsigned c) { app_of(win)->queue_key({true, 0, 0, 0, 0, c}); });
     ImGui_ImplOpenGL3_Init("#version 330 core");
 
     worker_ = std::make_unique<RenderWorker>([] { glfwPostEmptyEvent(); }, ranks_);
@@ -328,11 +341,17 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (ui_.shown)
         std::snprintf(shown, sizeof shown, "%llu,%d,%d,%llu", static_cast<unsigned long long>(ui_.shown->generation),
                       ui_.shown->scale, ui_.shown->spp, static_cast<unsigned long long>(ui_.shown->serial));
-    char line[900];
+    // grab: a move (M) is on; camera: the active camera's position (9 digits: a gesture's
+    // result, compared between runs).
+    char camera[96] = "none";
+    if (model_.has_scene())
+        std::snprintf(camera, sizeof camera, "%.9g,%.9g,%.9g", model_.camera().position.x, model_.camera().position.y,
+                      model_.camera().position.z);
+    char line[1000];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
                   "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s psnr=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
-                  "feature=%s draft=%s question=%s\n",
+                  "feature=%s draft=%s question=%s grab=%d camera=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), shown, int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
@@ -340,7 +359,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
                   model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, psnr, int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
-                  feature.c_str(), draft, open_question());
+                  feature.c_str(), draft, open_question(), int(input_.grab.has_value()), camera);
     if (line == status_line_ || status_file_failed_) return;
     try {
         write_file_atomic(*options_.status_file, line);
@@ -396,6 +415,11 @@ void ViewerApp::draw_questions(bool cancel, bool confirm) {
 }
 
 bool ViewerApp::draw_frame() {
+    for (const KeyEvent& e : keys_.take_frame()) {
+        if (e.text) ImGui_ImplGlfw_CharCallback(window_, e.codepoint);
+        else ImGui_ImplGlfw_KeyCallback(window_, e.key, e.scancode, e.action, e.mods);
+    }
+    if (!keys_.empty()) input_seen_ = true;  // the rest go to the next frames, drawn at once
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     ImGui::NewFrame();

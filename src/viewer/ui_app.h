@@ -10,6 +10,7 @@
 
 #include "viewer/gl_display.h"
 #include "viewer/gl_functions.h"
+#include "viewer/key_queue.h"
 #include "viewer/model.h"
 #include "viewer/render_worker.h"
 #include "viewer/ui_context.h"
@@ -35,6 +36,7 @@ public:
     // The GLFW callbacks.
     void note_input() { input_seen_ = true; }
     void note_key(int key, int action, int mods);
+    void queue_key(const KeyEvent& e) { input_seen_ = true; keys_.push(e); }
     void note_cursor(double x, double y) { input_seen_ = true; input_.note_cursor(x, y); }
     void note_button(int button, int action) { input_seen_ = true; input_.note_button(button, action); }
     void note_wheel() { input_seen_ = true; input_.note_wheel(); }
@@ -69,6 +71,7 @@ private:
     UiState ui_;
     PanelContext ctx_{model_, messages_, ui_};
     InputState input_;
+    KeyEventQueue keys_;  // key and text events waiting for ImGui, a frame's worth at a time
     ScriptRun script_;
 
     // What the render thread was last given.

@@ -204,7 +204,9 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
         draw->AddRect(ImVec2(cx - size / 2 - 1, cy - size / 2 - 1), ImVec2(cx + size / 2 + 1, cy + size / 2 + 1),
                       IM_COL32(255, 80, 80, 255));
     }
-    // The selected sphere's outline, as the camera sees it.
+    // The selected sphere's outline, as the camera sees it; where that is not wholly on the
+    // image (a wall, a sphere around the camera, one cut by the edge), also a tint over the
+    // pixels that see it, so a selection always shows.
     if (const auto sel = ctx.selection(); sel && model.prepared()) {
         const Scene& s = model.scene();
         const Shape& shape = s.shapes[size_t(s.primitives[size_t(*sel)].shape)];
@@ -212,13 +214,52 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
         std::vector<ImVec2> points;
         for (const auto& [fx, fy] : outline)
             points.emplace_back(float(rect.x + fx * rect.width) * to_points, float(rect.y + fy * rect.height) * to_points);
-        if (!points.empty()) {
-            draw->PushClipRect(ImVec2(float(ctx.view_area().x) * to_points, float(ctx.view_area().y) * to_points),
-                               ImVec2(float(ctx.view_area().x + ctx.view_area().width) * to_points,
-                                      float(ctx.view_area().y + ctx.view_area().height) * to_points));
-            draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);
-            draw->PopClipRect();
+        const PixelRect view = ctx.view_area();
+        draw->PushClipRect(ImVec2(float(view.x) * to_points, float(view.y) * to_points),
+                           ImVec2(float(view.x + view.width) * to_points, float(view.y + view.height) * to_points));
+        if (!outline_on_image(outline)) {
+            UiState::SelectionTint& tint = ctx.ui.selection_tint;
+            const int w = s.renderer.width, h = s.renderer.height;
+            // Cells of about 4 image pixels (at most 160 a side): cheap enough to cast again
+            // on every frame of an orbit.
+            const int cols = std::clamp((w + 3) / 4, 1, 160), rows = std::clamp((h + 3) / 4, 1, 160);
+            if (tint.generation != model.generation() || tint.primitive != *sel || tint.cols != cols || tint.rows != rows) {
+                tint.cells = sphere_coverage(*model.prepared(), shape.centre, shape.radius, cols, rows);
+                tint.any = std::find(tint.cells.begin(), tint.cells.end(), 1) != tint.cells.end();
+                tint.generation = model.generation();
+                tint.primitive = *sel;
+                tint.cols = cols;
+                tint.rows = rows;
+            }
+            const ImU32 colour = IM_COL32(255, 160, 0, 72);
+            for (int y = 0; y < rows; ++y)
+                for (int x = 0; x < cols;) {
+                    if (!tint.cells[size_t(y) * size_t(cols) + size_t(x)]) {
+                        ++x;
+                        continue;
+                    }
+                    int end = x;  // one rectangle per run of covered cells
+                    while (end < cols && tint.cells[size_t(y) * size_t(cols) + size_t(end)]) ++end;
+                    draw->AddRectFilled(
+                        ImVec2(float(rect.x + rect.width * x / cols) * to_points, float(rect.y + rect.height * y / rows) * to_points),
+                        ImVec2(float(rect.x + rect.width * end / cols) * to_points,
+                               float(rect.y + rect.height * (y + 1) / rows) * to_points),
+                        colour);
+                    x = end;
+                }
+            if (!tint.any) {
+                // Nowhere on the image (behind the camera, out of the view, hidden): said at its top right.
+                const std::string label = "selected: " + s.primitives[size_t(*sel)].id + " (not seen from here)";
+                const ImVec2 size = ImGui::CalcTextSize(label.c_str());
+                const float right = float(std::min(rect.x + rect.width, view.x + view.width)) * to_points;
+                const ImVec2 at(right - size.x - 9, float(std::max(rect.y, view.y) + 6) * to_points);
+                draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 170));
+                draw->AddText(at, IM_COL32(255, 160, 0, 255), label.c_str());
+            }
         }
+        if (!points.empty())
+            draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);
+        draw->PopClipRect();
     }
     // The render region (cyan), or the box being drawn (white).
     for (const auto& [box, colour] : {std::pair{ctx.ui.region, IM_COL32(0, 220, 255, 255)},
@@ -227,6 +268,15 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
             draw->AddRect(ImVec2(float(rect.x + box->x0 * scale) * to_points, float(rect.y + box->y0 * scale) * to_points),
                           ImVec2(float(rect.x + box->x1 * scale) * to_points, float(rect.y + box->y1 * scale) * to_points),
                           colour, 0.0f, 0, 1.0f);
+    // A move (M): what it does, at the image's bottom left while it lasts.
+    if (!ctx.ui.move_hint.empty()) {
+        const PixelRect view = ctx.view_area();
+        const ImVec2 size = ImGui::CalcTextSize(ctx.ui.move_hint.c_str());
+        const float bottom = float(std::min(rect.y + rect.height, view.y + view.height)) * to_points;
+        const ImVec2 at(float(std::max(rect.x, view.x) + 6) * to_points, bottom - size.y - 8);
+        draw->AddRectFilled(ImVec2(at.x - 3, at.y - 2), ImVec2(at.x + size.x + 3, at.y + size.y + 2), IM_COL32(0, 0, 0, 170));
+        draw->AddText(at, IM_COL32(255, 190, 80, 255), ctx.ui.move_hint.c_str());
+    }
     // Which view the image shows, on the image (the render needs no label).
     const ViewMode mode = tool.comparison.settings.mode;
     if (mode != ViewMode::render) {

@@ -136,6 +136,15 @@ struct UiState {
     NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
     std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
     int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
+    // Where the selection is seen (sphere_coverage), for its tint where its outline is off
+    // the image; computed again when the generation or the selection changes.
+    struct SelectionTint {
+        uint64_t generation = 0;
+        int primitive = -1, cols = 0, rows = 0;
+        std::vector<unsigned char> cells;
+        bool any = false;  // some cell sees it
+    } selection_tint;
+    std::string move_hint;                   // a move (M) is on: what it does, shown on the image
     bool drawing_region = false;             // B: the next left drag draws the render region
     std::optional<PixelBox> region;          // only these image pixels refine (none: all)
     std::optional<PixelBox> region_draft;    // the box being drawn

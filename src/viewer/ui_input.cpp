@@ -24,8 +24,21 @@ void InputState::note_key(int key, int action, int mods) {
     if (action == GLFW_RELEASE || (action == GLFW_PRESS && !chord)) chord_keys.erase(std::remove(chord_keys.begin(), chord_keys.end(), key), chord_keys.end());
 }
 
+void InputState::note_cursor(double x, double y) {
+    cursor = {x, y};
+    for (int b = 0; b < 3; ++b)
+        if (event_down[b] && !drag_from[b] && std::hypot(x - event_press[b].first, y - event_press[b].second) > kDragThresholdPixels)
+            drag_from[b] = cursor;
+}
+
 void InputState::note_button(int button, int action) {
     if (button < 0 || button >= 3) return;
+    if (action == GLFW_PRESS) {
+        event_down[button] = true;
+        event_press[button] = cursor.value_or(Point{0, 0});
+        drag_from[button].reset();
+    }
+    if (action == GLFW_RELEASE) event_down[button] = false;
     // The first press since the last frame is the one ImGui sees as the click.
     if (action == GLFW_PRESS && !press_at[button]) press_at[button] = cursor;
     if (action == GLFW_PRESS) release_at[button].reset();
@@ -71,7 +84,88 @@ PixelBox region_box(double ax, double ay, double bx, double by, const PixelRect&
     return {std::min(px(ax), px(bx)), std::min(py(ay), py(by)), std::max(px(ax), px(bx)), std::max(py(ay), py(by))};
 }
 
+constexpr const char* kGrabGroup = "grab";  // the undo step of one move (M)
+
+// What the move does, on the image for as long as it lasts.
+void set_move_hint(PanelContext& ctx, const InputState& in) {
+    const Scene& s = ctx.model.scene();
+    const int axis = in.grab->axis;
+    ctx.ui.move_hint = "moving " + s.primitives[size_t(in.grab->primitive)].id +
+                       (axis < 0 ? std::string(" (view plane)") : std::string(" (along ") + "xyz"[axis] + ")") +
+                       "\nclick / Return: place   Esc / right click: put back   X Y Z: axis";
+}
+
+// M: the selection starts following the pointer.
+void start_grab(PanelContext& ctx, InputState& in) {
+    const auto sel = ctx.selection();
+    if (!sel || !ctx.model.prepared()) {
+        ctx.messages.show_status("M moves the selection: click a sphere first");
+        return;
+    }
+    const Scene& s = ctx.model.scene();
+    const ImGuiIO& io = ImGui::GetIO();
+    InputState::Grab g;
+    g.primitive = *sel;
+    g.start = s.shapes[size_t(s.primitives[size_t(*sel)].shape)].centre;
+    g.x = io.MousePos.x * io.DisplayFramebufferScale.x;
+    g.y = io.MousePos.y * io.DisplayFramebufferScale.x;
+    g.axis = ctx.ui.axis_lock;
+    in.grab = g;
+    ctx.model.seal_undo_step();  // the move is one undo step of its own
+    set_move_hint(ctx, in);
+}
+
+// Ends the move: placed where it is (`keep`), or back where it was (its edit undone, no redo left).
+void end_grab(PanelContext& ctx, InputState& in, bool keep) {
+    if (!in.grab) return;
+    if (!keep && in.grab->moved) ctx.model.cancel_step(kGrabGroup);
+    ctx.model.seal_undo_step();
+    ctx.messages.show_status(keep ? "placed" : "move cancelled: put back");
+    in.grab.reset();
+    ctx.ui.move_hint.clear();
+}
+
+// One frame of the move: the selection at the pointer's offset from where the move began,
+// in the view plane at its depth or along the locked axis. Clicks end it; nothing orbits.
+void grab_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
+    ViewerModel& model = ctx.model;
+    InputState::Grab& g = *in.grab;
+    if (ctx.selection() != g.primitive || !model.prepared()) {
+        in.grab.reset();  // the selection went (undo, delete): nothing to move
+        ctx.ui.move_hint.clear();
+        return;
+    }
+    for (int b = 0; b < 3; ++b) in.drags[b].release();  // a click here places, never orbits or selects
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Left)) return end_grab(ctx, in, true);
+    if (ImGui::IsMouseClicked(ImGuiMouseButton_Right)) return end_grab(ctx, in, false);
+    const ImGuiIO& io = ImGui::GetIO();
+    const double to_fb = io.DisplayFramebufferScale.x;
+    const double image_scale = rect.width / model.scene().renderer.width;
+    const double dx = (io.MousePos.x * to_fb - g.x) / image_scale, dy = (io.MousePos.y * to_fb - g.y) / image_scale;
+    const Vec3 to = g.start + drag_offset(model.prepared()->camera, g.start, dx, dy, model.scene().renderer.height, g.axis);
+    const Scene& s = model.scene();
+    if (s.shapes[size_t(s.primitives[size_t(g.primitive)].shape)].centre == to) return;
+    const int p = g.primitive;
+    if (ctx.edit(Edit::object, [&](Scene& scene, ViewerSettings&) { own_shape(scene, p).centre = to; }, "move", kGrabGroup))
+        g.moved = true;
+}
+
+// The keys of a move: X, Y, Z lock an axis (again: the view plane), Return places it.
+void grab_keys(PanelContext& ctx, InputState& in) {
+    for (const int key : in.key_presses) {
+        if (!in.grab) return;
+        const int axis = key == GLFW_KEY_X ? 0 : key == GLFW_KEY_Y ? 1 : key == GLFW_KEY_Z ? 2 : -1;
+        if (axis >= 0) {
+            in.grab->axis = in.grab->axis == axis ? -1 : axis;
+            set_move_hint(ctx, in);
+        } else if (key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) {
+            end_grab(ctx, in, true);
+        }
+    }
+}
+
 void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
+    if (in.grab) return grab_mouse(ctx, in, rect);
     ViewerModel& model = ctx.model;
     CompareTool& tool = ctx.ui.compare;
     ImGuiIO& io = ImGui::GetIO();
@@ -125,13 +219,8 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             const double fx = (px - rect.x) / rect.width, fy = (py - rect.y) / rect.height;
             if (ctx.ui.nav.orbit_picked && model.prepared())
                 if (const auto p = surface_point(*model.prepared(), fx, fy)) in.pivot = *p;
-            // The sphere under it: a click selects it; a drag from the selection moves it.
+            // The sphere under it: a click selects it (a drag orbits, from the selection too; M moves it).
             in.press_pick = model.prepared() ? pick_primitive(model.scene(), model.prepared()->camera, fx, fy) : std::nullopt;
-            in.moves_selection = in.press_pick && in.press_pick == ctx.selection() && !ctx.ui.nav.fly;
-            if (in.moves_selection) {
-                const Scene& s = model.scene();
-                in.move_start = s.shapes[size_t(s.primitives[size_t(*in.press_pick)].shape)].centre;
-            }
         }
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
         if (left_click && io.KeyShift) {
@@ -176,39 +265,34 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         const auto [x, y] = pointer_of(b);
         // On the frame of its release a drag moves only to where the button went up, if it moved.
         if (!io.MouseDown[b] && (!in.released_here[b] || (x == g.last_x && y == g.last_y))) return false;
-        if (!g.move(x, y, model.camera(), dx, dy)) return false;
+        std::optional<InputState::Point> from;
+        if (in.drag_from[b]) from = InputState::Point{in.drag_from[b]->first * to_fb, in.drag_from[b]->second * to_fb};
+        if (!g.move(x, y, model.camera(), dx, dy, from)) return false;
         dx /= image_scale;
         dy /= image_scale;
         return true;
     };
     const NavigationSettings& nav = ctx.ui.nav;
-    const auto selected = ctx.selection();
-    if (in.moves_selection && selected && drag(in.drags[0])) {
-        // The selection follows the pointer in the view plane, or along the locked axis
-        // (X, Y or Z held, or the Selection panel's lock).
-        int axis = ctx.ui.axis_lock;
-        if (ImGui::IsKeyDown(GLFW_KEY_X)) axis = 0;
-        if (ImGui::IsKeyDown(GLFW_KEY_Y)) axis = 1;
-        if (ImGui::IsKeyDown(GLFW_KEY_Z)) axis = 2;
-        const Vec3 to = in.move_start + drag_offset(model.prepared()->camera, in.move_start, dx, dy, h, axis);
-        ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) { own_shape(s, *selected).centre = to; }, "move", "move");
-    } else if (!in.moves_selection && drag(in.drags[0]))
+    // Each drag's camera is a function of its whole offset and the camera where it started,
+    // stopped at surfaces on the way from there: the same pointer path gives the same camera
+    // whether its moves reached one frame or many.
+    if (drag(in.drags[0]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             Camera& cam = s.cameras[size_t(active)];
             if (nav.fly) {
                 cam = in.drags[0].start_camera;
                 look_drag(cam, dx, dy);
             } else {
-                cam = orbit_step(s, in.drags[0].start_camera, cam, in.pivot, dx, dy, nav.stop_at_surfaces);
+                cam = orbit_step(s, in.drags[0].start_camera, in.pivot, dx, dy, nav.stop_at_surfaces);
             }
         }, "orbit", "orbit");
     if (drag(in.drags[1]))
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             Camera& cam = s.cameras[size_t(active)];
-            const Camera before = cam;
-            cam = in.drags[1].start_camera;
+            const Camera start = in.drags[1].start_camera;
+            cam = start;
             pan_drag(cam, dx, dy, h);
-            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
+            if (nav.stop_at_surfaces) keep_outside(s, start, cam);
         }, "pan", "pan");
     if (in.middle_pans) {
         // The image follows the pointer from where the button went down: this frame's part of
@@ -223,10 +307,10 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     } else if (drag(in.drags[2])) {
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
             Camera& cam = s.cameras[size_t(active)];
-            const Camera before = cam;
-            cam = in.drags[2].start_camera;
+            const Camera start = in.drags[2].start_camera;
+            cam = start;
             dolly(cam, std::exp(dy * 0.005 * nav.speed));
-            if (nav.stop_at_surfaces) keep_outside(s, before, cam);
+            if (nav.stop_at_surfaces) keep_outside(s, start, cam);
         }, "dolly", "dolly");
     }
     // A button that went up ends its drag, after the drag's last move above.
@@ -286,9 +370,10 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
             requests.confirm_question = true;
         else if (typing) continue;
         else if (key == GLFW_KEY_ESCAPE) {
-            // Esc closes what is open first: the help, the selection, a drop-down or a question
-            // (its safe answer); then quits.
-            if (ui.help_visible) ui.help_visible = false;
+            // Esc closes what is open first: a move (put back), the help, the selection, a
+            // drop-down or a question (its safe answer); then quits.
+            if (in.grab) end_grab(ctx, in, false);
+            else if (ui.help_visible) ui.help_visible = false;
             else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && ui.selected) ui.selected.reset();
             else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
             else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
@@ -316,6 +401,14 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
     window_keys(ctx, in, requests);
     if (io.WantTextInput || ImGui::IsAnyItemActive()) {
         in.motion_keys_held = false;
+        in.key_orbit.reset();
+        return;
+    }
+    if (in.grab) {
+        // A move takes the keys until it ends (Esc: window_keys above).
+        grab_keys(ctx, in);
+        in.motion_keys_held = false;
+        in.key_orbit.reset();
         return;
     }
     bool question = false;
@@ -366,6 +459,10 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         model.seal_undo_step();
         model.set_target_spp(pressed(GLFW_KEY_RIGHT_BRACKET) ? std::min(spp * 2, 1 << 24) : std::max(1, spp / 2));
     }
+    if (pressed(GLFW_KEY_M)) {
+        start_grab(ctx, in);
+        if (in.grab) return;
+    }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
     if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
     // B: the next left drag draws the render region; Shift+B: the whole image again.
@@ -378,6 +475,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         ctx.edit(Edit::run_control, [](Scene&, ViewerSettings& s) { s.paused = !s.paused; });
     if (io.KeyCtrl) {
         in.motion_keys_held = false;
+        in.key_orbit.reset();
         return;
     }
     // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
@@ -394,14 +492,28 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         const double dt = in.motion_keys_held ? std::clamp(std::chrono::duration<double>(now - in.last_motion).count(), 0.0, 0.1) : 1.0 / 60;
         const int h = model.scene().renderer.height;
         const NavigationSettings& nav = ui.nav;
+        const int active = model.scene().camera;
+        // The arrows orbit about the target as a drag does (KeyOrbitGesture); anything else
+        // that moved the camera meanwhile (another key, a drag, undo) starts a new turn from there.
+        const bool orbiting = !nav.fly && (keys.orbit_x || keys.orbit_y);
+        if (!orbiting || (in.key_orbit && (in.key_orbit->last.position != model.camera().position || in.key_orbit->last.target != model.camera().target))) in.key_orbit.reset();
+        if (orbiting && !in.key_orbit) in.key_orbit = InputState::KeyOrbit{KeyOrbitGesture{model.camera()}, model.camera()};
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
-            Camera& cam = s.cameras[size_t(s.camera)];
-            const Camera before = cam;
-            apply_key_motion(cam, keys, dt, h, nav);
-            // Arrow keys orbit about the target: stopped at a wall, they slide along it.
-            const bool orbiting = !nav.fly && (keys.orbit_x || keys.orbit_y);
-            if (nav.stop_at_surfaces) keep_outside(s, before, cam, orbiting ? &before.target : nullptr);
+            Camera& cam = s.cameras[size_t(active)];
+            if (orbiting) cam = in.key_orbit->gesture.hold(s, keys.orbit_x, keys.orbit_y, dt, nav);
+            KeyMotion rest = keys;
+            if (orbiting) rest.orbit_x = rest.orbit_y = 0;
+            if (rest.any()) {
+                // Pan, dolly and fly move along straight lines: stopped at the first surface on
+                // the way, wherever the frames cut it.
+                const Camera before = cam;
+                apply_key_motion(cam, rest, dt, h, nav);
+                if (nav.stop_at_surfaces) keep_outside(s, before, cam);
+            }
         }, "camera keys", "keys");
+        if (in.key_orbit) in.key_orbit->last = model.camera();
+    } else {
+        in.key_orbit.reset();
     }
     in.motion_keys_held = keys.any();
     in.last_motion = now;
@@ -421,8 +533,9 @@ WindowRequests handle_input(PanelContext& ctx, InputState& in) {
     handle_keys(ctx, in, requests);
     in.key_presses.clear();
     in.key_mods.clear();
-    // One drag, one held key or one field's edit is one undo step: seal it once nothing is held.
-    if (!in.moving() && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
+    // One drag, one held key, one move (M) or one field's edit is one undo step: seal it
+    // once nothing is held. (A move redraws only as the pointer moves: it is not `moving`.)
+    if (!in.moving() && !in.grab && !ImGui::IsAnyItemActive()) ctx.model.seal_undo_step();
     return requests;
 }
 

@@ -16,8 +16,16 @@ struct InputState {
     DragGesture drags[3];        // left: orbit (fly: look), right: pan, middle: pan the image (Shift: dolly)
     Vec3 pivot;                  // what the left drag orbits about: the surface under the press, or the target
     std::optional<int> press_pick;   // the primitive under the left press (a click selects it)
-    bool moves_selection = false;    // the left drag started on the selection: it moves it
-    Vec3 move_start;                 // the selection's centre when that drag started
+    // M: the selection follows the pointer (no button held) until a click or Return places
+    // it, or Esc or a right click puts it back. A left drag never moves it: it orbits.
+    struct Grab {
+        int primitive = -1;
+        Vec3 start;                  // its centre when the move began
+        double x = 0, y = 0;         // the pointer then, framebuffer pixels
+        int axis = -1;               // X, Y or Z pressed: along that world axis only
+        bool moved = false;          // an edit was made (Esc undoes it)
+    };
+    std::optional<Grab> grab;
     bool divider_drag = false;   // the left button holds the split view's divider
     bool middle_pans = false;    // the middle drag pans the image (not Shift+middle: that dollies)
     double pan_last_x = 0, pan_last_y = 0;  // the middle pan so far, framebuffer pixels
@@ -41,9 +49,14 @@ struct InputState {
     std::optional<Point> press_at[3], release_at[3];
     std::optional<Point> released_here[3];    // where the button this frame sees released went up
     std::optional<Point> wheel_at, wheel_here;  // the pointer at the last wheel event (zoom's centre)
+    // By the events, not the frames: each button held, where it went down, and where the
+    // pointer's motion first went more than kDragThresholdPixels from there (the drag's start).
+    bool event_down[3] = {false, false, false};
+    Point event_press[3];
+    std::optional<Point> drag_from[3];
 
     void note_key(int key, int action, int mods = 0);
-    void note_cursor(double x, double y) { cursor = {x, y}; }
+    void note_cursor(double x, double y);
     void note_button(int button, int action);
     void note_wheel() { wheel_at = cursor; }
     // After ImGui::NewFrame: each button ImGui sees clicked this frame gets the position of
@@ -56,6 +69,13 @@ struct InputState {
     bool held_in_chord(int key) const;
     // The buttons held on the image for --status-file: 1 left, 2 right, 4 middle, 8 the divider.
     int pressed_bits() const;
+    // Held arrow keys orbit as a drag does: the whole turn since they went down, from the
+    // camera then (orbit_step), so a wall slides the camera the same whatever the frame rate.
+    struct KeyOrbit {
+        KeyOrbitGesture gesture;
+        Camera last;                 // the camera as the arrows last left it
+    };
+    std::optional<KeyOrbit> key_orbit;
     // A held button or camera key: the window redraws at its frame rate.
     bool moving() const;
 };

@@ -15,10 +15,11 @@ namespace {
 
 // The keys and mouse controls, for the help window (F1 or ?).
 constexpr const char* kHelpRows[][2] = {
-    {"left drag", "orbit about the surface under the pointer (else the target); stops at surfaces"},
+    {"left drag", "orbit about the surface under the pointer (else the target), also from the selection; stops at surfaces"},
     {"left drag (fly mode)", "look around"},
-    {"click", "select the sphere under the pointer (Esc: none)"},
-    {"left drag on the selection", "move it in the view plane; hold X, Y or Z for one axis"},
+    {"click", "select the sphere under the pointer (Esc: none); shown outlined, or tinted"},
+    {"M", "move the selection with the pointer: click or Return places it, Esc or right click puts it back"},
+    {"M, then X / Y / Z", "move along world x, y or z only (again: the view plane)"},
     {"right drag", "pan"},
     {"wheel, Ctrl+wheel, + / -", "zoom the image about the pointer (samples kept)"},
     {"Shift+wheel, Shift+middle drag", "dolly the camera"},
@@ -45,7 +46,7 @@ constexpr const char* kHelpRows[][2] = {
     {"Tab", "hide / show the panel (drag its left edge to resize it)"},
     {"F11", "fullscreen"},
     {"F1 or ?", "this help"},
-    {"Esc", "close the help, a drop-down or the selection; quit (asks first with unsaved edits)"},
+    {"Esc", "cancel a move; close the help, a drop-down or the selection; quit (asks first with unsaved edits)"},
     {"typed numbers", "apply on Enter or when the field is left"},
 };
 

@@ -43,8 +43,8 @@ void panel_selection(PanelContext& ctx) {
             own.centre = shape.centre;
             own.radius = shape.radius;
         }, name, name);
-    // Move by dragging the selected sphere on the image; X, Y or Z held (or here) locks an axis.
-    ImGui::TextUnformatted("drag it on the image; lock:");
+    // M moves it with the pointer (a left drag orbits); X, Y or Z then, or here, locks an axis.
+    ImGui::TextUnformatted("M moves it on the image; lock:");
     for (int a = -1; a < 3; ++a) {
         ImGui::SameLine();
         ImGui::RadioButton(a < 0 ? "view plane" : a == 0 ? "x" : a == 1 ? "y" : "z", &ctx.ui.axis_lock, a);

@@ -46,7 +46,7 @@ Edits made at the start, as the mouse makes them (pixels within the image):
   --orbit DX,DY         a left-button drag of (DX, DY) pixels (orbit)
   --click-focus X,Y     Ctrl+click at image pixel (X, Y): focus there
   --select X,Y          a click at image pixel (X, Y): selects the sphere there
-  --move-selection DX,DY  then drag the selection by (DX, DY) image pixels in the view plane
+  --move-selection DX,DY  then move it (M) by (DX, DY) image pixels in the view plane
                         (needs --select)
   --region X0,Y0 X1,Y1  refine only the image pixels [X0, X1) x [Y0, Y1) (the B key's box;
                         X0 < X1, Y0 < Y1, whole pixels)
