@@ -9,6 +9,8 @@ scenario=$1 keithray=$2 scene=$3 dir=$4
 status="$dir/status.txt"
 limit=${VIEWER_INPUT_LIMIT:-240}  # seconds for any one condition, on a loaded machine
 
+# Save and quit writes a bundled scene's copy into the current folder: the work folder.
+[[ $scenario == save_and_quit ]] && cd "$dir"
 # The command line's edits apply in an interactive run too (start_edits).
 start_edits=()
 [[ $scenario == start_edits ]] && start_edits=(--select 344,410 --region 100,120 300,260)
