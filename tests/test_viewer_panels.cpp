@@ -154,6 +154,14 @@ TEST(ResetRule, AnEditThatLeavesTheImageAsItWasKeepsTheSamples) {
     ASSERT_TRUE(m.undo());
     EXPECT_EQ(m.generation(), g + 2);  // the new material undone: the same image
     EXPECT_EQ(m.scene().materials.size(), materials);
+    // An edit that changes nothing (a drag held still repeats its step each frame) is no
+    // undo step and no unsaved edit.
+    const bool dirty = m.dirty(), could_undo = m.can_undo();
+    ASSERT_TRUE(m.edit(Edit::camera, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].fov += 0; }));
+    ASSERT_TRUE(m.edit(Edit::object, [&](Scene& s, ViewerSettings&) { viewer::own_shape(s, ball).radius += 0; }));
+    EXPECT_EQ(m.generation(), g + 2);
+    EXPECT_EQ(m.dirty(), dirty);
+    EXPECT_EQ(m.can_undo(), could_undo);
     // The render settings are part of the image: a renderer edit always restarts.
     ASSERT_TRUE(m.edit(Edit::renderer, [](Scene&, ViewerSettings& st) { st.render.seed += 1; }));
     EXPECT_EQ(m.generation(), g + 3);

@@ -112,9 +112,12 @@ jitter_click)
     wait_for 'help=1' || exit 1
     ;;
 drag)
-    # A real drag past the threshold does orbit (the control for jitter_click).
+    # A real drag past the threshold does orbit (the control for jitter_click): past the
+    # threshold, then on (an orbit step that moves nothing is no edit).
     xdotool mousedown 1
     wait_for 'press=1 pointer=250,330' || exit 1
+    xdotool mousemove_relative 30 0
+    wait_for 'pointer=280,330' || exit 1
     xdotool mousemove_relative 30 0
     wait_for 'dirty=1' || exit 1
     xdotool mouseup 1
@@ -276,6 +279,10 @@ select_edit)
     wait_for "press=1 pointer=$x,$y" || exit 1
     xdotool mousemove --window "$wid" $((x + 30)) $y
     wait_for "pointer=$((x + 30)),$y" || exit 1
+    # Past the threshold the drag starts; on from there it moves (a step that moves
+    # nothing is no edit).
+    xdotool mousemove --window "$wid" $((x + 60)) $y
+    wait_for "pointer=$((x + 60)),$y" || exit 1
     xdotool mouseup 1
     wait_for 'press=0' || exit 1
     echo "selected_after_move=$(field selected)"

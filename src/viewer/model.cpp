@@ -54,6 +54,24 @@ bool same_sampling(const RenderSettings& a, const RenderSettings& b) {
            a.rr_depth == b.rr_depth && a.seed == b.seed && a.kernels == b.kernels;
 }
 
+bool same_camera(const Camera& a, const Camera& b) {
+    return a.id == b.id && a.type == b.type && a.fov == b.fov && a.aspect == b.aspect && a.distance == b.distance &&
+           a.position == b.position && a.target == b.target && a.focal_distance == b.focal_distance && a.alpha == b.alpha;
+}
+
+// Whether an edit of `kind` left the authored scene as it was: a camera or lens edit changes
+// only the cameras (compared member by member: cheap, as a drag repeats its step each frame);
+// any other is compared as saved.
+bool unchanged(Edit kind, const Scene& a, const Scene& b) {
+    if (kind == Edit::camera || kind == Edit::lens) {
+        if (a.camera != b.camera || a.cameras.size() != b.cameras.size()) return false;
+        for (size_t i = 0; i < a.cameras.size(); ++i)
+            if (!same_camera(a.cameras[i], b.cameras[i])) return false;
+        return true;
+    }
+    return scene_to_json(a) == scene_to_json(b);
+}
+
 }  // namespace
 
 void ViewerModel::mark_saved() {
@@ -151,6 +169,9 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
     // render scene is taken (its ids are the panels'), the generation stays.
     const bool same_image = resets && prepared_ && prepared && kind != Edit::renderer && kind != Edit::scene &&
                             renders_same(*prepared_, *prepared) && same_sampling(settings.render, settings_.render);
+    // Nothing changed at all (a drag held still repeats its step every frame, a step stopped
+    // at a surface): no undo step, no unsaved edit, the samples kept.
+    if (same_image && unchanged(kind, scene, scene_)) return true;
     if (!prepared_) {
         // No scene yet (the command line's settings before the first load, or a broken
         // starting scene): nothing the user edited, nothing to undo or to save.
