@@ -128,7 +128,9 @@ TEST_F(InstalledScenes, TheViewerSavesAnInstalledSceneElsewhere) {
     write("mine.json", "{}");
     EXPECT_TRUE(viewer::scene_file_read_only(scene.source_file, data));
     EXPECT_FALSE(viewer::scene_file_read_only(dir / "mine.json", data));
-    EXPECT_FALSE(viewer::scene_file_read_only(scene.source_file, DataDir{data.path, false}));
+    // A build's res/ too: the shipped scenes and examples are never saved over (issue 47 B6).
+    EXPECT_TRUE(viewer::scene_file_read_only(scene.source_file, DataDir{data.path, false}));
+    EXPECT_TRUE(viewer::scene_file_read_only(data.path / "scenes/examples/furnace.json", DataDir{data.path, false}));
     // Save asks with the current folder's NAME.json; a writable scene's default stays beside it.
     EXPECT_EQ(viewer::SavePaths::for_scene(scene, true).scene, "assignment_03.json");
     EXPECT_EQ(fs::path(viewer::SavePaths::for_scene(scene, false).scene),

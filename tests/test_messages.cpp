@@ -158,13 +158,14 @@ TEST(HostileText, IdCannotForgeAnErrorLine) {
     std::string e = load_error(json);
     expect_one_bounded_line(e);
     EXPECT_NE(e.find("lamp\\nerror: forged\\x1B[0m"), std::string::npos) << e;
-    // An id in a warning: an area light carried by a primitive but not listed as active.
+    // An id in a warning: an area light whose primitive emits from another shape.
     json = R"({
       "cameras": [{"id": "cam", "type": "pinhole", "fov": 45, "aspect": 1, "position": [0, 0, -5], "target": [0, 0, 0]}],
       "materials": [{"id": "white", "type": "diffuse", "rho": [0.8, 0.8, 0.8]}],
-      "shapes": [{"id": "ball", "type": "sphere", "centre": [0, 0, 0], "radius": 1}],
-      "lights": [{"id": ID, "type": "area", "shape": "ball", "power": [1, 1, 1]}],
-      "scene": {"camera": "cam", "lights": [],
+      "shapes": [{"id": "ball", "type": "sphere", "centre": [0, 0, 0], "radius": 1},
+                 {"id": "other", "type": "sphere", "centre": [0, 3, 0], "radius": 1}],
+      "lights": [{"id": ID, "type": "area", "shape": "other", "power": [1, 1, 1]}],
+      "scene": {"camera": "cam", "lights": [ID],
                 "primitives": [{"id": "ball", "type": "emissive", "shape": "ball", "material": "white", "light": ID}],
                 "renderer": {"type": "PT", "dimensions": [2, 2], "samples": 1, "depth": 2, "output": "out.ppm"}}})";
     for (size_t at; (at = json.find("ID")) != std::string::npos;) json.replace(at, 2, nlohmann::json(id).dump());

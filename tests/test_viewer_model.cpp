@@ -25,6 +25,7 @@
 #include "viewer/model.h"
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
+#include "viewer/scene_edit.h"
 #include "viewer/status.h"
 
 namespace fs = std::filesystem;
@@ -248,7 +249,14 @@ TEST(ClickToFocus, ModelSetsFocalDistanceAndMakesALens) {
     ASSERT_TRUE(m.focus_at(0.5, 0.6));
     EXPECT_EQ(m.camera().type, CameraType::lens);
     EXPECT_NEAR(m.camera().focal_distance, 20, 0.01);
+    // Scene 3's camera has no aperture: every distance is sharp, the image is the same, so the
+    // samples stay (issue 47 B5), and the click says how to see the focus.
+    EXPECT_EQ(m.camera().alpha, 0);
+    EXPECT_EQ(m.generation(), g);
+    EXPECT_NE(focus_message(m.camera()).find("the aperture is 0"), std::string::npos);
+    ASSERT_TRUE(m.edit(Edit::lens, [](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)].alpha = 0.2; }));
     EXPECT_EQ(m.generation(), g + 1);
+    EXPECT_EQ(focus_message(m.camera()).find("aperture"), std::string::npos);
     // The pixel of the glass ball's centre (2, -3.5, -1), radius 1.5, focuses on its near
     // surface: (|c - o| - r) along that ray, times the ray's cosine to the axis.
     const CameraModel& cam = m.prepared()->camera;

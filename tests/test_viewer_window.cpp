@@ -494,6 +494,44 @@ TEST_F(ViewerWindow, EscWithUnsavedEditsAsksFirst) {
     EXPECT_NE(r["generation_after"], r["generation_before"]);  // the held arrow key orbited
 }
 
+// Issue 47 B5, B6: with unsaved edits on a bundled scene, Esc asks; Return is "Save and
+// quit", and since a bundled scene is never saved over, Save asks where; Return there saves
+// NAME.json in the working folder (with the edit), and the viewer quits. The shipped file
+// is as it was.
+TEST_F(ViewerWindow, SaveAndQuitSavesABundledSceneElsewhereThenQuits) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const std::string shipped = kr::test::read_file(kr::test::brief_scene_file(3));
+    auto r = drive(dir, "save_and_quit", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["asked"], "save-where");
+    EXPECT_EQ(r["exit_status"], "0");
+    EXPECT_EQ(kr::test::read_file(kr::test::brief_scene_file(3)), shipped);
+    ASSERT_TRUE(fs::exists(dir / "assignment_03.json"));
+    const kr::Scene saved = kr::load_scene_file(dir / "assignment_03.json").scene;
+    const kr::Scene file = kr::load_scene_file(kr::test::brief_scene_file(3)).scene;
+    EXPECT_NE(saved.cameras[size_t(saved.camera)].position, file.cameras[size_t(file.camera)].position);  // the orbit
+}
+
+// Issue 47 B5: the status bar at the default size shows every field; at the minimum window,
+// 640x400, the rate, elapsed time and progress bar give way and the state, spp, noise and
+// PSNR stay (the window shots, bar_default.ppm and bar_small.ppm, are for the eye).
+TEST_F(ViewerWindow, StatusBarKeepsTheFiguresAtTheMinimumWindow) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "status_bar", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["bar_default"], "state,spp,progress,time,rate,noise,psnr");
+    const std::string small = r["bar_small"];
+    for (const char* kept : {"state", "spp", "noise", "psnr"}) EXPECT_NE(small.find(kept), std::string::npos) << small;
+    EXPECT_EQ(small.find("rate"), std::string::npos) << small;
+    const kr::ImageFile shot = kr::read_image_file(dir / "bar_small.ppm");
+    EXPECT_EQ(shot.rgb8.width, 640);
+    EXPECT_EQ(shot.rgb8.height, 400);
+    if (const char* keep = std::getenv("KEITHRAY_KEEP_SHOTS")) {
+        fs::copy_file(dir / "bar_small.ppm", fs::path(keep) / "bar_small.ppm", fs::copy_options::overwrite_existing);
+        fs::copy_file(dir / "bar_default.ppm", fs::path(keep) / "bar_default.ppm", fs::copy_options::overwrite_existing);
+    }
+}
+
 // Esc then F1 reaching one frame (the viewer stopped while X queues them): the quit
 // question opens, then the help over it. ImGui 1.86 aborted when a window appeared after a
 // modal in the modal's first frame (the questions are now begun last in the frame).

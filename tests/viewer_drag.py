@@ -131,6 +131,11 @@ def run_test(args):
     before = v.image(s)
     xdotool("mousedown", 1)
     v.wait(lambda s: s.get("press") not in (None, "0"), "the press")
+    # Past the threshold first: the drag starts where it crosses it, a step that moves nothing
+    # is no edit, so the steps below each move the camera from there.
+    pointer = v.status()["pointer"]
+    xdotool("mousemove_relative", "--", args.step_px, 0)
+    v.wait(lambda s: s.get("pointer") != pointer, "the drag's start")
     shown_during, changed = 0, 0
     earlier_states = set()  # the status bar's state while an earlier view's frame is shown
     for step in range(args.steps):

@@ -9,6 +9,8 @@ scenario=$1 keithray=$2 scene=$3 dir=$4
 status="$dir/status.txt"
 limit=${VIEWER_INPUT_LIMIT:-240}  # seconds for any one condition, on a loaded machine
 
+# Save and quit writes a bundled scene's copy into the current folder: the work folder.
+[[ $scenario == save_and_quit ]] && cd "$dir"
 # The command line's edits apply in an interactive run too (start_edits).
 start_edits=()
 [[ $scenario == start_edits ]] && start_edits=(--select 344,410 --region 100,120 300,260)
@@ -121,9 +123,12 @@ jitter_click)
     wait_for 'help=1' || exit 1
     ;;
 drag)
-    # A real drag past the threshold does orbit (the control for jitter_click).
+    # A real drag past the threshold does orbit (the control for jitter_click): past the
+    # threshold, then on (an orbit step that moves nothing is no edit).
     xdotool mousedown 1
     wait_for 'press=1 pointer=250,330' || exit 1
+    xdotool mousemove_relative 30 0
+    wait_for 'pointer=280,330' || exit 1
     xdotool mousemove_relative 30 0
     wait_for 'dirty=1' || exit 1
     xdotool mouseup 1
@@ -504,6 +509,33 @@ esc_unsaved)
         echo "error=viewer exited (status $?) after Esc and F1; its stderr: $(tail -c 400 "$dir/view.err" | tr '\n' ' ')"
     fi
     ;;
+status_bar)
+    # The status bar at the default size, then at the minimum window, 640x400: a window shot
+    # of each once a frame has been drawn at that size (the image's place changed).
+    echo "bar_default=$(field bar)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/bar_default.ppm" || { echo "error=no window shot"; exit 1; }
+    before=$(field image)
+    xdotool windowsize "$wid" 640 400
+    wait_changed image "$before" || exit 1
+    xdotool mousemove --window "$wid" 100 100
+    wait_for 'pointer=100,100' || exit 1
+    echo "bar_small=$(field bar)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/bar_small.ppm" || { echo "error=no window shot"; exit 1; }
+    ;;
+save_and_quit)
+    # Unsaved edits, then Esc: the quit question, whose Return is "Save and quit". A bundled
+    # scene is never saved over, so Save asks where; Return there saves NAME.json in the
+    # working folder, and the viewer quits.
+    xdotool keydown Right
+    wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
+    xdotool key Escape
+    wait_for 'question=quit' || exit 1
+    xdotool key Return
+    wait_for 'question=save-where' || exit 1
+    echo "asked=save-where"
+    xdotool key Return
+    ;;
 esc_f1_one_frame)
     # Esc then F1 reaching one frame, as on a busy machine: the viewer is stopped while the
     # X server queues both taps. It asks to quit, then shows the help over the question.
@@ -529,7 +561,7 @@ esac
 echo "generation_after=$(field generation)"
 echo "spp_after=$(field spp)"
 
-if [[ $scenario == esc ]]; then
+if [[ $scenario == esc || $scenario == save_and_quit ]]; then
     end=$((SECONDS + limit))
     while kill -0 $pid 2>/dev/null && ((SECONDS < end)); do sleep 0.1; done
     if kill -0 $pid 2>/dev/null; then echo "error=still running after Esc"; exit 1; fi

@@ -116,6 +116,36 @@ bool same_light_geometry(const RenderScene& a, const RenderScene& b) {
 
 }  // namespace
 
+bool renders_same(const RenderScene& a, const RenderScene& b) {
+    auto same_material = [](const Material& x, const Material& y) {
+        return x.type == y.type && x.rho == y.rho && x.rho_r == y.rho_r && x.rho_t == y.rho_t && x.eta == y.eta &&
+               x.roughness == y.roughness;
+    };
+    if (a.spheres != b.spheres || a.sphere_light != b.sphere_light || a.sphere_material.size() != b.sphere_material.size())
+        return false;
+    for (size_t i = 0; i < a.sphere_material.size(); ++i)
+        if (!same_material(a.materials[size_t(a.sphere_material[i])], b.materials[size_t(b.sphere_material[i])]))
+            return false;
+    if (a.point_lights.size() != b.point_lights.size() || a.area_lights.size() != b.area_lights.size()) return false;
+    for (size_t i = 0; i < a.point_lights.size(); ++i)
+        if (!(a.point_lights[i].position == b.point_lights[i].position) ||
+            !(a.point_lights[i].intensity == b.point_lights[i].intensity))
+            return false;
+    for (size_t i = 0; i < a.area_lights.size(); ++i)
+        if (a.area_lights[i].sphere != b.area_lights[i].sphere || !(a.area_lights[i].radiance == b.area_lights[i].radiance))
+            return false;
+    const CameraModel &ca = a.camera, &cb = b.camera;
+    // A closed lens (radius 0) is a pinhole: the focal distance draws nothing (camera.cpp).
+    const bool lens = ca.lens_radius > 0 || cb.lens_radius > 0;
+    if (!(ca.position == cb.position) || !(ca.forward == cb.forward) || !(ca.right == cb.right) || !(ca.up == cb.up) ||
+        ca.tan_half_fov != cb.tan_half_fov || ca.aspect != cb.aspect || ca.lens_radius != cb.lens_radius ||
+        (lens && ca.focal_distance != cb.focal_distance))
+        return false;
+    const RendererSettings &ra = a.renderer, &rb = b.renderer;
+    return ra.type == rb.type && ra.width == rb.width && ra.height == rb.height && ra.samples == rb.samples &&
+           ra.depth == rb.depth && a.accel_backend == b.accel_backend && a.linear_scan == b.linear_scan;
+}
+
 RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings, const RenderScene* previous) {
     const std::string file = scene.source_file.string();
     auto warn = [&](const std::string& path, const std::string& message) {
@@ -164,8 +194,8 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
             const int existing = shape_sphere[prim.shape];
             const Primitive& first = scene.primitives[sphere_primitive[size_t(existing)]];
             const bool same_material = rs.materials[rs.sphere_material[existing]].id == scene.materials[prim.material].id;
-            const bool same_light = (prim.type == PrimitiveType::emissive) == (rs.sphere_light[existing] >= 0) &&
-                                    prim.light == first.light;
+            const bool emits = prim.type == PrimitiveType::emissive && active[size_t(prim.light)];
+            const bool same_light = emits == (rs.sphere_light[existing] >= 0) && (!emits || prim.light == first.light);
             if (first.shape == prim.shape) {
                 if (!same_material || !same_light)
                     warn(path, "shape " + in_quotes(shape.id) + " is already used by an earlier primitive; this one is ignored");
@@ -176,7 +206,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
                                   in_quotes(scene.shapes[first.shape].id) + "); rendered once, as the first";
             if (!same_material) message += "; its material " + in_quotes(scene.materials[prim.material].id) + " is left out";
             if (!same_light)
-                message += prim.type == PrimitiveType::emissive
+                message += emits
                                ? "; its light " + in_quotes(scene.lights[prim.light].id) + " does not emit"
                                : "; the first one's light emits";
             warn(path, message);
@@ -187,13 +217,12 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         rs.spheres.push_back({shape.centre, shape.radius});
         rs.sphere_material.push_back(use_material(prim.material));
         int light_index = -1;
-        if (prim.type == PrimitiveType::emissive) {
+        // An emissive primitive whose light is not in /scene/lights is switched off: its
+        // sphere stays, with its material, and emits nothing (the viewer's light checkbox).
+        if (prim.type == PrimitiveType::emissive && active[size_t(prim.light)]) {
             const Light& light = scene.lights[prim.light];
             light_index = static_cast<int>(rs.area_lights.size());
             rs.area_lights.push_back({static_cast<int>(rs.spheres.size()) - 1, light.power, 0});
-            if (!active[size_t(prim.light)])
-                warn(path + "/light", "light " + quote_user_text(light.id) +
-                                          " is not listed in /scene/lights; the primitive emits anyway");
             if (light.shape != prim.shape)
                 warn(path + "/shape", "differs from the shape of light " + quote_user_text(light.id) +
                                           "; the primitive's shape emits");

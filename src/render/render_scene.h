@@ -87,6 +87,13 @@ struct RenderScene {
     size_t light_count() const { return point_lights.size() + area_lights.size(); }
 };
 
+// Whether `a` and `b` render the same image (the same samples): their spheres, each sphere's
+// material parameters (not its id: a copy under a new name renders the same) and light, the
+// lights, the camera (a focal distance only where the lens is open) and the renderer block.
+// The viewer restarts its render only when an edit changes this. A member that changes the
+// samples joins it.
+bool renders_same(const RenderScene& a, const RenderScene& b);
+
 // A shadow segment towards a point light ends on that point, and the point may lie on a
 // surface (a light placed on a floor or wall). Rounding then puts the surface's crossing a
 // hair before or after the end, so shadows would speckle at random. is_occluded therefore

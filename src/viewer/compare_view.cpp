@@ -1,6 +1,7 @@
 #include "viewer/compare_view.h"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <utility>
 
@@ -37,7 +38,15 @@ std::optional<CompareFigures> compare_figures(const Rgb8Image& a, const Rgb8Imag
     // One pass over the values: the RMSE follows from the PSNR's mean squared error
     // (kr::psnr says 99 dB for identical images).
     const double db = psnr(a, b);
-    return CompareFigures{db, db == 99.0 ? 0.0 : std::pow(10.0, -db / 20)};
+    const bool identical = a.bytes == b.bytes;
+    return CompareFigures{db, identical ? 0.0 : std::pow(10.0, -db / 20), identical};
+}
+
+std::string format_psnr(const CompareFigures& figures) {
+    if (figures.identical) return "identical";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f dB", figures.psnr);
+    return text;
 }
 
 std::vector<float> pixel_errors(const Rgb8Image& a, const Rgb8Image& b, ErrorMetric metric) {

@@ -55,8 +55,11 @@ std::optional<std::filesystem::path> brief_reference_for(const std::filesystem::
 // values in [0, 1]. Nothing when the sizes differ.
 struct CompareFigures {
     double psnr = 0, rmse = 0;
+    bool identical = false;  // no pixel differs (kr::psnr's 99 dB stands for it in files)
 };
 std::optional<CompareFigures> compare_figures(const Rgb8Image& a, const Rgb8Image& b);
+// The PSNR as the window says it: "31.72 dB", or "identical" for equal images.
+std::string format_psnr(const CompareFigures& figures);
 
 // Per pixel, the error of a against b (same size) by `metric`.
 std::vector<float> pixel_errors(const Rgb8Image& a, const Rgb8Image& b, ErrorMetric metric);

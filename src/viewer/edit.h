@@ -52,4 +52,11 @@ using ToneSettings = DisplaySettings;
 std::optional<std::string> check_typed_value(std::string_view field, const double* values, int count, double lo,
                                              double hi);
 
+// A value from a widget that holds floats (ImGui's colour picker) as the shortest decimal that
+// reads back as that float: 0.9f is 0.9, not 0.8999999761581421, in the panel and the file.
+double shortest_decimal(float value);
+// The colour a float picker gave (`rgb`) over `before`: a component the picker left as it
+// was (the float of the old value) keeps the old value, a changed one is its shortest decimal.
+Color picked_colour(const Color& before, const float rgb[3]);
+
 }  // namespace kr::viewer

@@ -50,6 +50,20 @@ std::optional<PixelProbe> probe_pixel(const Snapshot& frame, int width, int heig
     return p;
 }
 
+std::string probe_line(const PixelProbe& p) {
+    char line[256];
+    if (p.earlier_view) {
+        std::snprintf(line, sizeof line, "pixel %d, %d   (an earlier view on screen: this view's frame is coming)", p.x,
+                      p.y);
+        return line;
+    }
+    const int n = std::snprintf(line, sizeof line, "pixel %d, %d   radiance %.4g %.4g %.4g   shown %d %d %d", p.x, p.y,
+                                p.mean.x, p.mean.y, p.mean.z, p.displayed[0], p.displayed[1], p.displayed[2]);
+    if (n > 0 && size_t(n) < sizeof line && !p.preview && std::isfinite(p.standard_error))
+        std::snprintf(line + n, sizeof line - size_t(n), "   %u samples, std. error %.3g", p.samples, p.standard_error);
+    return line;
+}
+
 double robust_scale(const std::vector<float>& values, double q) {
     std::vector<float> finite;
     finite.reserve(values.size());

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
@@ -36,7 +37,14 @@ struct PixelProbe {
     uint32_t samples = 0;              // samples accumulated (0 in a preview)
     double standard_error = 0;         // of the mean luminance; infinite below two samples
     bool preview = false;              // the frame is a low-resolution preview: no statistics
+    bool earlier_view = false;         // the frame is of an earlier view (the camera moved since):
+                                       // not this view's pixel (set by the caller, who knows)
 };
+
+// The probe as one line (the status bar's): pixel, radiance, shown value, and its samples and
+// standard error where the frame has them; a frame of an earlier view gives no figures, it
+// says that this view's frame is coming.
+std::string probe_line(const PixelProbe& p);
 
 // The pixel (x, y) of `frame` (full-resolution coordinates; a preview's pixel covering it),
 // or nothing outside the image. Its mean is the raw estimate's; its displayed value is that

@@ -1,6 +1,7 @@
 #include "viewer/model.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -43,6 +44,32 @@ std::string without_view(Scene scene) {
     }
     scene.camera = 0;
     return scene_to_json(scene);
+}
+
+// Whether two render settings draw the same samples (every member: one that joins
+// RenderSettings joins this).
+bool same_sampling(const RenderSettings& a, const RenderSettings& b) {
+    return a.integrator == b.integrator && a.estimator == b.estimator && a.allocation == b.allocation &&
+           a.light_sampling == b.light_sampling && a.max_depth == b.max_depth && a.target_spp == b.target_spp &&
+           a.rr_depth == b.rr_depth && a.seed == b.seed && a.kernels == b.kernels;
+}
+
+bool same_camera(const Camera& a, const Camera& b) {
+    return a.id == b.id && a.type == b.type && a.fov == b.fov && a.aspect == b.aspect && a.distance == b.distance &&
+           a.position == b.position && a.target == b.target && a.focal_distance == b.focal_distance && a.alpha == b.alpha;
+}
+
+// Whether an edit of `kind` left the authored scene as it was: a camera or lens edit changes
+// only the cameras (compared member by member: cheap, as a drag repeats its step each frame);
+// any other is compared as saved.
+bool unchanged(Edit kind, const Scene& a, const Scene& b) {
+    if (kind == Edit::camera || kind == Edit::lens) {
+        if (a.camera != b.camera || a.cameras.size() != b.cameras.size()) return false;
+        for (size_t i = 0; i < a.cameras.size(); ++i)
+            if (!same_camera(a.cameras[i], b.cameras[i])) return false;
+        return true;
+    }
+    return scene_to_json(a) == scene_to_json(b);
 }
 
 }  // namespace
@@ -137,6 +164,14 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
             return false;
         }
     }
+    // An edit of the scene that leaves what the render sees as it was (a new material that is
+    // a copy of the old, a focal distance with the aperture closed) keeps the samples: the
+    // render scene is taken (its ids are the panels'), the generation stays.
+    const bool same_image = resets && prepared_ && prepared && kind != Edit::renderer && kind != Edit::scene &&
+                            renders_same(*prepared_, *prepared) && same_sampling(settings.render, settings_.render);
+    // Nothing changed at all (a drag held still repeats its step every frame, a step stopped
+    // at a surface): no undo step, no unsaved edit, the samples kept.
+    if (same_image && unchanged(kind, scene, scene_)) return true;
     if (!prepared_) {
         // No scene yet (the command line's settings before the first load, or a broken
         // starting scene): nothing the user edited, nothing to undo or to save.
@@ -160,7 +195,10 @@ bool ViewerModel::edit(Edit kind, const std::function<void(Scene&, ViewerSetting
     }
     scene_ = std::move(scene);
     settings_ = settings;
-    if (resets) {
+    if (resets && same_image) {
+        prepared_ = std::move(prepared);
+        warnings_ = std::move(warnings);
+    } else if (resets) {
         prepared_ = std::move(prepared);
         warnings_ = std::move(warnings);
         // A camera edit keeps the base of the camera edits before it; any other starts anew.
@@ -177,9 +215,11 @@ void ViewerModel::restore(State& state, std::vector<State>& push_to) {
     if (state.resets) {
         std::vector<std::string> warnings;
         // Every state on the stacks was prepared once, so this succeeds.
-        prepared_ = prepare(state.scene, &warnings, prepared_.get());
+        auto prepared = prepare(state.scene, &warnings, prepared_.get());
+        const bool same_image = renders_same(*prepared_, *prepared) && same_sampling(state.settings.render, settings_.render);
+        prepared_ = std::move(prepared);
         warnings_ = std::move(warnings);
-        view_base_generation_ = ++generation_;
+        if (!same_image) view_base_generation_ = ++generation_;
     }
     const bool paused = settings_.paused;
     scene_ = std::move(state.scene);
@@ -271,6 +311,23 @@ Scene ViewerModel::scene_for_saving() const {
     // What the window shows, as `render` reads it back: the split view saves denoised, as Save does.
     scene.display.denoise = settings_.denoise != DenoiseView::off ? Denoise::on : Denoise::off;
     return scene;
+}
+
+double shortest_decimal(float value) {
+    // to_chars without a precision writes the shortest text that parses back to the same float.
+    char text[64];
+    const auto [end, ec] = std::to_chars(text, text + sizeof text, value);
+    if (ec != std::errc()) return double(value);
+    double out = double(value);
+    std::from_chars(text, end, out);
+    return out;
+}
+
+Color picked_colour(const Color& before, const float rgb[3]) {
+    double out[3] = {before.x, before.y, before.z};
+    for (int i = 0; i < 3; ++i)
+        if (rgb[i] != float(out[i])) out[i] = shortest_decimal(rgb[i]);
+    return Color(out[0], out[1], out[2]);
 }
 
 std::optional<std::string> check_typed_value(std::string_view field, const double* values, int count, double lo,

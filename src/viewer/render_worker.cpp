@@ -430,14 +430,19 @@ void RenderWorker::run() {
         };
         std::shared_ptr<const Snapshot> republish;
         bool publish_estimate = false;  // a frame of passes already taken (paused, stopped)
+        // A pause holds the passes once the job has a full-resolution frame: one that comes
+        // during the previews (or with an edit) still brings the picture to its first full
+        // frame, never a frozen preview (under the lock).
+        auto refining = [&] { return driver && !(paused_ && full_frame_made) && !stop_reason(); };
+        bool skip_previews = false;
         {
             std::unique_lock lock(mutex_);
             changed_.wait(lock, [&] {
-                return quit_ || pending_ || (driver && !paused_ && !stop_reason()) || features_due() ||
+                return quit_ || pending_ || refining() || features_due() ||
                        (driver && unpublished);
             });
             if (quit_) return;
-            if (!pending_ && !(driver && !paused_ && !stop_reason())) {
+            if (!pending_ && !refining()) {
                 if (unpublished) publish_estimate = true;
                 else republish = latest_;
             }
@@ -476,8 +481,8 @@ void RenderWorker::run() {
                 job_rays = job_nonfinite = 0;
                 previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
-                if (paused_) continue;  // an edit while paused shows nothing new until resumed
             }
+            skip_previews = paused_;
             rule = rule_;
             region.region = region_;
         }
@@ -505,13 +510,14 @@ void RenderWorker::run() {
         if (publish_estimate) {
             // The passes since the last frame, now that no pass follows them (paused, or a
             // stop rule met): made below.
-        } else if (next_preview < previews.size()) {
+        } else if (next_preview < previews.size() && !skip_previews) {
             const int scale = previews[next_preview];
             ++next_preview;
             // Not stopped by an edit: a preview is short by design (preview_scales), and during a
             // drag, edits coming faster than previews would otherwise leave the window none.
             make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame);
         } else {
+            next_preview = previews.size();  // paused: straight to the full frame
             const auto start = Clock::now();
             if (ranks_) {
                 // Every rank runs the pass to its end: they exchange rows after it.

@@ -254,7 +254,9 @@ public:
     // scratch, low-resolution previews first.
     void submit(RenderJob job);
     // Neither resets the estimate. Pausing takes effect at the end of the running pass,
-    // so the accumulated passes stay whole (and the image deterministic).
+    // so the accumulated passes stay whole (and the image deterministic), and not before the
+    // job has a full-resolution frame: a pause during the previews (or an edit while paused)
+    // skips the previews left and stops after the first full pass's frame.
     void set_paused(bool paused);
     // A new stop rule for the running estimate: it keeps its samples and refines on to the
     // new pass limit (kUnlimitedPasses: none), for the rule's seconds of full-resolution

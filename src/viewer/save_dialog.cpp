@@ -43,7 +43,7 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
 }  // namespace
 
 bool scene_file_read_only(const fs::path& file, const std::optional<DataDir>& data) {
-    if (data && data->installed && path_inside(file, data->path)) return true;
+    if (data && path_inside(file, data->path)) return true;
     std::error_code ec;
     return fs::exists(file, ec) && ::access(file.c_str(), W_OK) != 0;
 }

@@ -41,8 +41,9 @@ struct SavePaths {
     static SavePaths for_scene(const Scene& scene, bool read_only = false);
 };
 
-// Whether the viewer must not save over `file`: a scene of the install tree's bundled files
-// (`data`, core/data_dir.h), or a file this process cannot write.
+// Whether the viewer must not save over `file`: a bundled scene (`data`, core/data_dir.h: the
+// install tree's share/keithray or a build's res/, the brief's scenes and the examples, which
+// open as they ship and are saved elsewhere), or a file this process cannot write.
 bool scene_file_read_only(const std::filesystem::path& file, const std::optional<DataDir>& data);
 
 // The image kind an output named `path` is (its format, core/image_formats.h).

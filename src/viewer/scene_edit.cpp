@@ -2,7 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
+#include <string>
+
+#include "core/text.h"
 
 namespace kr::viewer {
 
@@ -11,6 +16,50 @@ void set_light_on(Scene& scene, int index, bool on) {
     const auto it = std::find(active.begin(), active.end(), index);
     if (on && it == active.end()) active.push_back(index);
     if (!on && it != active.end()) active.erase(it);
+}
+
+std::string light_unseen_reason(const Scene& scene, int index) {
+    const Light& light = scene.lights[size_t(index)];
+    if (!(max_component(light.power) > 0)) return "its power is 0: it emits nothing";
+    // The point (or sphere) that emits, and the primitive that carries an area light.
+    Vec3 at = light.position;
+    double radius = 0;
+    int carrier = -1;
+    if (light.type == LightType::area) {
+        for (size_t i = 0; i < scene.primitives.size() && carrier < 0; ++i)
+            if (scene.primitives[i].type == PrimitiveType::emissive && scene.primitives[i].light == index)
+                carrier = int(i);
+        if (carrier < 0) return "no primitive of the scene carries it: it emits nothing";
+        const Shape& s = scene.shapes[size_t(scene.primitives[size_t(carrier)].shape)];
+        at = s.centre;
+        radius = s.radius;
+    }
+    const Vec3 eye = scene.cameras.empty() ? Vec3(0, 0, 0) : scene.cameras[size_t(scene.camera)].position;
+    for (size_t i = 0; i < scene.primitives.size(); ++i) {
+        if (int(i) == carrier) continue;
+        const Shape& s = scene.shapes[size_t(scene.primitives[i].shape)];
+        const bool holds_light = length(at - s.centre) + radius < s.radius;
+        const bool holds_eye = length(eye - s.centre) < s.radius;
+        if (holds_light && !holds_eye)
+            return "it is inside the sphere of " + quote_user_text(scene.primitives[i].id) +
+                   ", which the camera is outside: its light does not leave that sphere";
+    }
+    return {};
+}
+
+std::string primitive_label(const Scene& scene, int p) {
+    const Primitive& prim = scene.primitives[size_t(p)];
+    std::string label = prim.id;
+    if (prim.shape >= 0 && scene.shapes[size_t(prim.shape)].id != prim.id)
+        label += " (shape " + scene.shapes[size_t(prim.shape)].id + ")";
+    if (prim.type == PrimitiveType::emissive) label += ", emissive";
+    return label;
+}
+
+std::string light_label(const Light& light) {
+    const std::string type(light_type_names.name(light.type));
+    if (light.id.find(type) != std::string::npos) return light.id;
+    return light.id + " (" + type + " light)";
 }
 
 std::optional<int> pick_primitive(const Scene& scene, const CameraModel& camera, double fx, double fy) {
@@ -199,6 +248,39 @@ int add_sphere(Scene& scene, const Vec3& centre, double radius) {
     return int(scene.primitives.size()) - 1;
 }
 
+SpherePlace free_sphere_place(const Scene& scene, const Vec3& eye, const Vec3& target, double radius) {
+    // The room a point has: its distance to the nearest surface of the scene's spheres (from
+    // outside, or from inside one that holds the eye too) and to the lights' points; 0 inside
+    // a sphere that does not hold the eye.
+    auto room = [&](const Vec3& c) {
+        double free = std::numeric_limits<double>::infinity();
+        for (const Primitive& prim : scene.primitives) {
+            const Shape& s = scene.shapes[size_t(prim.shape)];
+            const double d = length(c - s.centre);
+            if (d >= s.radius) free = std::min(free, d - s.radius);
+            else if (length(eye - s.centre) < s.radius) free = std::min(free, s.radius - d);
+            else return 0.0;
+        }
+        for (int l : scene.active_lights) {
+            const Light& light = scene.lights[size_t(l)];
+            if (light.type == LightType::point) free = std::min(free, length(c - light.position));
+        }
+        return free;
+    };
+    // From the target back towards the eye, the first point with room for the sphere, else
+    // the one with the most room (at least a quarter of the radius).
+    constexpr int kSteps = 64;
+    SpherePlace best{target, 0};
+    for (int k = 0; k < kSteps; ++k) {
+        const Vec3 c = target + (eye - target) * (double(k) / kSteps);
+        const double fit = 0.9 * room(c);
+        if (fit >= radius) return {c, radius};
+        if (fit > best.radius) best = {c, fit};
+    }
+    if (best.radius >= 0.25 * radius) return best;
+    return {target, radius};
+}
+
 void new_material_for(Scene& scene, int p) {
     Primitive& prim = scene.primitives[size_t(p)];
     Material copy = prim.material >= 0 ? scene.materials[size_t(prim.material)] : Material{};
@@ -226,6 +308,15 @@ void set_emissive(Scene& scene, int p, bool emissive, const Color& power) {
     prim.type = PrimitiveType::emissive;
     prim.light = int(scene.lights.size()) - 1;
     set_light_on(scene, prim.light, true);
+}
+
+std::string focus_message(const Camera& camera) {
+    char distance[64];
+    std::snprintf(distance, sizeof distance, "%.4g", camera.focal_distance);
+    std::string message = std::string("focused at distance ") + distance;
+    if (!(camera.alpha > 0))
+        message += "; the aperture is 0, so every distance is sharp: open it (Lens panel, aperture) to see the focus";
+    return message;
 }
 
 void copy_view(const Camera& from, Camera& to) {
@@ -259,6 +350,16 @@ bool recall_bookmark(Scene& scene, int n) {
     if (at < 0) return false;
     copy_view(scene.cameras[size_t(at)], scene.cameras[size_t(scene.camera)]);
     return true;
+}
+
+Color join_power(const ColourStrength& cs) {
+    auto decimal = [](double v) {
+        char text[40];
+        std::snprintf(text, sizeof text, "%.15g", v);
+        return std::strtod(text, nullptr);
+    };
+    const Color p = cs.colour * cs.strength;
+    return Color(decimal(p.x), decimal(p.y), decimal(p.z));
 }
 
 ColourStrength split_power(const Color& power) {

@@ -18,6 +18,21 @@ namespace kr::viewer {
 // Turns light `index` of the file on (into the scene block's lights) or off.
 void set_light_on(Scene& scene, int index, bool on);
 
+// Why light `index` of the file, switched on, adds nothing the camera can see; empty when it
+// may. A point light of power 0, or one inside a rendered sphere that does not hold the
+// camera (shadow rays do not cross a sphere, so it lights only that sphere's inside); an area
+// light of power 0, carried by no rendered primitive, or whose sphere lies wholly inside such
+// a sphere.
+std::string light_unseen_reason(const Scene& scene, int index);
+
+// A primitive as the panels name it: its id, then its shape's where that differs
+// ("sphere 01", "ball (shape sphere 3)"), and "emissive" where it is.
+std::string primitive_label(const Scene& scene, int p);
+
+// A light as the panels name it: its id, with its type where the id does not say it
+// ("area light", "lamp (area light)").
+std::string light_label(const Light& light);
+
 // The primitive whose sphere the pinhole ray through image point (fx, fy) in [0,1)^2 hits
 // first, if any.
 std::optional<int> pick_primitive(const Scene& scene, const CameraModel& camera, double fx, double fy);
@@ -71,11 +86,25 @@ void delete_primitive(Scene& scene, int p);
 // A new diffuse sphere at `centre` of `radius` (a new grey material when the file has no
 // diffuse one); returns its index.
 int add_sphere(Scene& scene, const Vec3& centre, double radius);
+// Where a new sphere of about `radius` goes on the line of sight from `eye` to `target`: the
+// point nearest the target where it overlaps no sphere of the scene block (one holding the
+// eye, a room's shell, counts from its inside) and holds no light, its radius shrunk to fit
+// there when it must (to no less than a quarter); the target as asked when no point of the
+// line has room.
+struct SpherePlace {
+    Vec3 centre;
+    double radius = 1;
+};
+SpherePlace free_sphere_place(const Scene& scene, const Vec3& eye, const Vec3& target, double radius);
 // Primitive `p` with a new material: a copy of its current one under a new id.
 void new_material_for(Scene& scene, int p);
 // Makes primitive `p` emissive with a new area light of `power` (on), or geometric again
 // (its light goes out of the scene block).
 void set_emissive(Scene& scene, int p, bool emissive, const Color& power = Color(5));
+
+// What a click-to-focus says: the focal distance set, and, where the aperture is closed
+// (alpha 0: every distance is sharp, the image unchanged), how to see the focus.
+std::string focus_message(const Camera& camera);
 
 // The view of a camera (position, target, fov, aspect), copied onto another; its lens stays.
 void copy_view(const Camera& from, Camera& to);
@@ -97,6 +126,7 @@ struct ColourStrength {
     double strength = 0;
 };
 ColourStrength split_power(const Color& power);
-inline Color join_power(const ColourStrength& cs) { return cs.colour * cs.strength; }
+// Each component to 15 significant digits: 0.9 x 30 is 27, not 27.000000000000004.
+Color join_power(const ColourStrength& cs);
 
 }  // namespace kr::viewer

@@ -68,6 +68,25 @@ std::optional<RegionStatus> region_status(const Snapshot& frame, const PixelBox&
     return r;
 }
 
+std::vector<bool> fit_status_fields(const std::vector<StatusField>& fields, double available, double spacing) {
+    // The most important first (priority 0 always), each taken where it still fits: a field
+    // too wide for what is left gives way, a smaller less important one may still show.
+    std::vector<size_t> order(fields.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return fields[a].priority < fields[b].priority; });
+    std::vector<bool> shown(fields.size(), false);
+    double used = 0;
+    int n = 0;
+    for (size_t i : order) {
+        const double need = fields[i].width + (n > 0 ? spacing : 0);
+        if (fields[i].priority > 0 && used + need > available) continue;
+        shown[i] = true;
+        used += need;
+        ++n;
+    }
+    return shown;
+}
+
 std::string format_noise(double noise) {
     char buf[32];
     const double percent = 100 * noise;

@@ -48,6 +48,17 @@ struct RegionStatus {
 };
 std::optional<RegionStatus> region_status(const Snapshot& frame, const PixelBox& box);
 
+// The status bar's first line is a row of fields, each of a width that holds its widest
+// figure (so nothing moves as the figures change) and a priority (0: always shown). Where the
+// window is too narrow for all, the fields of the largest priority number go first, so the
+// state, the spp, the noise and the PSNR stay legible at any width; a less important field
+// that still fits in what is left shows. Which fields show.
+struct StatusField {
+    double width = 0;
+    int priority = 0;
+};
+std::vector<bool> fit_status_fields(const std::vector<StatusField>& fields, double available, double spacing);
+
 // The noise estimate in the status bar, at most 9 characters: "5.61%", "0.0123%", "< 0.001%".
 std::string format_noise(double noise);
 

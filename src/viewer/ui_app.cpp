@@ -77,11 +77,11 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
             !problem.empty())
             throw std::runtime_error(problem + "; nothing opened or written");
     ui_.files.watch.watch(options_.scene);
-    // A bundled scene of the install tree is never saved over: Save asks where (ui_panel_save.cpp).
+    // A bundled scene (install tree or res/) is never saved over: Save asks where (ui_panel_save.cpp).
     ui_.save.read_only = scene_file_read_only(options_.scene, data_dir());
     if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene(), ui_.save.read_only);
     if (model_.has_scene() && ui_.save.read_only)
-        messages_.show_status("the scene's file is read-only (a bundled scene): Save asks where to save a copy");
+        messages_.show_status("a bundled scene, opened as it ships: Save asks where to save your copy");
     CompareTool& tool = ui_.compare;
     tool.comparison.settings = options_.compare;
     tool.locked_probe = options_.probe;
@@ -350,14 +350,15 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     char line[1000];
     std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
-                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s psnr=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
+                  "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s psnr=%s bar=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
                   "feature=%s draft=%s question=%s grab=%d camera=%s\n",
                   std::string(run_state_names.name(status.state)).c_str(), status.spp, status.target,
                   static_cast<unsigned long long>(model_.generation()), shown, int(model_.dirty()), int(ui_.help_visible),
                   int(ui_.panel_visible), input_.pressed_bits(), int(std::lround(io.MousePos.x)),
                   int(std::lround(io.MousePos.y)), std::string(view_mode_names.name(tool.comparison.settings.mode)).c_str(),
                   tool.comparison.settings.split, rect.x, rect.y, tool.view.fitted() ? "fit" : "",
-                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, psnr, int(ui_.nav.fly),
+                  model_.has_scene() ? rect.width / model_.scene().renderer.width : 0.0, probe, b, psnr,
+                  ui_.status_fields.empty() ? "none" : ui_.status_fields.c_str(), int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
                   feature.c_str(), draft, open_question(), int(input_.grab.has_value()), camera);
     if (line == status_line_ || status_file_failed_) return;
@@ -409,9 +410,24 @@ void ViewerApp::draw_panels() {
 // asserts when a window appears after a modal in the modal's first frame (Esc then F1
 // reaching one frame on a busy machine opened the quit question, then the help: an abort).
 void ViewerApp::draw_questions(bool cancel, bool confirm) {
-    if (quit_popup(quit_asked_, cancel)) glfwSetWindowShouldClose(window_, GLFW_TRUE);
-    discard_popup(ctx_, cancel);
-    overwrite_popup(ctx_, cancel, confirm);
+    const QuitAnswer answer = quit_popup(quit_asked_, cancel, confirm, ui_.save.read_only);
+    if (answer == QuitAnswer::quit) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+    if (answer == QuitAnswer::save_and_quit) {
+        save_scene_in_place(ctx_);  // a bundled scene's asks where: the quit waits for it
+        quit_after_save_ = true;
+    }
+    // A key that answered the quit question answers nothing else (the save-where question it
+    // opens waits for its own).
+    const bool answered = answer != QuitAnswer::none;
+    discard_popup(ctx_, cancel && !answered);
+    overwrite_popup(ctx_, cancel && !answered, confirm && !answered);
+    if (quit_after_save_) {
+        // Saved: quit. Still asking (where, overwrite): wait. Else the save failed or was
+        // cancelled (its message in the status bar): stay.
+        const bool asking = ui_.save.ask_where || ui_.save.ask_overwrite || std::string_view(open_question()) != "none";
+        if (!model_.dirty()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
+        if (!model_.dirty() || !asking) quit_after_save_ = false;
+    }
 }
 
 bool ViewerApp::draw_frame() {

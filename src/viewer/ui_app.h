@@ -93,6 +93,7 @@ private:
     bool failed_ = false;              // a write of --status-file or a render failed: the run exits 1
     bool status_file_failed_ = false;  // said once, not tried again
     bool quit_asked_ = false;  // the quit question is wanted
+    bool quit_after_save_ = false;  // "Save and quit" answered: quit once the scene is saved
     uint64_t inside_checked_generation_ = 0;  // ui_.inside_sphere is this generation's
     int settle_frames_ = 0;   // frames still to draw after input, so ImGui settles
     bool input_seen_ = false; // set by the GLFW callbacks

@@ -46,8 +46,11 @@ std::optional<PixelProbe> probe(const PanelContext& ctx, int x, int y) {
     const Snapshot* shown = ctx.ui.shown.get();
     const ViewerModel& model = ctx.model;
     if (!shown || !model.has_scene()) return std::nullopt;
-    return probe_pixel(*shown, model.scene().renderer.width, model.scene().renderer.height, x, y,
-                       model.settings().tone, ctx.ui.compare.linear_scale, model.settings().denoise);
+    auto p = probe_pixel(*shown, model.scene().renderer.width, model.scene().renderer.height, x, y,
+                         model.settings().tone, ctx.ui.compare.linear_scale, model.settings().denoise);
+    // Right after an orbit the frame on screen is an earlier view's (shows_earlier_view).
+    if (p) p->earlier_view = shown->generation != model.generation();
+    return p;
 }
 
 StatsFigures stats_figures(const PanelContext& ctx) {
@@ -314,16 +317,18 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
     const auto p = probe(ctx, int(std::floor((mx - rect.x) / scale)), int(std::floor((my - rect.y) / scale)));
     if (!p) return;
     // One line for the status bar; the box at the pointer only when asked for (I).
-    char line[256];
-    const int n = std::snprintf(line, sizeof line, "pixel %d, %d   radiance %.4g %.4g %.4g   shown %d %d %d", p->x, p->y,
-                                p->mean.x, p->mean.y, p->mean.z, p->displayed[0], p->displayed[1], p->displayed[2]);
-    if (n > 0 && size_t(n) < sizeof line && !p->preview && std::isfinite(p->standard_error))
-        std::snprintf(line + n, sizeof line - size_t(n), "   %u samples, std. error %.3g", p->samples, p->standard_error);
+    const std::string line = probe_line(*p);
     // The feature view's layer at the pixel.
-    const std::string& feature = tool.hover_feature = feature_readout(*ctx.ui.shown, mode, p->x, p->y);
-    tool.hover_text = feature.empty() ? std::string(line) : std::string(line) + "   " + feature;
+    const std::string& feature = tool.hover_feature =
+        p->earlier_view ? std::string() : feature_readout(*ctx.ui.shown, mode, p->x, p->y);
+    tool.hover_text = feature.empty() ? line : line + "   " + feature;
     if (!tool.probe_box) return;
     ImGui::BeginTooltip();
+    if (p->earlier_view) {
+        ImGui::TextUnformatted(line.c_str());
+        ImGui::EndTooltip();
+        return;
+    }
     ImGui::Text("pixel %d, %d", p->x, p->y);
     ImGui::Text("radiance %.4g %.4g %.4g", p->mean.x, p->mean.y, p->mean.z);
     ImGui::Text("shown    %d %d %d", p->displayed[0], p->displayed[1], p->displayed[2]);

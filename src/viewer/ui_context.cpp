@@ -85,7 +85,10 @@ void add_sphere_at_target(PanelContext& ctx) {
     int added = -1;
     const Camera cam = ctx.model.camera();
     ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) {
-        added = add_sphere(s, cam.target, std::max(1e-3, 0.05 * length(cam.target - cam.position)));
+        // At the target, or nearer on the line of sight where that is inside a sphere or a light.
+        const SpherePlace at =
+            free_sphere_place(s, cam.position, cam.target, std::max(1e-3, 0.05 * length(cam.target - cam.position)));
+        added = add_sphere(s, at.centre, at.radius);
     }, "add sphere");
     if (added >= 0) ctx.ui.selected = added;
 }
@@ -112,7 +115,7 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
             ctx.ui.save.read_only = scene_file_read_only(file, data_dir());
             ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene(), ctx.ui.save.read_only);
             if (ctx.ui.save.read_only)
-                ctx.messages.show_status("the scene's file is read-only (a bundled scene): Save asks where to save a copy");
+                ctx.messages.show_status("a bundled scene, opened as it ships: Save asks where to save your copy");
             // The brief's reference follows the scene; one the user chose stays.
             CompareTool& tool = ctx.ui.compare;
             if (tool.reference_automatic || !tool.comparison.reference()) {

@@ -135,6 +135,7 @@ struct UiState {
     bool pick_focus = false;                 // the next click on the image focuses the lens
     NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
     std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
+    std::string status_fields;               // the status bar's fields shown ("state,spp,...": the status file's bar=)
     int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
     // Where the selection is seen (sphere_coverage), for its tint where its outline is off
     // the image; computed again when the generation or the selection changes.

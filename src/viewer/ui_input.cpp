@@ -236,6 +236,7 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             in.drags[0].release();  // a focus click, never an orbit
             const Vec2 film = raster_to_camera((px - rect.x) / rect.width * w, (py - rect.y) / rect.height * h, w, h);
             if (!model.focus_at(film.x, film.y)) ctx.messages.show_error("click-to-focus: nothing there to focus on");
+            else ctx.messages.show_status(focus_message(model.camera()));
             ctx.ui.pick_focus = false;
         }
         if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {

@@ -2,9 +2,11 @@
 // flashed at the pointer, and the quit and discard questions.
 #include "viewer/ui_overlays.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -70,18 +72,23 @@ void draw_status_bar(PanelContext& ctx) {
                      ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoBringToFrontOnFocus);
     const Snapshot* current = ctx.frame();
     const RunStatus st = run_status(current, ctx.model.settings(), !ctx.model.has_scene(), ctx.shows_earlier_view());
-    // Line 1: state, spp, progress with ETA, elapsed, Mrays/s, noise. Fixed-width fields, so
-    // nothing moves as the figures change.
+    // Line 1: state, spp, progress with ETA, elapsed, Mrays/s, noise, PSNR: fields of fixed
+    // widths (their widest figures), so nothing moves as the figures change; where the window
+    // is narrow, the least important go (fit_status_fields).
     static const ImVec4 kStateColours[] = {{0.8f, 0.8f, 0.8f, 1}, {0.5f, 0.8f, 1, 1}, {0.5f, 0.8f, 1, 1},
                                            {1, 0.8f, 0.3f, 1},     {0.4f, 0.9f, 0.4f, 1}, {1, 0.4f, 0.4f, 1}};
     static_assert(std::size(kStateColours) == run_state_names.names.size());
-    ImGui::AlignTextToFramePadding();
-    ImGui::TextColored(kStateColours[size_t(st.state)], "%-9s", std::string(run_state_names.name(st.state)).c_str());
-    ImGui::SameLine(90);
+    auto text_width = [](const std::string& s) { return double(ImGui::CalcTextSize(s.c_str()).x); };
     const std::string shown(current ? shown_word(*current, ctx.model.settings().denoise) : "");
-    if (st.unlimited) ImGui::Text("%d spp (unlimited) %s", st.spp, shown.c_str());
-    else ImGui::Text("%d / %d spp %s", st.spp, st.target, shown.c_str());
-    ImGui::SameLine(240);
+    char text[128];
+    if (st.unlimited) std::snprintf(text, sizeof text, "%d spp (unlimited) %s", st.spp, shown.c_str());
+    else std::snprintf(text, sizeof text, "%d / %d spp %s", st.spp, st.target, shown.c_str());
+    const std::string spp = text;
+    // Its widest: the spp as many digits as the target (at least 3), the longest word.
+    const int digits = int(std::to_string(std::max({st.target, st.spp, 999})).size());
+    const std::string wide_number(size_t(digits), '8');
+    const std::string spp_wide = st.unlimited ? wide_number + " spp (unlimited) denoised"
+                                              : wide_number + " / " + wide_number + " spp denoised";
     char overlay[64] = "";
     if (st.progress >= 0) {
         if (st.state == RunState::done) std::snprintf(overlay, sizeof overlay, "done (%s)", st.rule.c_str());
@@ -94,37 +101,73 @@ void draw_status_bar(PanelContext& ctx) {
     } else {
         std::snprintf(overlay, sizeof overlay, "unlimited: no stop rule");
     }
-    ImGui::ProgressBar(st.progress >= 0 ? float(st.progress) : 0.0f, ImVec2(220, 0), overlay);
-    ImGui::SameLine(480);
-    ImGui::Text("%s", st.preview ? "preview" : format_duration(st.elapsed).c_str());
-    ImGui::SameLine(560);
-    ImGui::Text("%.2f Mrays/s", st.mrays_per_second);
-    ImGui::SameLine(680);
-    // A fixed width, so the figure after it never runs into it. With a render region, the
-    // region's own samples and noise instead (the whole image's in the tooltip): the spp and
-    // the stop rules count the whole image.
+    const std::string elapsed = st.preview ? "preview" : format_duration(st.elapsed);
+    std::snprintf(text, sizeof text, "%.2f Mrays/s", st.mrays_per_second);
+    const std::string rate = text;
+    // With a render region, the region's own samples and noise instead (the whole image's in
+    // the tooltip): the spp and the stop rules count the whole image.
     std::optional<RegionStatus> region;
     if (ctx.ui.region && current) region = region_status(*current, *ctx.ui.region);
     const std::string noise = st.noise >= 0 ? "noise " + format_noise(st.noise) : "noise: needs 2 spp";
+    std::string noise_text = noise;
     if (region) {
         const std::string region_noise = region->noise >= 0 ? format_noise(region->noise) : "needs 2 spp";
-        ImGui::TextColored(ImVec4(0, 0.86f, 1, 1), "region %.4g spp, noise %s", region->samples_per_pixel,
-                           region_noise.c_str());
-        if (ImGui::IsItemHovered())
-            ImGui::SetTooltip("the render region's pixels: mean samples, estimated relative error\n"
-                              "the whole image (the spp and the stop rules count it): %s", noise.c_str());
-    } else if (st.noise >= 0) {
-        ImGui::TextUnformatted(noise.c_str());
-    } else {
-        ImGui::TextDisabled("%s", noise.c_str());
+        std::snprintf(text, sizeof text, "region %.4g spp, noise %s", region->samples_per_pixel, region_noise.c_str());
+        noise_text = text;
     }
     const std::optional<CompareFigures>& figures = ctx.ui.compare.figures;
-    if (figures && current) {
-        // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
-        if (region) ImGui::SameLine(0, 24);
-        else ImGui::SameLine(800);
-        ImGui::Text("vs B %.2f dB", figures->psnr);
+    // Against image B (the reference, or a kept snapshot), as `keithray psnr` computes it.
+    const std::string psnr = figures && current ? "vs B " + format_psnr(*figures) : "";
+    enum Field { state, spp_field, progress, time, mrays, noise_field, psnr_field };
+    const double spacing = ImGui::GetStyle().ItemSpacing.x * 2;
+    const std::vector<StatusField> fields = {
+        {text_width("rendering"), 0},
+        {text_width(spp_wide), 0},
+        {std::max(120.0, text_width("ETA 59m59s (noise)") + 16), 2},
+        {text_width("59m59s"), 3},
+        {text_width("99999.99 Mrays/s"), 4},
+        {text_width(region ? "region 99999 spp, noise needs 2 spp" : "noise: needs 2 spp"), 1},
+        {psnr.empty() ? 0.0 : text_width("vs B identical"), 1},
+    };
+    const std::vector<bool> show = fit_status_fields(fields, io.DisplaySize.x - 2 * ImGui::GetStyle().WindowPadding.x, spacing);
+    static constexpr const char* kFieldNames[] = {"state", "spp", "progress", "time", "rate", "noise", "psnr"};
+    ctx.ui.status_fields.clear();
+    for (size_t i = 0; i < show.size(); ++i)
+        if (show[i] && (i != size_t(psnr_field) || !psnr.empty()))
+            ctx.ui.status_fields += (ctx.ui.status_fields.empty() ? "" : ",") + std::string(kFieldNames[i]);
+    ImGui::AlignTextToFramePadding();
+    double x = ImGui::GetCursorPosX();
+    bool first = true;
+    auto place = [&](Field f) {
+        if (!show[size_t(f)]) return false;
+        if (!first) ImGui::SameLine(float(x));
+        first = false;
+        x += fields[size_t(f)].width + spacing;
+        return true;
+    };
+    if (place(state)) ImGui::TextColored(kStateColours[size_t(st.state)], "%s", std::string(run_state_names.name(st.state)).c_str());
+    if (place(spp_field)) ImGui::TextUnformatted(spp.c_str());
+    if (place(progress)) {
+        // A dark fill under the light overlay text: legible over the filled part too.
+        ImGui::PushStyleColor(ImGuiCol_PlotHistogram, ImVec4(0.16f, 0.42f, 0.62f, 1));
+        ImGui::ProgressBar(st.progress >= 0 ? float(st.progress) : 0.0f, ImVec2(float(fields[progress].width), 0), overlay);
+        ImGui::PopStyleColor();
     }
+    if (place(time)) ImGui::TextUnformatted(elapsed.c_str());
+    if (place(mrays)) ImGui::TextUnformatted(rate.c_str());
+    if (place(noise_field)) {
+        if (region) {
+            ImGui::TextColored(ImVec4(0, 0.86f, 1, 1), "%s", noise_text.c_str());
+            if (ImGui::IsItemHovered())
+                ImGui::SetTooltip("the render region's pixels: mean samples, estimated relative error\n"
+                                  "the whole image (the spp and the stop rules count it): %s", noise.c_str());
+        } else if (st.noise >= 0) {
+            ImGui::TextUnformatted(noise.c_str());
+        } else {
+            ImGui::TextDisabled("%s", noise.c_str());
+        }
+    }
+    if (!psnr.empty() && place(psnr_field)) ImGui::TextUnformatted(psnr.c_str());
     // Line 2: one message, the most important first; full text on hover.
     const std::string* message = nullptr;
     ImVec4 colour(0.85f, 0.85f, 0.85f, 1);
@@ -190,20 +233,28 @@ void draw_help(UiState& ui) {
     ImGui::End();
 }
 
-bool quit_popup(bool& asked, bool cancel) {
+QuitAnswer quit_popup(bool& asked, bool cancel, bool confirm, bool save_asks_where) {
     if (asked) {
         ImGui::OpenPopup(kQuitQuestion);
         asked = false;
     }
-    if (!ImGui::BeginPopupModal(kQuitQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return false;
-    ImGui::Text("The scene has unsaved edits. Quit and lose them?");
-    bool quit = false;
-    if (ImGui::Button("Quit without saving")) {
-        quit = true;
+    if (!ImGui::BeginPopupModal(kQuitQuestion, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return QuitAnswer::none;
+    ImGui::Text("The scene has unsaved edits. Save them before quitting?");
+    QuitAnswer quit = QuitAnswer::none;
+    if (ImGui::Button(save_asks_where ? "Save as... and quit (Return)" : "Save and quit (Return)") || confirm) {
+        quit = QuitAnswer::save_and_quit;
         ImGui::CloseCurrentPopup();
     }
     ImGui::SameLine();
-    if (ImGui::Button("Cancel") || cancel) ImGui::CloseCurrentPopup();
+    if (ImGui::Button("Quit without saving")) {
+        quit = QuitAnswer::quit;
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel") || (cancel && quit == QuitAnswer::none)) {
+        quit = QuitAnswer::stay;
+        ImGui::CloseCurrentPopup();
+    }
     ImGui::EndPopup();
     return quit;
 }

@@ -14,8 +14,11 @@ void draw_help(UiState& ui);
 void draw_error_flash(const Messages& messages);
 // The questions take Esc (`cancel`, from the frame's key presses: ImGui 1.86 misses a quick
 // tap) as their safe answer.
-// Asks before quitting with unsaved edits (opened when `asked`): true to quit now.
-bool quit_popup(bool& asked, bool cancel);
+// Asks before quitting with unsaved edits (opened when `asked`): save them and quit (Ctrl+S's
+// save: over the scene's file, or, `save_asks_where`, a bundled or read-only scene's copy
+// where the user says; Return, `confirm`), quit without saving, or stay (Esc).
+enum class QuitAnswer { none, save_and_quit, quit, stay };
+QuitAnswer quit_popup(bool& asked, bool cancel, bool confirm = false, bool save_asks_where = false);
 // Asks before an open or reload drops unsaved edits (SceneFiles::pending_open).
 void discard_popup(PanelContext& ctx, bool cancel);
 // The question open (called at the top level): "quit", "discard", "overwrite" or "none".

@@ -12,15 +12,24 @@ namespace kr::viewer {
 void panel_camera(PanelContext& ctx) {
     if (!ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const Scene& scene = ctx.model.scene();
+    // Each camera by its id and its type as it is now: scene 3's camera "pinhole" becomes a
+    // lens-based one by click-to-focus, and the Lens panel says so too.
+    auto camera_label = [&](size_t i) {
+        const Camera& c = scene.cameras[i];
+        const std::string type(camera_type_names.name(c.type));
+        return c.id == type ? c.id : c.id + " (" + type + ")";
+    };
     if (scene.cameras.size() > 1) {
         int active = scene.camera;
-        if (ImGui::BeginCombo("active", scene.cameras[size_t(active)].id.c_str())) {
+        if (ImGui::BeginCombo("active", camera_label(size_t(active)).c_str())) {
             for (size_t i = 0; i < scene.cameras.size(); ++i)
-                if (ImGui::Selectable((scene.cameras[i].id + "##cam" + std::to_string(i)).c_str(), int(i) == active))
+                if (ImGui::Selectable((camera_label(i) + "##cam" + std::to_string(i)).c_str(), int(i) == active))
                     active = int(i);
             ImGui::EndCombo();
         }
         if (active != scene.camera) ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.camera = active; }, "active camera");
+    } else {
+        ImGui::TextDisabled("camera %s", camera_label(size_t(scene.camera)).c_str());
     }
     Camera cam = ctx.model.camera();
     const double span = std::max(1.0, length(cam.target - cam.position));

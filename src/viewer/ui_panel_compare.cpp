@@ -152,9 +152,9 @@ void panel_compare(PanelContext& ctx) {
     ImGui::EndDisabled();
     // A is the image shown: the panel names which (raw, denoised or split), as the stats JSON does.
     if (tool.figures && ctx.ui.shown)
-        ImGui::Text("A (%s) vs B: PSNR %.2f dB, RMSE %.4g",
-                    std::string(shown_word(*ctx.ui.shown, ctx.model.settings().denoise)).c_str(), tool.figures->psnr,
-                    tool.figures->rmse);
+        ImGui::Text("A (%s) vs B: %s%s, RMSE %.4g",
+                    std::string(shown_word(*ctx.ui.shown, ctx.model.settings().denoise)).c_str(),
+                    tool.figures->identical ? "" : "PSNR ", format_psnr(*tool.figures).c_str(), tool.figures->rmse);
     else if (!tool.figures_note.empty()) ImGui::TextDisabled("A vs B: %s", tool.figures_note.c_str());
 
     // The locked probe.
@@ -164,7 +164,9 @@ void panel_compare(PanelContext& ctx) {
         ImGui::TextDisabled("hover the image to read a pixel");
         return;
     }
-    if (const auto p = probe(ctx, tool.locked_probe->first, tool.locked_probe->second)) {
+    if (const auto p = probe(ctx, tool.locked_probe->first, tool.locked_probe->second); p && p->earlier_view) {
+        ImGui::TextDisabled("%s", probe_line(*p).c_str());
+    } else if (p) {
         ImGui::Text("pixel %d, %d: radiance %.4g %.4g %.4g", p->x, p->y, p->mean.x, p->mean.y, p->mean.z);
         ImGui::Text("shown %d %d %d", p->displayed[0], p->displayed[1], p->displayed[2]);
         if (!p->preview)

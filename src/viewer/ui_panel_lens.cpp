@@ -14,13 +14,15 @@ void panel_lens(PanelContext& ctx) {
     auto apply = [&](const char* name) {
         ctx.edit(Edit::lens, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(s.camera)] = cam; }, name, name);
     };
+    // The type of the active camera (whose id, in the Camera panel, may be a type's name).
     if (combo("camera type", cam.type, camera_type_names)) apply("camera type");
-    if (cam.type == CameraType::lens) {
-        if (field(ctx, "focal distance", &cam.focal_distance, 1, float(0.01 * std::max(1.0, cam.focal_distance)), 1e-4,
-                  kHuge))
-            apply("focal distance");
-        if (field(ctx, "aperture (alpha)", &cam.alpha, 1, 0.005f, 0.0, kHuge)) apply("aperture");
-    }
+    // The lens's fields show for a pinhole too, greyed: switching the type moves no control.
+    ImGui::BeginDisabled(cam.type != CameraType::lens);
+    if (field(ctx, "focal distance", &cam.focal_distance, 1, float(0.01 * std::max(1.0, cam.focal_distance)), 1e-4,
+              kHuge))
+        apply("focal distance");
+    if (field(ctx, "aperture (alpha)", &cam.alpha, 1, 0.005f, 0.0, kHuge)) apply("aperture");
+    ImGui::EndDisabled();
     ImGui::Checkbox("pick focus (F)", &ctx.ui.pick_focus);
     ImGui::SameLine();
     ImGui::TextDisabled("or Ctrl+click the image");

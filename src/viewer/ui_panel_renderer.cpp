@@ -15,7 +15,11 @@ void panel_renderer(PanelContext& ctx) {
     changed |= ImGui::SliderInt("depth", &r.max_depth, 0, kMaxDepth, "%d", ImGuiSliderFlags_AlwaysClamp);
     changed |= combo("estimator", r.estimator, estimator_names);
     changed |= combo("allocation", r.allocation, allocation_names);
-    if (r.integrator != Integrator::wrt) changed |= combo("light sampling", r.light_sampling, light_sampling_names);
+    // Greyed for WRT (point lights only, no sampling of area lights): switching the
+    // integrator moves no control.
+    ImGui::BeginDisabled(r.integrator == Integrator::wrt);
+    changed |= combo("light sampling", r.light_sampling, light_sampling_names);
+    ImGui::EndDisabled();
     const bool restart = ImGui::Button("Restart");
     if (changed || restart) {
         // depth and the renderer type also live in the authored renderer block (saved with the scene).

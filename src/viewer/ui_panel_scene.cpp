@@ -2,11 +2,13 @@
 // and redo, the loader's warnings.
 #include <algorithm>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <imgui.h>
 
+#include "core/data_dir.h"
 #include "scene/scene_list.h"
 #include "viewer/ui_panels.h"
 
@@ -32,8 +34,20 @@ void panel_scene(PanelContext& ctx) {
         files.choices = scene_choices(folders);
         files.folders = folders;
     }
-    if (ImGui::BeginCombo("open", current.filename().string().c_str())) {
-        for (const SceneChoice& c : files.choices) {
+    // Every choice at once (as tall as the window allows), under a line per folder; a bundled
+    // folder says that its scenes open as they ship and Save asks where.
+    if (ImGui::BeginCombo("open", current.filename().string().c_str(), ImGuiComboFlags_HeightLargest)) {
+        const std::optional<DataDir> data = data_dir();
+        fs::path folder;
+        for (size_t i = 0; i < files.choices.size(); ++i) {
+            const SceneChoice& c = files.choices[i];
+            if (i == 0 || c.path.parent_path() != folder) {
+                folder = c.path.parent_path();
+                if (i > 0) ImGui::Separator();
+                const bool bundled = data && path_inside(c.path, data->path);
+                ImGui::TextDisabled("%s%s", (folder.empty() ? std::string(".") : folder.string()).c_str(),
+                                    bundled ? "  (bundled: Save asks where)" : "");
+            }
             const std::string label = c.label + "##" + c.path.string();
             if (ImGui::Selectable(label.c_str(), c.path == current)) open_scene_asking(ctx, c.path);
         }
@@ -57,7 +71,22 @@ void panel_scene(PanelContext& ctx) {
     ImGui::SameLine();
     if (ImGui::Button("Reset view")) model.reset_view();
     ImGui::TextDisabled("the file is watched: saving it in an editor reloads it");
-    for (const std::string& w : model.warnings()) ImGui::TextWrapped("warning: %s", w.c_str());
+    // The loader's warnings under one line that is always there, folded: an edit that adds
+    // or clears one moves no control under the pointer.
+    const std::vector<std::string>& warnings = model.warnings();
+    if (warnings.empty()) {
+        ImGui::TextDisabled("no warnings");
+    } else {
+        const std::string head = std::to_string(warnings.size()) + (warnings.size() == 1 ? " warning" : " warnings") +
+                                 "###warnings";
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.8f, 0.3f, 1.0f));
+        const bool open = ImGui::TreeNode(head.c_str());
+        ImGui::PopStyleColor();
+        if (open) {
+            for (const std::string& w : warnings) ImGui::TextWrapped("%s", w.c_str());
+            ImGui::TreePop();
+        }
+    }
 }
 
 }  // namespace kr::viewer

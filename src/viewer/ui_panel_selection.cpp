@@ -15,7 +15,7 @@ void panel_selection(PanelContext& ctx) {
     if (!ImGui::CollapsingHeader("Selection", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const auto sel = ctx.selection();
     if (ImGui::Button("Add sphere")) add_sphere_at_target(ctx);
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("a diffuse sphere at the camera's target");
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("a diffuse sphere at the camera's target, or nearer where that is taken");
     if (!sel) {
         ImGui::SameLine();
         ImGui::TextDisabled("click a sphere on the image to select it");
@@ -32,7 +32,7 @@ void panel_selection(PanelContext& ctx) {
     const int p = *sel;
     const Primitive& prim = scene.primitives[size_t(p)];
     const std::string name = "object " + prim.id;
-    ImGui::Text("%s: sphere %s", prim.id.c_str(), scene.shapes[size_t(prim.shape)].id.c_str());
+    ImGui::TextUnformatted(primitive_label(scene, p).c_str());
     Shape shape = scene.shapes[size_t(prim.shape)];
     const double span = std::max(1.0, shape.radius);
     bool moved = field(ctx, "centre", &shape.centre.x, 3, float(0.01 * span), -kHuge, kHuge);
@@ -66,13 +66,15 @@ void panel_selection(PanelContext& ctx) {
     bool emissive = prim.type == PrimitiveType::emissive;
     if (ImGui::Checkbox("emissive", &emissive))
         ctx.edit(Edit::object, [&](Scene& s, ViewerSettings&) { set_emissive(s, p, emissive); }, name);
-    if (emissive && prim.light >= 0) {
-        Light light = scene.lights[size_t(prim.light)];
-        ImGui::SameLine();
-        ImGui::TextDisabled("light %s", light.id.c_str());
-        if (power_fields(ctx, light.power))
-            ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(prim.light)] = light; }, name, name);
-    }
+    // Its light's power, greyed while it has none: checking "emissive" moves no control.
+    const bool has_light = emissive && prim.light >= 0;
+    Light light = has_light ? scene.lights[size_t(prim.light)] : Light{};
+    ImGui::SameLine();
+    ImGui::TextDisabled("%s", has_light ? ("light " + light.id).c_str() : "no light");
+    ImGui::BeginDisabled(!has_light);
+    if (power_fields(ctx, light.power) && has_light)
+        ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(prim.light)] = light; }, name, name);
+    ImGui::EndDisabled();
 }
 
 }  // namespace kr::viewer

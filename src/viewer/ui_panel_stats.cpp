@@ -71,7 +71,9 @@ void plot_convergence(PanelContext& ctx) {
     ImGui::Dummy(ImVec2(width, height));
     ImGui::TextColored(ImVec4(0.35f, 0.67f, 1, 1), "estimated relative error");
     ImGui::SameLine();
-    ImGui::TextColored(ImVec4(1, 0.63f, 0.24f, 1), ctx.ui.compare.comparison.reference() ? "RMSE vs reference" : "(no reference)");
+    // The RMSE is of image A against image B, the reference or a kept snapshot, as picked.
+    const CompareImage* b = ctx.ui.compare.comparison.b();
+    ImGui::TextColored(ImVec4(1, 0.63f, 0.24f, 1), "%s", b ? ("RMSE vs B (" + b->name + ")").c_str() : "RMSE: no image B");
     ImGui::InputText("csv", &ctx.ui.save.paths.convergence);
     ImGui::BeginDisabled(points.empty());
     if (ImGui::Button("Save convergence CSV")) request_save(ctx, SaveKind::convergence, ctx.ui.save.paths.convergence);

@@ -71,7 +71,7 @@ bool colour_picker(const char* label, Color& c) {
     float rgb[3] = {float(c.x), float(c.y), float(c.z)};
     const std::string id = std::string("##pick ") + label;
     if (!ImGui::ColorEdit3(id.c_str(), rgb, ImGuiColorEditFlags_NoInputs | ImGuiColorEditFlags_Float)) return false;
-    c = Color(rgb[0], rgb[1], rgb[2]);
+    c = picked_colour(c, rgb);  // 0.9, not the float's 0.8999999761581421
     return true;
 }
 
