@@ -175,15 +175,19 @@ size_t update_adaptive(RenderState& state, double target, uint32_t min_samples, 
     return count;
 }
 
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
+    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
+           state.passes >= kAllocationWarmup;
+}
+
 void plan_pass(RenderState& state, const RenderSettings& settings, const RowShare* share) {
-    const PixelBuffers& px = state.buffers();
     SamplePlan& plan = state.plan;
-    const int width = state.width, height = state.height;
-    if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
-        state.passes < kAllocationWarmup) {
+    if (!plan_reads_statistics(settings, state)) {
         plan.pass_samples.clear();
         return;
     }
+    const PixelBuffers& px = state.buffers();
+    const int width = state.width, height = state.height;
     const size_t n = px.sample_count.size(), w = size_t(width);
     std::vector<int> own = rows_owned(share, height), guarded = rows_guarded(share, height);
     // Rows with no pixel on (the noise rule's mask, a render region's) take no samples, and
@@ -274,11 +278,6 @@ void plan_pass(RenderState& state, const RenderSettings& settings, const RowShar
         take_row(weight_of + start, active ? active + start : nullptr, floor, quota_scale, credit_of + start,
                  take_of + start, w);
     }
-}
-
-bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
-    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
-           state.passes >= kAllocationWarmup;
 }
 
 }  // namespace kr

@@ -43,7 +43,7 @@ std::optional<StopReason> ProgressiveDriver::stop_reason(const StopRule& rule) c
     StopStatus status;
     status.seconds = seconds_;
     status.noise_met = noise_met_ && noise_checked_ == rule.noise;
-    if (hooks_) status.agreed = own_agreed_;
+    if (hooks_) status.agreed = &own_agreed_;
     return kr::stop_reason(rule, state_, status);
 }
 

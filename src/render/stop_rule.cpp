@@ -13,24 +13,6 @@ bool noise_target_met(RenderState& state, const StopRule& rule, const RowShare* 
     return state.relative_error(share) <= rule.noise || update_adaptive(state, rule.noise, rule.min_samples, share) == 0;
 }
 
-bool own_rule_met(const StopRule& rule, StopReason reason, const RenderState&, double seconds) {
-    switch (reason) {
-    case StopReason::time:
-        return rule.seconds > 0 && seconds >= rule.seconds;
-    default:
-        return false;
-    }
-}
-
-std::optional<StopReason> stop_reason(const StopRule& rule, const RenderState& state, const StopStatus& status) {
-    if (status.noise_met && rule.noise > 0) return StopReason::noise;
-    for (size_t k = 0; k < kOwnStopRuleCount; ++k)
-        if (status.agreed ? (*status.agreed)[k] : own_rule_met(rule, kOwnStopRules[k], state, status.seconds))
-            return kOwnStopRules[k];
-    if (state.passes >= rule.max_passes) return StopReason::passes;
-    return std::nullopt;
-}
-
 StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise, double wall_seconds) {
     StopProgress progress;
     // Wall seconds per second of the time rule's clock, and per pass.

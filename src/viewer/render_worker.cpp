@@ -449,7 +449,7 @@ void RenderWorker::run() {
                 paused_seconds_ = 0;
                 if (paused_) pause_start_ = job_start_;
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
-                // The estimate render applies, before allocating (render_state.h).
+                // The estimate render applies, before allocating (outputs.h).
                 const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
                 if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false, true), "the render of a " + image);
                     !shortfall.empty()) {
