@@ -74,8 +74,8 @@ std::vector<double> row_seconds(const std::string& file, int size, int passes) {
     std::vector<double> seconds(size_t(size), 0.0);
     for (int pass = 0; pass < passes; ++pass)
         for (int y = 0; y < size; ++y) {
-            state.buffers().active_rows.assign(size_t(size), 0);
-            state.buffers().active_rows[size_t(y)] = 1;
+            state.active_rows.assign(size_t(size), 0);
+            state.active_rows[size_t(y)] = 1;
             const double start = cpu_seconds();
             render_pass(scene, settings, state);
             seconds[size_t(y)] += cpu_seconds() - start;
@@ -124,14 +124,14 @@ int main(int argc, char** argv) {
             for (int round = 0; round < rounds; ++round) {
                 // Timed the second time: a render allocates the plan's buffers in its first plan.
                 RenderState s = made;
-                s.plan_pass(settings, rows);
-                (void)s.update_adaptive(0.01, 16, rows);
+                plan_pass(s, settings, rows);
+                (void)update_adaptive(s, 0.01, 16, rows);
                 double start = cpu_seconds();
-                s.plan_pass(settings, rows);
+                plan_pass(s, settings, rows);
                 plan.push_back(cpu_seconds() - start);
                 start = cpu_seconds();
                 (void)s.relative_error(rows);
-                (void)s.update_adaptive(0.01, 16, rows);
+                (void)update_adaptive(s, 0.01, 16, rows);
                 check.push_back(cpu_seconds() - start);
             }
             const size_t own = rows_owned(rows, size).size();

@@ -128,7 +128,7 @@ inline size_t state_bytes(const RenderState& s) {
     return s.radiance_sum().capacity() * sizeof(Color) + s.radiance_compensation().capacity() * sizeof(Color) +
            s.radiance_sq_sum().capacity() * sizeof(Color) + s.depth_sum().capacity() * sizeof(double) +
            s.luminance_sq_sum().capacity() * sizeof(double) + s.sample_count().capacity() * sizeof(uint32_t) +
-           s.sample_index().capacity() * sizeof(uint32_t) + s.active().capacity();
+           s.sample_index().capacity() * sizeof(uint32_t) + s.plan.active.capacity();
 }
 
 // A small still life: floor, diffuse, mirror and glass balls, a point light and (for the

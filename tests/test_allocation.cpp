@@ -85,9 +85,9 @@ TEST(Allocation, PlanSpendsOnePassInProportionToTheDeviation) {
     const RenderSettings settings = adaptive_settings();
     std::vector<long> total(size_t(w) * h, 0);
     for (int r = 0; r < rounds; ++r) {
-        state.plan_pass(settings);
-        ASSERT_EQ(state.pass_samples().size(), total.size());
-        for (size_t i = 0; i < total.size(); ++i) total[i] += state.pass_samples()[i];
+        plan_pass(state, settings);
+        ASSERT_EQ(state.plan.pass_samples.size(), total.size());
+        for (size_t i = 0; i < total.size(); ++i) total[i] += state.plan.pass_samples[i];
     }
     // Fractions carry over: after `rounds` passes every pixel is within one sample of its
     // quota, so the sum is within one sample per pixel of rounds x pixels.
@@ -110,18 +110,18 @@ TEST(Allocation, PlanSpendsOnePassInProportionToTheDeviation) {
 TEST(Allocation, UniformBeforeTheWarmupForStratifiedAndWhenAskedFor) {
     RenderState state = two_halves(8, 8, kAllocationWarmup - 1);
     RenderSettings settings = adaptive_settings();
-    state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples().empty());  // one sample each: the variance is not known yet
+    plan_pass(state, settings);
+    EXPECT_TRUE(state.plan.pass_samples.empty());  // one sample each: the variance is not known yet
     state.passes = kAllocationWarmup;
-    state.plan_pass(settings);
-    EXPECT_FALSE(state.pass_samples().empty());
+    plan_pass(state, settings);
+    EXPECT_FALSE(state.plan.pass_samples.empty());
     settings.estimator = Estimator::stratified;  // its strata need exactly s samples per pixel
-    state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples().empty());
+    plan_pass(state, settings);
+    EXPECT_TRUE(state.plan.pass_samples.empty());
     settings = adaptive_settings();
     settings.allocation = Allocation::uniform;
-    state.plan_pass(settings);
-    EXPECT_TRUE(state.pass_samples().empty());
+    plan_pass(state, settings);
+    EXPECT_TRUE(state.plan.pass_samples.empty());
     // No variance anywhere: nothing to adapt to.
     RenderState flat(8, 8);
     flat.passes = kAllocationWarmup;
@@ -130,22 +130,22 @@ TEST(Allocation, UniformBeforeTheWarmupForStratifiedAndWhenAskedFor) {
         flat.buffers().radiance_sum[i] = Color(kAllocationWarmup * 0.5);
         flat.buffers().luminance_sq_sum[i] = kAllocationWarmup * 0.25;
     }
-    flat.plan_pass(adaptive_settings());
-    EXPECT_TRUE(flat.pass_samples().empty());
+    plan_pass(flat, adaptive_settings());
+    EXPECT_TRUE(flat.plan.pass_samples.empty());
 }
 
 // The noise rule's mask and the allocation together: pixels that met their share get
 // nothing, the others share a pass as large as their count.
 TEST(Allocation, InactivePixelsGetNoSamples) {
     RenderState state = two_halves(8, 8, kAllocationWarmup);
-    state.buffers().active.assign(64, 1);
-    for (int i = 0; i < 16; ++i) state.buffers().active[i] = 0;
+    state.plan.active.assign(64, 1);
+    for (int i = 0; i < 16; ++i) state.plan.active[i] = 0;
     long sum = 0;
     for (int r = 0; r < 100; ++r) {
-        state.plan_pass(adaptive_settings());
+        plan_pass(state, adaptive_settings());
         for (int i = 0; i < 64; ++i) {
-            if (i < 16) EXPECT_EQ(state.pass_samples()[i], 0);
-            sum += state.pass_samples()[i];
+            if (i < 16) EXPECT_EQ(state.plan.pass_samples[i], 0);
+            sum += state.plan.pass_samples[i];
         }
     }
     EXPECT_LE(sum, 100L * 48);
@@ -157,24 +157,24 @@ TEST(Allocation, InactivePixelsGetNoSamples) {
 TEST(Allocation, RowsWithNoActivePixelTakeNothingAndKeepTheirCredit) {
     const int w = 8, h = 8;
     RenderState state = two_halves(w, h, kAllocationWarmup);
-    state.plan_pass(adaptive_settings());  // credits and a plan in every row
-    const std::vector<float> credit = state.buffers().sample_credit;
-    state.buffers().active.assign(size_t(w) * h, 0);
+    plan_pass(state, adaptive_settings());  // credits and a plan in every row
+    const std::vector<float> credit = state.plan.sample_credit;
+    state.plan.active.assign(size_t(w) * h, 0);
     for (int y = 5; y < 7; ++y)
-        for (int x = 2; x < 7; ++x) state.buffers().active[size_t(y) * w + x] = 1;
+        for (int x = 2; x < 7; ++x) state.plan.active[size_t(y) * w + x] = 1;
     RenderState far = state;  // rows 0-3 (not next to an active row) with other statistics
     for (size_t i = 0; i < size_t(4 * w); ++i) far.buffers().luminance_sq_sum[i] *= 3;
-    state.plan_pass(adaptive_settings());
-    far.plan_pass(adaptive_settings());
-    EXPECT_EQ(state.pass_samples(), far.pass_samples());
+    plan_pass(state, adaptive_settings());
+    plan_pass(far, adaptive_settings());
+    EXPECT_EQ(state.plan.pass_samples, far.plan.pass_samples);
     long taken = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * w + x;
-            taken += state.pass_samples()[i];
-            if (state.buffers().active[i]) continue;
-            EXPECT_EQ(state.pass_samples()[i], 0) << x << "," << y;
-            EXPECT_EQ(state.buffers().sample_credit[i], credit[i]) << x << "," << y;
+            taken += state.plan.pass_samples[i];
+            if (state.plan.active[i]) continue;
+            EXPECT_EQ(state.plan.pass_samples[i], 0) << x << "," << y;
+            EXPECT_EQ(state.plan.sample_credit[i], credit[i]) << x << "," << y;
         }
     EXPECT_LE(taken, 10);
     EXPECT_GT(taken, 0);
@@ -297,9 +297,9 @@ TEST(Allocation, SameImageWhateverTheThreadsAndInTheViewer) {
     rule.noise = 0.04;  // not met by pass 24 (about 0.05): the mask is updated at passes 16, 20, 24
     const RenderState noise_one = render_with(1), noise_two = render_with(2);
     EXPECT_EQ(noise_one.sample_count(), noise_two.sample_count());
-    EXPECT_EQ(noise_one.active(), noise_two.active());
+    EXPECT_EQ(noise_one.plan.active, noise_two.plan.active);
     EXPECT_EQ(noise_one.relative_error(), noise_two.relative_error());
-    const auto still_active = std::count(noise_one.active().begin(), noise_one.active().end(), 1);
+    const auto still_active = std::count(noise_one.plan.active.begin(), noise_one.plan.active.end(), 1);
     EXPECT_GT(still_active, 0);
     EXPECT_LT(still_active, 256);  // the mask has left some pixels out
     rule.noise = 0;
@@ -335,9 +335,9 @@ void each_process_plans_its_rows_as_one_process_does(int w, int h) {
     // One process: the estimate, the mask's update and the next plan, in the driver's order.
     RenderState whole = rendered;
     const double error = whole.relative_error();
-    const size_t active = whole.update_adaptive(0.1, 16);
-    whole.plan_pass(settings);
-    ASSERT_FALSE(whole.pass_samples().empty());
+    const size_t active = update_adaptive(whole, 0.1, 16);
+    plan_pass(whole, settings);
+    ASSERT_FALSE(whole.plan.pass_samples.empty());
     ASSERT_GT(active, 0u);
     ASSERT_LT(active, size_t(w * h));  // the mask leaves some pixels out
     for (const bool held : {true, false})
@@ -357,14 +357,14 @@ void each_process_plans_its_rows_as_one_process_does(int w, int h) {
                 if (held) {  // the held rows' sums, counts and carried fractions
                     s.reset(w, h, guarded);
                     s.passes = rendered.passes;
-                    s.buffers().sample_credit.resize(s.sample_count().size());
+                    s.plan.sample_credit.resize(s.sample_count().size());
                     for (int y : guarded)
                         for (size_t x = 0; x < size_t(w); ++x) {
                             const size_t from = size_t(y) * w + x, to = s.row_start(y) + x;
                             s.buffers().radiance_sum[to] = rendered.radiance_sum()[from];
                             s.buffers().luminance_sq_sum[to] = rendered.luminance_sq_sum()[from];
                             s.buffers().sample_count[to] = rendered.sample_count()[from];
-                            s.buffers().sample_credit[to] = rendered.sample_credit()[from];
+                            s.plan.sample_credit[to] = rendered.plan.sample_credit[from];
                         }
                 } else {
                     for (int y = 0; y < h; ++y) {
@@ -377,8 +377,8 @@ void each_process_plans_its_rows_as_one_process_does(int w, int h) {
                     }
                 }
                 errors[size_t(r)] = s.relative_error(&share);
-                actives[size_t(r)] = s.update_adaptive(0.1, 16, &share);
-                s.plan_pass(settings, &share);
+                actives[size_t(r)] = update_adaptive(s, 0.1, 16, &share);
+                plan_pass(s, settings, &share);
             });
         for (std::thread& t : threads) t.join();
         for (int r = 0; r < count; ++r) {
@@ -389,9 +389,9 @@ void each_process_plans_its_rows_as_one_process_does(int w, int h) {
             for (int y : rows_owned(r, count, h))
                 for (size_t x = 0; x < size_t(w); ++x) {
                     const size_t i = s.row_start(y) + x, at = size_t(y) * w + x;
-                    EXPECT_EQ(s.active()[i], whole.active()[at]) << at;
-                    EXPECT_EQ(s.pass_samples()[i], whole.pass_samples()[at]) << at;
-                    EXPECT_EQ(s.sample_credit()[i], whole.sample_credit()[at]) << at;
+                    EXPECT_EQ(s.plan.active[i], whole.plan.active[at]) << at;
+                    EXPECT_EQ(s.plan.pass_samples[i], whole.plan.pass_samples[at]) << at;
+                    EXPECT_EQ(s.plan.sample_credit[i], whole.plan.sample_credit[at]) << at;
                 }
         }
     }

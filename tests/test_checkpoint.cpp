@@ -34,7 +34,7 @@ void expect_same_state(const RenderState& a, const RenderState& b) {
     EXPECT_EQ(a.rays, b.rays);
     EXPECT_EQ(a.sample_count(), b.sample_count());
     EXPECT_EQ(a.sample_index(), b.sample_index());
-    EXPECT_EQ(a.active(), b.active());
+    EXPECT_EQ(a.plan.active, b.plan.active);
     EXPECT_EQ(a.depth_sum(), b.depth_sum());
     EXPECT_EQ(a.radiance_compensation().size(), b.radiance_compensation().size());
     for (size_t i = 0; i < a.radiance_compensation().size(); ++i)
@@ -79,8 +79,8 @@ TEST(Checkpoint, ResumedRenderIsTheUninterruptedOne) {
         render_until(scene, settings, whole, rule);
         ASSERT_EQ(whole.passes, 36);
         // The noise rule's mask and the allocation's carried fractions are in play.
-        EXPECT_EQ(whole.active().empty(), c.noise == 0);
-        EXPECT_EQ(whole.sample_credit().empty(), c.allocation == Allocation::uniform);
+        EXPECT_EQ(whole.plan.active.empty(), c.noise == 0);
+        EXPECT_EQ(whole.plan.sample_credit.empty(), c.allocation == Allocation::uniform);
         const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
         for (int k : {3, 10, 25}) {
             StopRule first = rule;
@@ -219,16 +219,16 @@ TEST(Checkpoint, RefusesNumbersNoRenderWrites) {
     RenderState state(8, 8);
     state.track_halves();  // the denoiser's halves
     render_until(scene, settings, state, rule);
-    ASSERT_FALSE(state.active().empty());
-    ASSERT_FALSE(state.sample_credit().empty());
+    ASSERT_FALSE(state.plan.active.empty());
+    ASSERT_FALSE(state.plan.sample_credit.empty());
     const CheckpointKey key = checkpoint_key(authored, scene, settings, rule);
     const size_t at = 2 * 8 + 5;  // pixel (5, 2)
     ASSERT_GE(state.sample_count()[at], 2u);
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
 
-    auto decoded = [&](const std::function<void(PixelBuffers&)>& change) -> std::string {
+    auto decoded = [&](const std::function<void(RenderState&)>& change) -> std::string {
         RenderState edited = state;
-        change(edited.buffers());
+        change(edited);
         RenderState target(8, 8);
         try {
             decode_checkpoint(encode_checkpoint(key, edited), "run/r.ckpt", key, target);
@@ -238,23 +238,27 @@ TEST(Checkpoint, RefusesNumbersNoRenderWrites) {
         }
         return "(accepted)";
     };
-    EXPECT_EQ(decoded([](PixelBuffers&) {}), "(accepted)");
-    EXPECT_EQ(decoded([&](PixelBuffers& px) { px.radiance_sq_sum[at].y = px.luminance_sq_sum[at] = inf; }), "(accepted)");
-    const std::pair<const char*, std::function<void(PixelBuffers&)>> cases[] = {
-        {"radiance sum (0.5, nan,", [&](PixelBuffers& px) { px.radiance_sum[at] = Color(0.5, nan, 0.5); }},
-        {"radiance sum (inf,", [&](PixelBuffers& px) { px.radiance_sum[at].x = inf; }},
-        {"compensation", [&](PixelBuffers& px) { px.radiance_compensation[at].z = nan; }},
-        {"sum of squared radiance", [&](PixelBuffers& px) { px.radiance_sq_sum[at].x = -1; }},
-        {"sum of squared luminance nan", [&](PixelBuffers& px) { px.luminance_sq_sum[at] = nan; }},
-        {"sum of depths -3", [&](PixelBuffers& px) { px.depth_sum[at] = -3; }},
-        {"samples accumulated but", [&](PixelBuffers& px) { px.sample_count[at] = px.sample_index[at] + 1; }},
-        {"samples drawn in 12 passes (at most 64 a pass)", [&](PixelBuffers& px) { px.sample_index[at] = 12 * 64 + 1; }},
-        {"sums without a sample", [&](PixelBuffers& px) { px.sample_count[at] = 0, px.half_count[at] = 0; }},
-        {"mask is 7", [&](PixelBuffers& px) { px.active[at] = 7; }},
-        {"carried fraction of a sample nan", [&](PixelBuffers& px) { px.sample_credit[at] = float(nan); }},
-        {"carried fraction of a sample -1", [&](PixelBuffers& px) { px.sample_credit[at] = -1; }},
-        {"half's radiance sum", [&](PixelBuffers& px) { px.half_sum[at].y = inf; }},
-        {"a half of", [&](PixelBuffers& px) { px.half_count[at] = px.sample_count[at] + 1; }},
+    // A change to the film's sums (the plan's cases change the state's plan).
+    const auto sums = [](std::function<void(PixelBuffers&)> change) {
+        return std::function<void(RenderState&)>([change](RenderState& s) { change(s.buffers()); });
+    };
+    EXPECT_EQ(decoded([](RenderState&) {}), "(accepted)");
+    EXPECT_EQ(decoded(sums([&](PixelBuffers& px) { px.radiance_sq_sum[at].y = px.luminance_sq_sum[at] = inf; })), "(accepted)");
+    const std::pair<const char*, std::function<void(RenderState&)>> cases[] = {
+        {"radiance sum (0.5, nan,", sums([&](PixelBuffers& px) { px.radiance_sum[at] = Color(0.5, nan, 0.5); })},
+        {"radiance sum (inf,", sums([&](PixelBuffers& px) { px.radiance_sum[at].x = inf; })},
+        {"compensation", sums([&](PixelBuffers& px) { px.radiance_compensation[at].z = nan; })},
+        {"sum of squared radiance", sums([&](PixelBuffers& px) { px.radiance_sq_sum[at].x = -1; })},
+        {"sum of squared luminance nan", sums([&](PixelBuffers& px) { px.luminance_sq_sum[at] = nan; })},
+        {"sum of depths -3", sums([&](PixelBuffers& px) { px.depth_sum[at] = -3; })},
+        {"samples accumulated but", sums([&](PixelBuffers& px) { px.sample_count[at] = px.sample_index[at] + 1; })},
+        {"samples drawn in 12 passes (at most 64 a pass)", sums([&](PixelBuffers& px) { px.sample_index[at] = 12 * 64 + 1; })},
+        {"sums without a sample", sums([&](PixelBuffers& px) { px.sample_count[at] = 0, px.half_count[at] = 0; })},
+        {"mask is 7", [&](RenderState& s) { s.plan.active[at] = 7; }},
+        {"carried fraction of a sample nan", [&](RenderState& s) { s.plan.sample_credit[at] = float(nan); }},
+        {"carried fraction of a sample -1", [&](RenderState& s) { s.plan.sample_credit[at] = -1; }},
+        {"half's radiance sum", sums([&](PixelBuffers& px) { px.half_sum[at].y = inf; })},
+        {"a half of", sums([&](PixelBuffers& px) { px.half_count[at] = px.sample_count[at] + 1; })},
     };
     for (const auto& [what, change] : cases) {
         const std::string message = decoded(change);
@@ -264,11 +268,11 @@ TEST(Checkpoint, RefusesNumbersNoRenderWrites) {
         EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
     // The first bad pixel, row by row.
-    const std::string first = decoded([&](PixelBuffers& px) {
+    const std::string first = decoded(sums([&](PixelBuffers& px) {
         px.radiance_sum[at].x = nan;
         px.depth_sum[at + 9] = nan;
         px.depth_sum[3] = -1;
-    });
+    }));
     EXPECT_NE(first.find("pixel (3, 0): its sum of depths -1"), std::string::npos) << first;
 }
 

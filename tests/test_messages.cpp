@@ -15,6 +15,7 @@
 #include "core/limits.h"
 #include "core/memory.h"
 #include "core/text.h"
+#include "render/outputs.h"
 #include "render/progressive.h"
 #include "scene/load.h"
 #include "test_util.h"

@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "core/memory.h"
+#include "render/outputs.h"
 #include "render/render_state.h"
 #include "scene/save.h"
 #include "test_util.h"

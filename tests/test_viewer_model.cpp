@@ -281,7 +281,7 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
     settings.target_spp = 1;
     settings.kernels = PacketIsa::double_lanes;
     RenderState state(1, 1);
-    state.buffers().pass_samples = {uint8_t(kMaxPassSamples)};
+    state.plan.pass_samples = {uint8_t(kMaxPassSamples)};
     for (int i = 0; i < 1000000 / kMaxPassSamples; ++i) ASSERT_TRUE(render_pass(scene, settings, state));
     ASSERT_EQ(state.sample_count()[0], 1000000u);
     const Color mean = state.radiance().pixels[0];

@@ -27,6 +27,7 @@
 #include "viewer/inspect.h"
 #include "viewer/navigation.h"
 #include "viewer/scene_edit.h"
+#include "render/outputs.h"
 #include "render/render_scene.h"
 #include "render/render_state.h"
 #include "scene/load.h"

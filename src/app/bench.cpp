@@ -117,7 +117,7 @@ Timing time_render(const RenderScene& scene, const RenderSettings& settings, int
     RenderState state(width, height);
     const double start = clock();
     for (int i = 0; i < passes; ++i) {
-        state.plan_pass(settings);
+        plan_pass(state, settings);
         render_pass(scene, settings, state);
     }
     return {clock() - start, state.rays};

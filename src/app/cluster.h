@@ -6,7 +6,7 @@
 //
 // How a render is shared (docs/scaling.md): rank r renders the pixel rows y with
 // y mod N == r, every pixel's samples in the single-process order, so each pixel's sums are
-// those of one process bit for bit. Each rank plans its own rows (render/render_state.h,
+// those of one process bit for bit. Each rank plans its own rows (render/row_share.h,
 // RowShare): after a pass whose next step reads the statistics (adaptive allocation, the
 // noise rule), it receives the three sums of its rows' neighbouring rows (the 3x3 guard's)
 // from the ranks r - 1 and r + 1, and the image-wide sums are gathered as per-row sums that

@@ -148,7 +148,7 @@ public:
             owned_rows_.assign(size_t(state.height), 0);
             for (int y : rows_owned(this, state.height)) owned_rows_[size_t(y)] = 1;
         }
-        state.buffers().active_rows = owned_rows_;
+        state.active_rows = owned_rows_;
         // Planning and the noise rule since the last pass, less their exchanges.
         if (passes_ > 0) cost_.between_seconds += wall_seconds() - pass_end_ - (cost_.combine_seconds - combine_mark_);
         cpu_start_ = cpu_seconds();
@@ -156,7 +156,7 @@ public:
 
     void after_pass(RenderState& state, bool statistics) override {
         cost_.busy_seconds += cpu_seconds() - cpu_start_;
-        state.buffers().active_rows.clear();
+        state.active_rows.clear();
         ++passes_;
         pass_end_ = wall_seconds();
         combine_mark_ = cost_.combine_seconds;
@@ -440,8 +440,8 @@ void MpiCluster::gather_state(RenderState& state, uint64_t& rays, uint64_t& nonf
     deal.gather(state, px.sample_count, mine, gathered);
     deal.gather(state, px.sample_index, mine, gathered);
     // The noise rule's mask and the plan's credit are set by each rank on its own rows only.
-    if (!px.active.empty()) deal.gather(state, px.active, mine, gathered);
-    if (!px.sample_credit.empty()) deal.gather(state, px.sample_credit, mine, gathered);
+    if (!state.plan.active.empty()) deal.gather(state, state.plan.active, mine, gathered);
+    if (!state.plan.sample_credit.empty()) deal.gather(state, state.plan.sample_credit, mine, gathered);
     if (state.tracks_halves()) {  // with --denoise and in the viewer: the final denoiser reads them
         deal.gather(state, px.half_sum, mine, gathered);
         deal.gather(state, px.half_count, mine, gathered);
@@ -458,15 +458,15 @@ void MpiCluster::scatter_state(RenderState& state) const {
     const RowDeal deal{rank_, size_, state.width, state.height};
     PixelBuffers& px = state.buffers();
     // The counters and which optional buffers are in use, then each buffer.
-    long long counters[5] = {state.passes, (long long)state.nonfinite_samples, !px.active.empty(),
-                             !px.sample_credit.empty(), state.tracks_halves()};
+    long long counters[5] = {state.passes, (long long)state.nonfinite_samples, !state.plan.active.empty(),
+                             !state.plan.sample_credit.empty(), state.tracks_halves()};
     MPI_Bcast(counters, 5, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
     if (!leader()) {
         state.passes = int(counters[0]);
         state.nonfinite_samples = 0;  // counted once, at rank 0
         state.rays = 0;
-        if (counters[2]) px.active.resize(px.sample_count.size());
-        if (counters[3]) px.sample_credit.resize(px.sample_count.size());
+        if (counters[2]) state.plan.active.resize(px.sample_count.size());
+        if (counters[3]) state.plan.sample_credit.resize(px.sample_count.size());
         if (counters[4] && !state.tracks_halves()) state.track_halves();
     }
     deal.scatter(px.radiance_sum);
@@ -476,8 +476,8 @@ void MpiCluster::scatter_state(RenderState& state) const {
     deal.scatter(px.radiance_sq_sum);
     deal.scatter(px.sample_count);
     deal.scatter(px.sample_index);
-    if (counters[2]) deal.scatter(px.active);
-    if (counters[3]) deal.scatter(px.sample_credit);
+    if (counters[2]) deal.scatter(state.plan.active);
+    if (counters[3]) deal.scatter(state.plan.sample_credit);
     if (counters[4]) {  // a checkpoint of a render with --denoise: the final denoiser's halves
         deal.scatter(px.half_sum);
         deal.scatter(px.half_count);

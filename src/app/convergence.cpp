@@ -405,7 +405,7 @@ struct Bench {
         for (int pass = 1; pass <= spp; ++pass) {
             for (Series& s : series) {
                 const double t0 = cpu_seconds();
-                s.state.plan_pass(s.settings);
+                plan_pass(s.state, s.settings);
                 render_pass(scene, s.settings, s.state);
                 s.seconds += cpu_seconds() - t0;
                 if (pass == checkpoints[next_checkpoint]) {

@@ -1,10 +1,11 @@
-// Adaptive allocation: the plan of the next pass (samples per pixel by estimated noise) and
-// the noise rule's mask of pixels still above their share of the error.
+// The planner (allocation.h): the plan of the next pass (samples per pixel by estimated noise)
+// and the noise rule's mask of pixels still above their share of the error.
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "core/vectorise.h"
+#include "render/allocation.h"
 #include "render/render_state.h"
 
 namespace kr {
@@ -115,23 +116,33 @@ KR_INDEPENDENT_ITERATIONS
 
 }  // namespace
 
-size_t RenderState::update_adaptive(double target, uint32_t min_samples, const RowShare* share) {
-    const size_t n = px_.sample_count.size(), w = size_t(width);
+void SamplePlan::clear() {
+    active.clear();
+    pass_samples.clear();
+    sample_credit.clear();
+    for (auto& buffer : scratch) buffer.clear();
+}
+
+size_t update_adaptive(RenderState& state, double target, uint32_t min_samples, const RowShare* share) {
+    const PixelBuffers& px = state.buffers();
+    SamplePlan& plan = state.plan;
+    const int width = state.width, height = state.height;
+    const size_t n = px.sample_count.size(), w = size_t(width);
     const std::vector<int> own = rows_owned(share, height), guarded = rows_guarded(share, height);
     // Rows in parallel, their sums added in order (as plan_pass).
-    std::vector<double>& error_sq = px_.allocation_scratch[0];
-    std::vector<double>& row_sums = px_.allocation_scratch[1];
+    std::vector<double>& error_sq = plan.scratch[0];
+    std::vector<double>& row_sums = plan.scratch[1];
     error_sq.resize(n);
     row_sums.resize(n);
     std::vector<double> row_signal(size_t(height), 0.0);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
         const int y = guarded[k];
-        const size_t start = row_start(y);
+        const size_t start = state.row_start(y);
         for (size_t i = start; i < start + w; ++i) {
-            const double mean = px_.sample_count[i] ? luminance(px_.radiance_sum[i]) / px_.sample_count[i] : 0.0;
+            const double mean = px.sample_count[i] ? luminance(px.radiance_sum[i]) / px.sample_count[i] : 0.0;
             row_signal[size_t(y)] += mean * mean;
-            const double se = pixel_standard_error(i);
+            const double se = state.pixel_standard_error(i);
             error_sq[i] = se * se;
         }
         sum_three_along_row(&error_sq[start], &row_sums[start], w);
@@ -140,16 +151,16 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples, const R
     double signal_sq = 0;
     for (double s : row_signal) signal_sq += s;
     const double allowed = target * target * signal_sq / double(std::max<size_t>(size_t(width) * size_t(height), 1));
-    px_.active.resize(n);
+    plan.active.resize(n);
     std::vector<double> row_count(size_t(height), 0.0);
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
-        const size_t start = row_start(y);
-        const double* const above = y > 0 ? row_sums.data() + row_start(y - 1) : nullptr;
-        const double* const below = y + 1 < height ? row_sums.data() + row_start(y + 1) : nullptr;
-        const uint32_t* const samples = px_.sample_count.data() + start;
-        uint8_t* const active = px_.active.data() + start;
+        const size_t start = state.row_start(y);
+        const double* const above = y > 0 ? row_sums.data() + state.row_start(y - 1) : nullptr;
+        const double* const below = y + 1 < height ? row_sums.data() + state.row_start(y + 1) : nullptr;
+        const uint32_t* const samples = px.sample_count.data() + start;
+        uint8_t* const active = plan.active.data() + start;
         size_t count = 0;
         guard_row(error_sq.data() + start, row_sums.data() + start, above, below, w, [&](size_t x, double guarded) {
             const bool needs_more = samples[x] < min_samples || !(guarded <= allowed);
@@ -164,22 +175,29 @@ size_t RenderState::update_adaptive(double target, uint32_t min_samples, const R
     return count;
 }
 
-void RenderState::plan_pass(const RenderSettings& settings, const RowShare* share) {
-    if (settings.allocation != Allocation::adaptive || settings.estimator == Estimator::stratified ||
-        passes < kAllocationWarmup) {
-        px_.pass_samples.clear();
+bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
+    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
+           state.passes >= kAllocationWarmup;
+}
+
+void plan_pass(RenderState& state, const RenderSettings& settings, const RowShare* share) {
+    SamplePlan& plan = state.plan;
+    if (!plan_reads_statistics(settings, state)) {
+        plan.pass_samples.clear();
         return;
     }
-    const size_t n = px_.sample_count.size(), w = size_t(width);
+    const PixelBuffers& px = state.buffers();
+    const int width = state.width, height = state.height;
+    const size_t n = px.sample_count.size(), w = size_t(width);
     std::vector<int> own = rows_owned(share, height), guarded = rows_guarded(share, height);
     // Rows with no pixel on (the noise rule's mask, a render region's) take no samples, and
     // their zero weights would add nothing to the sums below: only the others are planned
     // (and their neighbours read), so a region's pass plans what its pixels need.
     std::vector<int> idle_rows;
-    if (!px_.active.empty()) {
+    if (!plan.active.empty()) {
         std::vector<uint8_t> row_on(size_t(height), 0);
         for (const int y : own) {
-            const uint8_t* const row = px_.active.data() + row_start(y);
+            const uint8_t* const row = plan.active.data() + state.row_start(y);
             row_on[size_t(y)] = std::any_of(row, row + w, [](uint8_t on) { return on != 0; });
         }
         const auto on = [&](int y) { return y >= 0 && y < height && row_on[size_t(y)]; };
@@ -195,23 +213,23 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     // Every loop runs over rows in parallel; sums are taken per row and then over the rows in
     // order, so the plan is the same for any number of threads or processes. The loops are
     // fused: at 512x512 the plan is bound by memory traffic.
-    std::vector<double>& variance = px_.allocation_scratch[0];
-    std::vector<double>& row_sums = px_.allocation_scratch[1];  // 3-wide sums along each row
-    std::vector<double>& weight = px_.allocation_scratch[2];
+    std::vector<double>& variance = plan.scratch[0];
+    std::vector<double>& row_sums = plan.scratch[1];  // 3-wide sums along each row
+    std::vector<double>& weight = plan.scratch[2];
     variance.resize(n);
     row_sums.resize(n);
     weight.resize(n);
     // The buffers' data as locals: the plan's byte stores may alias any member.
-    const uint32_t* const count = px_.sample_count.data();
-    const Color* const radiance = px_.radiance_sum.data();
-    const double* const luminance_sq = px_.luminance_sq_sum.data();
-    const uint8_t* const active = px_.active.empty() ? nullptr : px_.active.data();
+    const uint32_t* const count = px.sample_count.data();
+    const Color* const radiance = px.radiance_sum.data();
+    const double* const luminance_sq = px.luminance_sq_sum.data();
+    const uint8_t* const active = plan.active.empty() ? nullptr : plan.active.data();
     double* const variance_of = variance.data();
     double* const row_sums_of = row_sums.data();
     double* const weight_of = weight.data();
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < guarded.size(); ++k) {
-        const size_t start = row_start(guarded[k]);
+        const size_t start = state.row_start(guarded[k]);
         sample_variance_row(count + start, radiance + start, luminance_sq + start, variance_of + start, w);
         sum_three_along_row(variance_of + start, row_sums_of + start, w);
     }
@@ -221,9 +239,9 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         const int y = own[k];
-        const size_t start = row_start(y);
-        const double* const above = y > 0 ? row_sums_of + row_start(y - 1) : nullptr;
-        const double* const below = y + 1 < height ? row_sums_of + row_start(y + 1) : nullptr;
+        const size_t start = state.row_start(y);
+        const double* const above = y > 0 ? row_sums_of + state.row_start(y - 1) : nullptr;
+        const double* const below = y + 1 < height ? row_sums_of + state.row_start(y + 1) : nullptr;
         const uint8_t* const row_on = active ? active + start : nullptr;
         weight_row(variance_of + start, row_sums_of + start, above, below, row_on, weight_of + start, w);
         // The row's sum in order of x, as every process and thread count adds it.
@@ -244,27 +262,22 @@ void RenderState::plan_pass(const RenderSettings& settings, const RowShare* shar
     const double floor = active_count ? kAllocationFloor * sum / double(active_count) : 0.0;
     const double total = sum * (1 + kAllocationFloor);  // of weight + floor over active pixels
     if (!(total > 0) || !std::isfinite(total)) {
-        px_.pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
+        plan.pass_samples.clear();  // no variance anywhere (or all unknown): one sample each
         return;
     }
-    px_.sample_credit.resize(n, 0.0f);
-    px_.pass_samples.resize(n);
-    float* const credit_of = px_.sample_credit.data();
-    uint8_t* const take_of = px_.pass_samples.data();
-    for (const int y : idle_rows) std::fill_n(take_of + row_start(y), w, uint8_t(0));
+    plan.sample_credit.resize(n, 0.0f);
+    plan.pass_samples.resize(n);
+    float* const credit_of = plan.sample_credit.data();
+    uint8_t* const take_of = plan.pass_samples.data();
+    for (const int y : idle_rows) std::fill_n(take_of + state.row_start(y), w, uint8_t(0));
     const double quota_scale = double(active_count) / total;
 #pragma omp parallel for schedule(static)
     for (size_t k = 0; k < own.size(); ++k) {
         // Quotas sum to the active pixel count: the pass costs what a uniform one does.
-        const size_t start = row_start(own[k]);
+        const size_t start = state.row_start(own[k]);
         take_row(weight_of + start, active ? active + start : nullptr, floor, quota_scale, credit_of + start,
                  take_of + start, w);
     }
-}
-
-bool plan_reads_statistics(const RenderSettings& settings, const RenderState& state) {
-    return settings.allocation == Allocation::adaptive && settings.estimator != Estimator::stratified &&
-           state.passes >= kAllocationWarmup;
 }
 
 }  // namespace kr

@@ -147,7 +147,10 @@ std::string differences(const std::string& checkpoint, const std::string& here) 
 // accumulated as drawn, and in a half as in the pixel; no more drawn than `passes` passes
 // give (kMaxPassSamples each); no sums without samples; a mask of 0 and 1; carried fractions
 // within what the allocation carries.
-std::string first_bad_pixel(const PixelBuffers& px, int width, int passes) {
+std::string first_bad_pixel(const RenderState& state) {
+    const PixelBuffers& px = state.buffers();
+    const SamplePlan& plan = state.plan;
+    const int width = state.width, passes = state.passes;
     const size_t n = px.sample_count.size();
     auto finite = [](const Color& c) { return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z); };
     auto not_negative = [](double v) { return v >= 0; };  // false for NaN
@@ -182,11 +185,11 @@ std::string first_bad_pixel(const PixelBuffers& px, int width, int passes) {
         else if (count == 0 && (px.radiance_sum[i] != Color() || px.radiance_compensation[i] != Color() ||
                                 sq != Color() || px.luminance_sq_sum[i] != 0 || px.depth_sum[i] != 0))
             why = "sums without a sample";
-        else if (!px.active.empty() && px.active[i] > 1)
-            why = "its noise-rule mask is " + std::to_string(px.active[i]) + ", not 0 or 1";
-        else if (!px.sample_credit.empty() &&
-                 !(px.sample_credit[i] >= 0 && px.sample_credit[i] <= 4.0f * float(kMaxPassSamples)))
-            why = "its carried fraction of a sample " + number_text(px.sample_credit[i]) + " is outside [0, " +
+        else if (!plan.active.empty() && plan.active[i] > 1)
+            why = "its noise-rule mask is " + std::to_string(plan.active[i]) + ", not 0 or 1";
+        else if (!plan.sample_credit.empty() &&
+                 !(plan.sample_credit[i] >= 0 && plan.sample_credit[i] <= 4.0f * float(kMaxPassSamples)))
+            why = "its carried fraction of a sample " + number_text(plan.sample_credit[i]) + " is outside [0, " +
                   std::to_string(4 * kMaxPassSamples) + "]";
         else if (!px.half_sum.empty() && !finite(px.half_sum[i]))
             why = "its half's radiance sum " + colour(px.half_sum[i]) + " is not finite";
@@ -266,10 +269,10 @@ std::string encode_checkpoint(const CheckpointKey& key, const RenderState& state
     w.put_all(state.radiance_sq_sum());
     w.put_all(state.sample_count());
     w.put_all(state.sample_index());
-    w.put(uint8_t(!state.active().empty()));
-    w.put_all(state.active());
-    w.put(uint8_t(!state.sample_credit().empty()));
-    w.put_all(state.sample_credit());
+    w.put(uint8_t(!state.plan.active.empty()));
+    w.put_all(state.plan.active);
+    w.put(uint8_t(!state.plan.sample_credit.empty()));
+    w.put_all(state.plan.sample_credit);
     // The final denoiser's two halves (a render with --denoise): resumed, it reads the same ones.
     w.put(uint8_t(state.tracks_halves()));
     if (state.tracks_halves()) {
@@ -319,8 +322,8 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     r.get_all(px.radiance_sq_sum, n);
     r.get_all(px.sample_count, n);
     r.get_all(px.sample_index, n);
-    if (r.get<uint8_t>()) r.get_all(px.active, n);
-    if (r.get<uint8_t>()) r.get_all(px.sample_credit, n);
+    if (r.get<uint8_t>()) r.get_all(restored.plan.active, n);
+    if (r.get<uint8_t>()) r.get_all(restored.plan.sample_credit, n);
     if (r.get<uint8_t>()) {
         r.get_all(px.half_sum, n);
         r.get_all(px.half_count, n);
@@ -328,7 +331,7 @@ void decode_checkpoint(const std::string& bytes, const std::filesystem::path& fi
     if (r.left() != sizeof(uint64_t) || restored.passes < 0) refuse("checkpoint damaged (unexpected layout)");
     // A valid checksum says the bytes are those written, not that a render wrote them: the
     // numbers must be ones a render holds, or they would reach every layer of the image.
-    if (const std::string bad = first_bad_pixel(px, width, restored.passes); !bad.empty())
+    if (const std::string bad = first_bad_pixel(restored); !bad.empty())
         refuse("checkpoint holds numbers no render writes, nothing resumed: " + bad);
     state = std::move(restored);
 }

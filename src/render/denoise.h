@@ -25,7 +25,7 @@ struct DenoiseInput {
     std::span<const float> albedo;    // 3 per pixel: first-surface albedo, averaged
     std::span<const float> normal;    // 3 per pixel: first-surface normal, averaged (shorter at silhouettes)
     std::span<const double> depth;    // the mean primary hit distance
-    // The final filter's two independent halves of each pixel's samples (RenderState::halves):
+    // The final filter's two independent halves of each pixel's samples (Film::halves):
     // their means and counts. Absent (null), or a pixel with an empty half: that pixel's
     // distances are taken on the mean itself.
     const Image* half[2] = {nullptr, nullptr};

@@ -36,14 +36,14 @@ double mean_samples(const std::vector<uint32_t>& samples) {
 
 }  // namespace
 
-RenderEstimates render_estimates(const RenderState& state, unsigned layers) {
+RenderEstimates render_estimates(const Film& film, unsigned layers) {
     RenderEstimates out;
-    if (layers & kLayerRadiance) out.radiance = state.radiance();
-    if (layers & kLayerDepth) out.depth = state.mean_depth();
-    if (layers & kLayerSamples) out.samples = state.sample_count();
+    if (layers & kLayerRadiance) out.radiance = film.radiance();
+    if (layers & kLayerDepth) out.depth = film.mean_depth();
+    if (layers & kLayerSamples) out.samples = film.sample_count();
     if (layers & kLayerVariance) {
-        out.variance = state.variance_of_mean();
-        if (state.tracks_halves()) out.halves = state.halves();
+        out.variance = film.variance_of_mean();
+        if (film.tracks_halves()) out.halves = film.halves();
     }
     return out;
 }
@@ -210,6 +210,13 @@ std::vector<FileOutput> output_files(const RenderScene& scene, RenderEstimates e
 
 std::vector<FileOutput> output_files(const RenderScene& scene, const RenderState& state, const OutputRequest& request) {
     return output_files(scene, render_estimates(state, layers_for(request) | develop_reads(request.develop)), request);
+}
+
+uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised) {
+    const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
+    uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
+    if (denoised) output += kHalvesBytesPerPixel + kDenoiseBytesPerPixel;
+    return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
 }
 
 }  // namespace kr

@@ -21,7 +21,7 @@
 
 namespace kr {
 
-// A render's per-pixel estimates as develop reads them: from a RenderState's sums
+// A render's per-pixel estimates as develop reads them: from a film's sums
 // (render_estimates), or the viewer's copy of them in its snapshot. A layer left empty was
 // not asked for.
 struct RenderEstimates {
@@ -33,13 +33,13 @@ struct RenderEstimates {
     // keeps them (the viewer's render thread makes them once per edit); develop makes them
     // when it denoises and they are empty.
     std::vector<float> albedo, normal;  // 3 per pixel
-    // The two independent halves of each pixel's samples (RenderState::halves), where the state
-    // keeps them: the final denoiser's guides. Empty: none.
-    RenderState::Halves halves;
+    // The two independent halves of each pixel's samples (Film::halves), where the film keeps
+    // them: the final denoiser's guides. Empty: none.
+    Film::Halves halves;
 };
-// The estimates of `state` for the layers `layers` asks for (RenderLayer bits); with the
-// variance, the halves where the state tracks them.
-RenderEstimates render_estimates(const RenderState& state, unsigned layers);
+// The estimates of `film` (a RenderState's) for the layers `layers` asks for (RenderLayer
+// bits); with the variance, the halves where the film tracks them.
+RenderEstimates render_estimates(const Film& film, unsigned layers);
 
 // How a render is developed into its images. A new step (a denoiser reading the albedo and
 // normal layers) is one more option here and one more step in develop().
@@ -123,5 +123,13 @@ std::vector<FileOutput> output_files(const RenderScene& scene, const RenderState
 
 // The HDR image of a developed render (its layers as floats).
 HdrImage hdr_from_developed(Developed image);
+
+// An upper estimate of the memory a render of width x height pixels holds at its peak: the
+// RenderState (kRenderStateBytesPerPixel), then at the end the mean radiance (and, when
+// blurred, two more radiance images), the mean depth, and the larger output stage: the two
+// 8-bit images and their encoded bytes, or an EXR's 14 float layers and its encoded bytes.
+// A denoised render adds its halves (film.h: kHalvesBytesPerPixel), its feature buffers and the
+// denoiser's working images (render/denoise.h: kDenoiseBytesPerPixel).
+uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised = false);
 
 }  // namespace kr

@@ -15,14 +15,16 @@ ProgressiveDriver::ProgressiveDriver(const RenderScene& scene, const RenderSetti
 
 bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* cancel) {
     if (noise_checked_ && *noise_checked_ != rule.noise) {
-        state_.clear_adaptive();  // the mask followed another target
+        state_.plan.clear_adaptive();  // the mask followed another target
         noise_met_ = false;
     }
     noise_checked_ = rule.noise;
     const auto start = std::chrono::steady_clock::now();
     const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
+    // The planner, the film, the row share: plan the pass, narrow it to this process's rows,
+    // add its samples (and the halves'), then share what the next step reads.
     if (hooks_) hooks_->before_plan(state_);
-    state_.plan_pass(settings_, share);
+    plan_pass(state_, settings_, share);
     if (hooks_) hooks_->before_pass(state_);
     state_.begin_half_pass();
     if (!render_pass(scene_, settings_, state_, cancel)) return false;
@@ -31,15 +33,18 @@ bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* canc
     if (hooks_) hooks_->after_pass(state_, noise_check || plan_reads_statistics(settings_, state_));
     if (noise_check) noise_met_ = noise_target_met(state_, rule, share);
     seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (hooks_) time_agreed_ = hooks_->any(rule.seconds > 0 && seconds_ >= rule.seconds);
+    if (hooks_)
+        for (size_t k = 0; k < kOwnStopRuleCount; ++k)
+            own_agreed_[k] = hooks_->any(own_rule_met(rule, kOwnStopRules[k], state_, seconds_));
     return true;
 }
 
 std::optional<StopReason> ProgressiveDriver::stop_reason(const StopRule& rule) const {
-    if (noise_met_ && rule.noise > 0 && noise_checked_ == rule.noise) return StopReason::noise;
-    if (hooks_ ? time_agreed_ : rule.seconds > 0 && seconds_ >= rule.seconds) return StopReason::time;
-    if (state_.passes >= rule.max_passes) return StopReason::passes;
-    return std::nullopt;
+    StopStatus status;
+    status.seconds = seconds_;
+    status.noise_met = noise_met_ && noise_checked_ == rule.noise;
+    if (hooks_) status.agreed = &own_agreed_;
+    return kr::stop_reason(rule, state_, status);
 }
 
 StopReason render_until(const RenderScene& scene, const RenderSettings& settings, RenderState& state,

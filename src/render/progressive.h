@@ -1,9 +1,10 @@
 // ProgressiveDriver, the one driver of progressive passes (plan, pass, process exchange, stop
 // rules) under the CLI (render_until), the viewer's render thread and MPI ranks. It includes
-// the pieces it drives: the render state and its allocation (render_state.h), one pass
-// (render_pass.h) and the stop rules (stop_rule.h).
+// the pieces it drives: the render state (render_state.h: its film, its planner and the rows a
+// pass samples), one pass (render_pass.h) and the stop rules (stop_rule.h).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <functional>
 #include <optional>
@@ -22,16 +23,19 @@ namespace kr {
 class PassHooks {
 public:
     virtual ~PassHooks() = default;
-    // Before plan_pass: narrows the pixels the pass plans for (a render region), so that its
-    // samples, as many as those pixels, go to them alone. after_pass undoes it too.
+    // Before plan_pass: narrows the pixels the pass plans for (a render region, through
+    // state.plan.active), so that its samples, as many as those pixels, go to them alone.
+    // after_pass undoes it too.
     virtual void before_plan(RenderState&) {}
-    // After plan_pass, before render_pass: narrows the pass to this process's pixels.
+    // After plan_pass, before render_pass: narrows the pass to this process's pixels
+    // (state.active_rows).
     virtual void before_pass(RenderState& state) = 0;
     // After render_pass: undoes before_pass; when `statistics`, the next step reads the
     // statistics of this process's rows and their neighbours (plan_pass, update_adaptive), so
     // the process must then hold those rows' radiance_sum, luminance_sq_sum and sample_count.
     virtual void after_pass(RenderState& state, bool statistics) = 0;
-    // One stop decision for all processes: whether any of them says `stop` (e.g. --time).
+    // One stop decision for all processes: whether any of them says `stop` (each of
+    // kOwnStopRules, e.g. --time).
     virtual bool any(bool stop) = 0;
     // The rows this process plans and samples, and the exchange of the per-row sums that the
     // plan, the noise rule and the estimated error add up (nullptr: every row, one process).
@@ -39,9 +43,9 @@ public:
 };
 
 // The one driver of progressive passes (yocto-gl's trace_samples): each pass() plans the
-// pass (plan_pass), lets `hooks` narrow it to this process's pixels, renders it
-// (render_pass), shares what the next step reads, and applies the noise rule; stop_reason()
-// says which rule ends the render. render_until loops over it for the CLI and MPI ranks; the
+// pass (plan_pass, the planner), lets `hooks` narrow it to this process's pixels (the row
+// share), renders it into the film (render_pass), shares what the next step reads, and
+// applies the noise rule; stop_reason() says which rule ends the render (stop_rule.h). render_until loops over it for the CLI and MPI ranks; the
 // viewer's render thread calls pass() between its previews and edits, with a cancel flag,
 // under rules its user changes as it goes. The scene, settings, state and hooks must outlive
 // the driver.
@@ -55,7 +59,7 @@ public:
     // checked. Returns false, and does nothing more, when `cancel` ended the pass early: the
     // state then holds part of a pass (render_pass) and is to be reset or dropped.
     bool pass(const StopRule& rule, const std::atomic<bool>* cancel = nullptr);
-    // The rule that ends the render now, if any, in this order: the noise target met at its
+    // The rule that ends the render now, if any (kr::stop_reason): the noise target met at its
     // last check (while `rule` keeps that target), the time (with hooks: the processes' common
     // decision after the last pass), the passes.
     std::optional<StopReason> stop_reason(const StopRule& rule) const;
@@ -68,7 +72,7 @@ private:
     RenderState& state_;
     PassHooks* hooks_;
     double seconds_ = 0;
-    bool time_agreed_ = false;             // with hooks: every process's time is up
+    std::array<bool, kOwnStopRuleCount> own_agreed_{};  // with hooks: the processes' decisions (StopStatus)
     std::optional<double> noise_checked_;  // the noise target the adaptive mask follows
     bool noise_met_ = false;               // ... and whether its last check met it
 };

@@ -207,8 +207,8 @@ public:
         PixelBuffers& px = state.buffers();
         sample_index_ = px.sample_index.data();
         sobol_keys_ = px.sobol_keys.data();
-        active_ = px.active.empty() ? nullptr : px.active.data();
-        pass_samples_ = px.pass_samples.empty() ? nullptr : px.pass_samples.data();
+        active_ = state.plan.active.empty() ? nullptr : state.plan.active.data();
+        pass_samples_ = state.plan.pass_samples.empty() ? nullptr : state.plan.pass_samples.data();
         for (int k = 0; k < kSampleBatch; ++k) {
             // A Sobol pass restarts these samplers in place (restart_sobol), or for the float
             // lanes keeps its samples' keys and indices instead; the other estimators make
@@ -370,7 +370,7 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         px.sobol_keys.resize(pixels);
         px.sobol_keys_seed = settings.seed;
     }
-    const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
+    const uint8_t* const rows_active = state.active_rows.empty() ? nullptr : state.active_rows.data();
     const bool avx2 = avx2_accumulation();
     const PacketKernels kernels = packet_kernels(scene, settings);
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)

@@ -1,208 +1,22 @@
 #include "render/render_state.h"
 
-#include <algorithm>
-#include <cmath>
-
-#include "render/denoise.h"
-#include "render/trace.h"
+#include <utility>
 
 namespace kr {
 
 void RenderState::reset(int w, int h, std::vector<int> held) {
-    width = w;
-    height = h;
-    held_ = std::move(held);
-    slot_.clear();
-    if (!held_.empty()) {
-        slot_.assign(size_t(h), -1);
-        for (size_t k = 0; k < held_.size(); ++k) slot_[size_t(held_[k])] = int(k);
-    }
-    const size_t n = static_cast<size_t>(w) * (held_.empty() ? static_cast<size_t>(h) : held_.size());
-    px_.radiance_sum.assign(n, Color());
-    px_.radiance_compensation.assign(n, Color());
-    px_.depth_sum.assign(n, 0.0);
-    px_.luminance_sq_sum.assign(n, 0.0);
-    px_.radiance_sq_sum.assign(n, Color());
-    px_.sample_count.assign(n, 0);
-    px_.sample_index.assign(n, 0);
+    Film::reset(w, h, std::move(held));
+    plan.clear();
+    active_rows.clear();
     passes = 0;
     rays = 0;
     nonfinite_samples = 0;
-    px_.active.clear();
-    px_.active_rows.clear();
-    px_.pass_samples.clear();
-    px_.sample_credit.clear();
-    for (auto& scratch : px_.allocation_scratch) scratch.clear();
-    px_.sobol_keys.clear();
-    if (tracks_halves()) track_halves();
 }
 
-void RenderState::track_halves() {
-    const size_t n = px_.sample_count.size();
-    px_.half_sum.assign(n, Color());
-    px_.half_count.assign(n, 0);
-}
-
-void RenderState::add_sums_to_half(int sign) {
+void RenderState::add_pass_to_half(int sign) {
     if (!tracks_halves()) return;
-    // Only the pixels the pass samples (its rows, the noise rule's mask and the plan:
-    // render_pass skips the others), whose sums are the only ones it changes: a region's or an
-    // adaptive pass costs what its pixels cost, and the others' halves stay as they are, bit
-    // for bit.
-    const size_t w = size_t(width);
-    const long rows = long(px_.half_sum.size() / std::max<size_t>(1, w));
-    const uint8_t* const rows_on = px_.active_rows.empty() ? nullptr : px_.active_rows.data();
-    const uint8_t* const active = px_.active.empty() ? nullptr : px_.active.data();
-    const uint8_t* const planned = px_.pass_samples.empty() ? nullptr : px_.pass_samples.data();
-#pragma omp parallel for schedule(static)
-    for (long r = 0; r < rows; ++r) {
-        const size_t y = held_.empty() ? size_t(r) : size_t(held_[size_t(r)]);
-        if (rows_on && !rows_on[y]) continue;
-        for (size_t i = size_t(r) * w; i < size_t(r + 1) * w; ++i) {
-            if ((active && !active[i]) || (planned && !planned[i])) continue;
-            px_.half_sum[i] += double(sign) * (px_.radiance_sum[i] + px_.radiance_compensation[i]);
-            px_.half_count[i] += uint32_t(sign) * px_.sample_count[i];  // modulo 2^32, exact
-        }
-    }
-}
-
-RenderState::Halves RenderState::halves() const {
-    Halves out;
-    for (int h = 0; h < 2; ++h) {
-        out.mean[h] = Image(width, height);
-        out.count[h].assign(px_.sample_count.size(), 0);
-    }
-    if (!tracks_halves()) return out;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < px_.sample_count.size(); ++i) {
-        const uint32_t odd = std::min(px_.half_count[i], px_.sample_count[i]), even = px_.sample_count[i] - odd;
-        const Color total = px_.radiance_sum[i] + px_.radiance_compensation[i];
-        out.count[0][i] = even;
-        out.count[1][i] = odd;
-        if (odd) out.mean[1].pixels[i] = px_.half_sum[i] / double(odd);
-        if (even) out.mean[0].pixels[i] = (total - px_.half_sum[i]) / double(even);
-    }
-    return out;
-}
-
-uint64_t render_memory_bytes(int width, int height, bool blurred, bool denoised) {
-    const uint64_t eight_bit = 2 * 3 + 2 * 3, exr = 2 * 14 * sizeof(float);
-    uint64_t output = sizeof(Color) * (blurred ? 3 : 1) + sizeof(double) + std::max(eight_bit, exr);
-    if (denoised) output += kHalvesBytesPerPixel + kDenoiseBytesPerPixel;
-    return uint64_t(width) * uint64_t(height) * (kRenderStateBytesPerPixel + output);
-}
-
-Image RenderState::radiance() const {
-    Image img(width, height);
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < img.pixels.size(); ++i)
-        img.pixels[i] = px_.sample_count[i]
-                            ? (px_.radiance_sum[i] + px_.radiance_compensation[i]) / double(px_.sample_count[i])
-                            : Color();
-    return img;
-}
-
-std::vector<double> RenderState::mean_depth() const {
-    std::vector<double> d(px_.depth_sum.size(), kMissDepth);
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < d.size(); ++i)
-        if (px_.sample_count[i]) d[i] = px_.depth_sum[i] / double(px_.sample_count[i]);
-    return d;
-}
-
-std::vector<Color> RenderState::variance_of_mean() const {
-    std::vector<Color> v(px_.radiance_sum.size(), Color(kInfinity));
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < v.size(); ++i) {
-        const double n = px_.sample_count[i];
-        if (n < 2 || !is_finite(px_.radiance_sq_sum[i])) continue;  // unknown, as sample_variance
-        // The unbiased sample variance of each channel, then over n for the mean's.
-        auto channel = [&](double sum, double sq_sum) {
-            const double mean = sum / n;
-            return std::max(0.0, (sq_sum - n * mean * mean) / (n - 1)) / n;
-        };
-        v[i] = {channel(px_.radiance_sum[i].x, px_.radiance_sq_sum[i].x), channel(px_.radiance_sum[i].y, px_.radiance_sq_sum[i].y),
-                channel(px_.radiance_sum[i].z, px_.radiance_sq_sum[i].z)};
-    }
-    return v;
-}
-
-double RenderState::pixel_standard_error(size_t i) const {
-    return std::sqrt(sample_variance(i) / px_.sample_count[i]);  // of the mean of n samples
-}
-
-std::vector<int> row_owners(int count, int height) {
-    std::vector<int> owner(size_t(std::max(height, 0)));
-    size_t y = 0;
-    for (int64_t block = 0; block < kRowBlocks; ++block)
-        for (int r = 0; r < count; ++r) {
-            const int64_t share = height / count + (r < height % count);
-            // Block `block` of the share's kRowBlocks near-equal blocks.
-            const int64_t rows = (block + 1) * share / kRowBlocks - block * share / kRowBlocks;
-            std::fill_n(owner.begin() + ptrdiff_t(y), rows, r);
-            y += size_t(rows);
-        }
-    return owner;
-}
-
-std::vector<int> rows_owned(int index, int count, int height) {
-    const std::vector<int> owner = row_owners(count, height);
-    std::vector<int> rows;
-    for (int y = 0; y < height; ++y)
-        if (owner[size_t(y)] == index) rows.push_back(y);
-    return rows;
-}
-
-std::vector<int> rows_guarded(int index, int count, int height) {
-    const std::vector<int> owner = row_owners(count, height);
-    std::vector<int> rows;
-    const auto owns = [&](int y) { return y >= 0 && y < height && owner[size_t(y)] == index; };
-    for (int y = 0; y < height; ++y)
-        if (owns(y) || owns(y - 1) || owns(y + 1)) rows.push_back(y);
-    return rows;
-}
-
-std::vector<int> rows_owned(const RowShare* share, int height) {
-    return share ? rows_owned(share->index(), share->count(), height) : rows_owned(0, 1, height);
-}
-
-std::vector<int> rows_guarded(const RowShare* share, int height) {
-    return share ? rows_guarded(share->index(), share->count(), height) : rows_guarded(0, 1, height);
-}
-
-double RenderState::relative_error(const RowShare* share) const {
-    // Per-row sums in parallel, added in row order: the same estimate for any thread or
-    // process count. (The viewer shows it after every pass.) Per row: the error, the signal,
-    // and whether a pixel's error is unknown.
-    const size_t w = size_t(width);
-    const std::vector<int> own = rows_owned(share, height);
-    std::vector<double> rows(3 * size_t(height), 0.0);
-#pragma omp parallel for schedule(static)
-    for (size_t k = 0; k < own.size(); ++k) {
-        const size_t y = size_t(own[k]), start = row_start(own[k]);
-        double error = 0, signal = 0;
-        for (size_t i = start; i < start + w; ++i) {
-            const double se = pixel_standard_error(i);
-            if (!std::isfinite(se)) {
-                rows[3 * y + 2] = 1;
-                break;
-            }
-            error += se * se;
-            const double mean = luminance(px_.radiance_sum[i]) / px_.sample_count[i];
-            signal += mean * mean;
-        }
-        rows[3 * y] = error;
-        rows[3 * y + 1] = signal;
-    }
-    if (share) share->combine(rows, 3);
-    double error_sq = 0, signal_sq = 0;
-    for (size_t y = 0; y < size_t(height); ++y) {
-        if (rows[3 * y + 2] != 0) return kInfinity;
-        error_sq += rows[3 * y];
-        signal_sq += rows[3 * y + 1];
-    }
-    if (signal_sq <= 0) return error_sq > 0 ? kInfinity : 0.0;
-    return std::sqrt(error_sq / signal_sq);
+    const auto data = [](const std::vector<uint8_t>& v) { return v.empty() ? nullptr : v.data(); };
+    add_sums_to_half(sign, data(active_rows), data(plan.active), data(plan.pass_samples));
 }
 
 }  // namespace kr

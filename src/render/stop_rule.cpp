@@ -10,7 +10,7 @@ bool noise_check_due(const StopRule& rule, int passes) {
 
 bool noise_target_met(RenderState& state, const StopRule& rule, const RowShare* share) {
     // Every pixel within its share means the whole image is within the target too.
-    return state.relative_error(share) <= rule.noise || state.update_adaptive(rule.noise, rule.min_samples, share) == 0;
+    return state.relative_error(share) <= rule.noise || update_adaptive(state, rule.noise, rule.min_samples, share) == 0;
 }
 
 StopProgress stop_progress(const StopRule& rule, int passes, double seconds, double noise, double wall_seconds) {

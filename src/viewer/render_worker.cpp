@@ -116,7 +116,7 @@ void RegionHooks::before_plan(RenderState& state) {
     applied_ = false;
     if (!region) return;
     const int w = state.width, h = state.height;
-    std::vector<uint8_t>& active = state.buffers().active;
+    std::vector<uint8_t>& active = state.plan.active;
     saved_.swap(active);  // empty: every pixel, else the noise rule's mask
     active.assign(state.sample_count().size(), 0);
     // A process of a shared render holds some rows only (RenderState::row_start).
@@ -133,7 +133,7 @@ void RegionHooks::before_plan(RenderState& state) {
 void RegionHooks::before_pass(RenderState& state) {
     rows_applied_ = false;
     if (!applied_) return;
-    std::vector<uint8_t>& rows = state.buffers().active_rows;
+    std::vector<uint8_t>& rows = state.active_rows;
     saved_rows_ = rows;  // empty: every row
     if (rows.empty()) rows.assign(size_t(state.height), 1);
     for (int y = 0; y < state.height; ++y)
@@ -142,8 +142,8 @@ void RegionHooks::before_pass(RenderState& state) {
 }
 
 void RegionHooks::after_pass(RenderState& state, bool) {
-    if (applied_) state.buffers().active.swap(saved_);
-    if (rows_applied_) state.buffers().active_rows.swap(saved_rows_);
+    if (applied_) state.plan.active.swap(saved_);
+    if (rows_applied_) state.active_rows.swap(saved_rows_);
     saved_.clear();
     saved_rows_.clear();
     applied_ = rows_applied_ = false;
@@ -454,7 +454,7 @@ void RenderWorker::run() {
                 paused_seconds_ = 0;
                 if (paused_) pause_start_ = job_start_;
                 const int w = job.scene->renderer.width, h = job.scene->renderer.height;
-                // The estimate render applies, before allocating (render_state.h).
+                // The estimate render applies, before allocating (outputs.h).
                 const std::string image = std::to_string(w) + "x" + std::to_string(h) + " image";
                 if (std::string shortfall = memory_shortfall(render_memory_bytes(w, h, false, true), "the render of a " + image);
                     !shortfall.empty()) {

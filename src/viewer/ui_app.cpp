@@ -14,7 +14,7 @@
 #include "core/file_write.h"
 #include "core/memory.h"
 #include "core/text.h"
-#include "render/render_state.h"
+#include "render/outputs.h"
 #include "scene/load.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
