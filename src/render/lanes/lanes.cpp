@@ -52,12 +52,10 @@ struct Target {
            &lanes::id::kernels},
 const Target kTargets[] = {KR_LANE_TARGETS(KR_LANE_TARGET_ROW)};
 #undef KR_LANE_TARGET_ROW
+static_assert(std::size(kTargets) == size_t(LaneKernels::one_path));
 
-const Target& target(LaneKernels kernels) {
-    for (const Target& t : kTargets)
-        if (t.id == kernels) return t;
-    return kTargets[0];  // not reached: one_path is never looked up
-}
+// A target's row: LaneKernels is made from the same rows in the same order (targets.h).
+const Target& target(LaneKernels kernels) { return kTargets[size_t(kernels)]; }
 
 // Whether this build has the target's kernels and this CPU runs them.
 bool runs(const Target& t) { return t.kernels->built && t.level <= cpu_level(); }
@@ -106,14 +104,19 @@ LaneKernels choice_kernels(LaneChoice choice) {
 }
 
 // The camera rays' kernels for these: the double lanes of the highest level up to theirs (the
-// single-precision targets take theirs).
+// single-precision targets take theirs), worked out once per target.
 const lanes::TargetKernels* camera_kernels(LaneKernels kernels) {
-    if (kernels == LaneKernels::one_path) return nullptr;
-    const Target& of = target(kernels);
-    const Target* best = nullptr;
-    for (const Target& t : kTargets)
-        if (!t.single && t.level <= of.level && runs(t) && (!best || t.level > best->level)) best = &t;
-    return best ? best->kernels : nullptr;
+    static const auto of = [] {
+        std::array<const lanes::TargetKernels*, size_t(LaneKernels::one_path) + 1> camera{};
+        for (const Target& row : kTargets) {
+            const Target* best = nullptr;
+            for (const Target& t : kTargets)
+                if (!t.single && t.level <= row.level && runs(t) && (!best || t.level > best->level)) best = &t;
+            camera[size_t(row.id)] = best ? best->kernels : nullptr;
+        }
+        return camera;  // one_path: none
+    }();
+    return of[size_t(kernels)];
 }
 
 }  // namespace
@@ -229,10 +232,12 @@ void accumulate(const PixelSums& sums, const size_t* pixels, const SampleResult*
                 uint64_t& rays, uint64_t& nonfinite) {
     // The double lanes of the highest level from x86-64-v3 on, where asked and run; else any
     // x86-64's.
-    static const lanes::TargetKernels* const v3 =
-        avx2_accumulation() ? target(choice_kernels(LaneChoice::double_lanes)).kernels : nullptr;
-    static const lanes::TargetKernels* const any = target(LaneKernels::x86_64).kernels;
-    ((avx2 && v3) ? v3 : any)->accumulate(sums, pixels, results, count, rays, nonfinite);
+    static const auto accumulate_of = [] {
+        const LaneKernels v3 = choice_kernels(LaneChoice::double_lanes);
+        const lanes::TargetKernels* any = target(LaneKernels::x86_64).kernels;
+        return std::array<const lanes::TargetKernels*, 2>{any, v3 == LaneKernels::one_path ? any : target(v3).kernels};
+    }();
+    accumulate_of[avx2]->accumulate(sums, pixels, results, count, rays, nonfinite);
 }
 
 }  // namespace kr
