@@ -23,13 +23,13 @@ PixelSums pixel_sums_of(PixelBuffers& px) {
 // in the order they were drawn, so every pixel's sums are those of tracing them one by one.
 class PassThread {
 public:
-    PassThread(const RenderScene& scene, const RenderSettings& settings, RenderState& state, bool avx2,
+    PassThread(const RenderScene& scene, const RenderSettings& settings, RenderState& state, AccumulateBatch accumulate,
                LaneKernels kernels)
         : scene_(scene),
           settings_(settings),
           state_(state),
           sums_(pixel_sums_of(state.buffers())),
-          avx2_(avx2),
+          accumulate_(accumulate),
           kernels_(kernels),
           sobol_lanes_(sobol_camera_lanes(kernels)) {
         PixelBuffers& px = state.buffers();
@@ -146,14 +146,14 @@ private:
                                        count, results_);
         else
             trace_camera_samples(scene_, settings_, width, height, xs_, ys_, samplers_, count, results_);
-        accumulate(sums_, pixels_, results_, count, avx2_, rays, nonfinite);
+        accumulate_(sums_, pixels_, results_, count, rays, nonfinite);
     }
 
     const RenderScene& scene_;
     const RenderSettings& settings_;
     const RenderState& state_;
     const PixelSums sums_;
-    const bool avx2_;
+    const AccumulateBatch accumulate_;  // the CPU level's (accumulation)
     const LaneKernels kernels_;
     const bool sobol_lanes_;  // Sobol batches go to trace_sobol_camera_samples
     uint32_t* sample_index_;
@@ -199,11 +199,11 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
         px.sobol_keys_seed = settings.seed;
     }
     const uint8_t* const rows_active = px.active_rows.empty() ? nullptr : px.active_rows.data();
-    const bool avx2 = avx2_accumulation();
+    const AccumulateBatch accumulate = accumulation(true);
     const LaneKernels kernels = lane_kernels(scene, settings);
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
-        PassThread thread(scene, settings, state, avx2, kernels);
+        PassThread thread(scene, settings, state, accumulate, kernels);
         // Rows handed out one at a time: rows through glass cost far more than rows of wall.
 #pragma omp for schedule(dynamic, 1)
         for (int y = 0; y < height; ++y) {

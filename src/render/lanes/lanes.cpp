@@ -228,16 +228,16 @@ void trace_camera_samples(const RenderScene& scene, const RenderSettings& settin
 
 bool avx2_accumulation() { return choice_kernels(LaneChoice::double_lanes) != LaneKernels::one_path; }
 
-void accumulate(const PixelSums& sums, const size_t* pixels, const SampleResult* results, int count, bool avx2,
-                uint64_t& rays, uint64_t& nonfinite) {
+AccumulateBatch accumulation(bool avx2) {
     // The double lanes of the highest level from x86-64-v3 on, where asked and run; else any
     // x86-64's.
-    static const auto accumulate_of = [] {
-        const LaneKernels v3 = choice_kernels(LaneChoice::double_lanes);
-        const lanes::TargetKernels* any = target(LaneKernels::x86_64).kernels;
-        return std::array<const lanes::TargetKernels*, 2>{any, v3 == LaneKernels::one_path ? any : target(v3).kernels};
-    }();
-    accumulate_of[avx2]->accumulate(sums, pixels, results, count, rays, nonfinite);
+    const LaneKernels v3 = choice_kernels(LaneChoice::double_lanes);
+    return (avx2 && v3 != LaneKernels::one_path ? target(v3) : target(LaneKernels::x86_64)).kernels->accumulate;
+}
+
+void accumulate(const PixelSums& sums, const size_t* pixels, const SampleResult* results, int count, bool avx2,
+                uint64_t& rays, uint64_t& nonfinite) {
+    accumulation(avx2)(sums, pixels, results, count, rays, nonfinite);
 }
 
 }  // namespace kr

@@ -78,5 +78,10 @@ void accumulate(const PixelSums& sums, const size_t* pixels, const SampleResult*
                 uint64_t& rays, uint64_t& nonfinite);
 // Whether this build and CPU have the x86-64-v3 accumulation.
 bool avx2_accumulation();
+// The addition accumulate makes, as a function a pass calls for each batch: the x86-64-v3
+// target's where `avx2` and avx2_accumulation(), else any x86-64's.
+using AccumulateBatch = void (*)(const PixelSums& sums, const size_t* pixels, const SampleResult* results, int count,
+                                 uint64_t& rays, uint64_t& nonfinite);
+AccumulateBatch accumulation(bool avx2);
 
 }  // namespace kr
