@@ -397,7 +397,7 @@ test::SceneBuilder scaled_room(double scale, int balls) {
 }
 
 Image render_image(const RenderScene& scene, int spp, Integrator integrator = Integrator::pt,
-                   PacketIsa kernels = PacketIsa::best) {
+                   LaneChoice kernels = LaneChoice::best) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.integrator = integrator;
     settings.kernels = kernels;
@@ -442,7 +442,7 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
     const RenderScene unit_scene = scaled_room(1, 34).build();
     // One path at a time: the BVHs against the plain path (the lanes' own tree and their
     // rounding: ExtremeScalesInTheLanes below).
-    const PacketIsa one = PacketIsa::one_path;
+    const LaneChoice one = LaneChoice::off;
     const Image unit = render_image(unit_scene, 2, Integrator::pt, one),
                 unit_wrt = render_image(unit_scene, 1, Integrator::wrt);
     ASSERT_GT(total_luminance(unit), 0.0);
@@ -486,14 +486,14 @@ TEST(Accel, ExtremeScalesGiveThePlainPathsImage) {
 // their images are the one-path image to the lanes' rounding.
 TEST(Accel, ExtremeScalesInTheLanes) {
     for (int spheres : {4, 34}) {
-        const Image unit = render_image(scaled_room(1, spheres).build(), 2, Integrator::pt, PacketIsa::one_path);
+        const Image unit = render_image(scaled_room(1, spheres).build(), 2, Integrator::pt, LaneChoice::off);
         for (double scale : {1e-100, 1e-40, 1e-20, 1e-13, 1e-6, 1.0, 1e6, 1e13, 1e20, 1e30, 1e100}) {
             const RenderScene scene = scaled_room(scale, spheres).build();
             char where[48];
             std::snprintf(where, sizeof where, "%d spheres, scale %g", spheres, scale);
             if (spheres > 16) EXPECT_EQ(scene.bvh.packets(), scale <= 1e20) << where;  // the tree's boxes in floats
             EXPECT_EQ(float_lanes_fit(scene), scale >= 1e-6 && scale <= 1e6) << where;
-            const Image one_path = render_image(scene, 2, Integrator::pt, PacketIsa::one_path);
+            const Image one_path = render_image(scene, 2, Integrator::pt, LaneChoice::off);
             const Image lanes = render_image(scene, 2);
             EXPECT_LE(largest_relative_difference(one_path, unit), 1e-9) << where;
             // Single precision moves a rare sample by more (a path's decision near a boundary):

@@ -593,7 +593,7 @@ TEST(Denoise, BothFiltersAreProportionalToTheLightsPower) {
         for (Light& light : scene.lights) light.power = light.power * power;
         const RenderScene rs = prepare_scene(scene);
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
-        settings.kernels = PacketIsa::double_lanes;
+        settings.kernels = LaneChoice::double_lanes;
         settings.allocation = Allocation::uniform;
         RenderState state(32, 32);
         state.track_halves();

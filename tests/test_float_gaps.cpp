@@ -223,7 +223,7 @@ TEST(FloatGaps, AnEditsPreparedSceneChecksTheGapsAsAFreshOne) {
 }
 
 // A render's radiance with its variance layer, and its count of non-finite samples.
-HdrImage render(const RenderScene& scene, PacketIsa kernels, uint64_t seed, int passes, uint64_t& nonfinite) {
+HdrImage render(const RenderScene& scene, LaneChoice kernels, uint64_t seed, int passes, uint64_t& nonfinite) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.kernels = kernels;
     settings.seed = seed;
@@ -255,13 +255,13 @@ TEST(FloatGaps, EveryKernelRendersHostileScenesAsOnePath) {
     const int passes = 48;
     for (const auto& [scene, what] : scenes) {
         uint64_t nonfinite = 0;
-        const HdrImage one_path = render(scene, PacketIsa::one_path, 1, passes, nonfinite);
+        const HdrImage one_path = render(scene, LaneChoice::off, 1, passes, nonfinite);
         EXPECT_EQ(nonfinite, 0u) << what;
-        for (PacketIsa kernels : {PacketIsa::best, PacketIsa::float8, PacketIsa::double_lanes, PacketIsa::any}) {
+        for (LaneChoice kernels : {LaneChoice::best, LaneChoice::float8, LaneChoice::double_lanes, LaneChoice::any}) {
             const HdrImage lanes = render(scene, kernels, 2, passes, nonfinite);
-            EXPECT_EQ(nonfinite, 0u) << what << ", " << packet_isa_names.name(kernels);
+            EXPECT_EQ(nonfinite, 0u) << what << ", " << lane_choice_names.name(kernels);
             const StatisticalResult r = statistical_compare(lanes, "lanes", one_path, "one path", {});
-            EXPECT_TRUE(r.agree) << what << ", " << packet_isa_names.name(kernels) << ": max |z| " << r.max_abs_z
+            EXPECT_TRUE(r.agree) << what << ", " << lane_choice_names.name(kernels) << ": max |z| " << r.max_abs_z
                                  << " (limit " << r.z_limit << "), chi2 " << r.chi_square << " (limit "
                                  << r.chi_square_limit << ")";
         }
@@ -301,13 +301,13 @@ TEST(FloatGaps, SizesAreJudgedWhereRaysReach) {
 
     const int passes = 48;
     uint64_t nonfinite = 0;
-    const HdrImage one_path = render(scene, PacketIsa::one_path, 1, passes, nonfinite);
+    const HdrImage one_path = render(scene, LaneChoice::off, 1, passes, nonfinite);
     EXPECT_EQ(nonfinite, 0u);
-    for (PacketIsa kernels : {PacketIsa::best, PacketIsa::float8}) {
+    for (LaneChoice kernels : {LaneChoice::best, LaneChoice::float8}) {
         const HdrImage lanes = render(scene, kernels, 2, passes, nonfinite);
-        EXPECT_EQ(nonfinite, 0u) << packet_isa_names.name(kernels);
+        EXPECT_EQ(nonfinite, 0u) << lane_choice_names.name(kernels);
         const StatisticalResult r = statistical_compare(lanes, "lanes", one_path, "one path", {});
-        EXPECT_TRUE(r.agree) << packet_isa_names.name(kernels) << ": max |z| " << r.max_abs_z << " (limit "
+        EXPECT_TRUE(r.agree) << lane_choice_names.name(kernels) << ": max |z| " << r.max_abs_z << " (limit "
                              << r.z_limit << "), chi2 " << r.chi_square << " (limit " << r.chi_square_limit << ")";
     }
 }

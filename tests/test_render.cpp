@@ -317,7 +317,7 @@ TEST(Dielectric, LightInsideGlassInTheLanes) {
     b.scene.renderer.width = b.scene.renderer.height = 16;
     const RenderScene scene = b.build();
     const double expected = (1 - fresnel_dielectric(1, 1 / eta)) * le / (eta * eta);
-    for (PacketIsa isa : {PacketIsa::best, PacketIsa::double_lanes, PacketIsa::one_path}) {
+    for (LaneChoice isa : {LaneChoice::best, LaneChoice::double_lanes, LaneChoice::off}) {
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
         settings.kernels = isa;
         settings.allocation = Allocation::uniform;

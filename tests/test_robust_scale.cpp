@@ -18,15 +18,15 @@ using namespace kr::robust;
 // distances a test meets, relative too.
 TEST(RobustScale, SceneScaledFrom1em4To1e4GivesTheSameImage) {
     for (Integrator integrator : {Integrator::wrt, Integrator::pt})
-        for (PacketIsa kernels : {PacketIsa::double_lanes, PacketIsa::best}) {
-            if (integrator == Integrator::wrt && kernels != PacketIsa::best) continue;  // one path
+        for (LaneChoice kernels : {LaneChoice::double_lanes, LaneChoice::best}) {
+            if (integrator == Integrator::wrt && kernels != LaneChoice::best) continue;  // one path
             RenderSettings settings = settings_for(integrator, 8, 4);
             settings.kernels = kernels;
             const RenderScene unit = still_life(1).build();
-            const PacketKernels ran = packet_kernels(unit, settings);
-            const bool single = ran == PacketKernels::x86_64_v3_float || ran == PacketKernels::x86_64_v4_float;
+            const LaneKernels ran = lane_kernels(unit, settings);
+            const bool single = single_precision(ran);
             const std::string where = std::string(integrator_names.name(integrator)) + ", " +
-                                      std::string(packet_kernels_names.name(ran));
+                                      std::string(lane_kernels_names.name(ran));
             const RenderState reference = render(unit, settings, 24, 24, 4);
             const Image ref = reference.radiance();
             for (double s : {1e-4, 1e-2, 1e2, 1e4}) {

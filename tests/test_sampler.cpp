@@ -61,7 +61,7 @@ TEST(Sobol, SecondDimensionIsItsGeneratorMatrix) {
     }
 }
 
-// The packet tracer draws Sobol numbers in SIMD lanes of words (render/packet.cpp) with the
+// The lanes draw Sobol numbers in SIMD lanes of words (render/lanes/) with the
 // same templates: every lane must give the bits one word gives.
 #pragma GCC diagnostic ignored "-Wpsabi"  // the lanes stay in this function
 TEST(Sobol, LanesGiveWhatOneWordGives) {

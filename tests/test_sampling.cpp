@@ -10,7 +10,7 @@
 
 #include "core/rng.h"
 #include "core/sampling.h"
-#include "render/lanes.h"
+#include "render/lanes/lanes.h"
 #include "render/light.h"
 #include "render/settings.h"
 #include "test_util.h"

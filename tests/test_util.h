@@ -126,10 +126,10 @@ inline Scene brief_scene(int n, int size) {
 }
 
 // The relative tolerance of a render's analytic value: the rounding of the single-precision
-// lanes where they trace the scene (packet_kernels), else double's.
+// lanes where they trace the scene (lane_kernels), else double's.
 inline double analytic_tolerance(const RenderScene& scene, const RenderSettings& settings) {
-    const PacketKernels kernels = packet_kernels(scene, settings);
-    return kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float ? 1e-6 : 1e-9;
+    const LaneKernels kernels = lane_kernels(scene, settings);
+    return single_precision(kernels) ? 1e-6 : 1e-9;
 }
 
 // Upper critical value of the chi-square distribution with `dof` degrees of freedom at

@@ -279,7 +279,7 @@ TEST(Accumulation, NoDriftAfterAMillionSamples) {
     RenderSettings settings = RenderSettings::from_scene(scene.renderer);
     settings.max_depth = 0;
     settings.target_spp = 1;
-    settings.kernels = PacketIsa::double_lanes;
+    settings.kernels = LaneChoice::double_lanes;
     RenderState state(1, 1);
     state.plan.pass_samples = {uint8_t(kMaxPassSamples)};
     for (int i = 0; i < 1000000 / kMaxPassSamples; ++i) ASSERT_TRUE(render_pass(scene, settings, state));

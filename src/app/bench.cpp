@@ -178,7 +178,7 @@ struct BenchOptions {
     double fraction = 1.0 / 32;
     int runs = 3, threads = 0, size = 256;
     double lens = 0;
-    PacketIsa kernels = PacketIsa::best;
+    LaneChoice kernels = LaneChoice::best;
 };
 
 BenchOptions parse(int argc, char** argv) {
@@ -193,7 +193,7 @@ BenchOptions parse(int argc, char** argv) {
         else if (arg == "--runs") o.runs = int(parse_number(arg, value(), 1, 1000));
         else if (arg == "--threads") o.threads = int(parse_number(arg, value(), 1, 4096));
         else if (arg == "--size") o.size = int(parse_number(arg, value(), 1, 8192));
-        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
+        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), lane_choice_names);
         else if (arg == "--lens") o.lens = parse_number(arg, value(), 1e-9, 1e9);
         else if (arg == "--stress") {
             for (const std::string& item : split_list(value()))
@@ -284,14 +284,14 @@ int bench_throughput(const BenchOptions& o) {
             std::printf("| %s | %s | %d of %d | %.2f | %.1f | %.0f | %.1f | %s |\n", name.c_str(),
                         std::string(integrator_names.name(settings.integrator)).c_str(), spp, settings.target_spp, s,
                         median(mrays[c]), estimate, median(pass_ms[c]),
-                        std::string(packet_kernels_names.name(packet_kernels(cameras[c], settings))).c_str());
+                        std::string(lane_kernels_names.name(lane_kernels(cameras[c], settings))).c_str());
         }
         std::fflush(stdout);
     }
     std::printf("\nAll scenes at their own sample counts: %.0f s estimated (%d threads, %s, --kernels %s).\n",
                 total_estimate, omp_get_max_threads(),
                 o.linear ? "linear scan" : ("BVH " + std::string(accel_backend_names.name(o.accel.front()))).c_str(),
-                std::string(packet_isa_names.name(o.kernels)).c_str());
+                std::string(lane_choice_names.name(o.kernels)).c_str());
     return 0;
 }
 
@@ -370,7 +370,7 @@ int bench_stress(const BenchOptions& o) {
                                                                                            : "";
                 count.built[k] = {o.linear ? "linear" : std::string(accel_backend_names.name(bvh.backend())),
                                   own ? std::to_string(bvh.node_count()) : "-", own ? std::to_string(bvh.depth()) : "-",
-                                  std::string(packet_kernels_names.name(packet_kernels(scene, settings))) + lanes};
+                                  std::string(lane_kernels_names.name(lane_kernels(scene, settings))) + lanes};
             }
         }
     std::vector<std::vector<double>> sweep(bvhs);  // ns per ray, per BVH, per count

@@ -57,16 +57,16 @@ std::string module_place(const std::string& name) {
 int print_version() {
     std::printf("keithray %s\n", KEITHRAY_VERSION);
     std::printf("build: %s, %s\n", KEITHRAY_BUILD_TYPE, KEITHRAY_COMPILER);
-    const PacketKernels kernels = cpu_kernels(PacketIsa::best);
-    const std::string name(packet_kernels_names.name(kernels));
-    if (kernels == PacketKernels::one_path)
+    const LaneKernels kernels = cpu_lane_kernels(LaneChoice::best);
+    const std::string name(lane_kernels_names.name(kernels));
+    if (kernels == LaneKernels::one_path)
         std::printf("SIMD kernels on this CPU: none, one path at a time (%s)\n",
-                    cpu_kernels(PacketIsa::any) == PacketKernels::x86_64 ? "the CPU lacks AVX2 and FMA"
+                    cpu_lane_kernels(LaneChoice::any) == LaneKernels::x86_64 ? "the CPU lacks AVX2 and FMA"
                                                                         : "not built for this CPU");
     else
         std::printf("SIMD kernels on this CPU: %s (%s paths at a time in single precision; x86-64-v3 lanes, "
                     "four in double, where a scene's sizes or gaps need it)\n",
-                    name.c_str(), kernels == PacketKernels::x86_64_v4_float ? "sixteen" : "eight");
+                    name.c_str(), lane_count(kernels) == 16 ? "sixteen" : lane_count(kernels) == 8 ? "eight" : "four");
 #ifdef KEITHRAY_HAVE_EMBREE
     std::printf("Embree: yes (%s): scenes of more than 32 spheres (%s)\n", KEITHRAY_EMBREE_VERSION,
                 module_place("embree").c_str());
@@ -96,13 +96,13 @@ std::vector<CommandHelp> command_helps() {
     };
     return {
         {"render", "render scenes headless into image files", render_options_help(), "scene",
-         {{"--kernels", names(packet_isa_names)}}},
+         {{"--kernels", names(lane_choice_names)}}},
         {"view", "the interactive viewer", viewer::view_usage(), "scene",
          {{"--view", names(viewer::view_mode_names)}, {"--error", names(viewer::error_metric_names)}}},
         {"compare", "pass/fail check of a render against a reference, for CI", compare_usage(), "image", {}},
         {"psnr", "PSNR (8-bit) or RMSE and relative MSE (HDR) of two images", psnr_usage(), "image", {}},
         {"bench", "speed and convergence figures", std::string(bench_usage()) + "\n" + convergence_usage(), "scene",
-         {{"--kernels", names(packet_isa_names)}}},
+         {{"--kernels", names(lane_choice_names)}}},
     };
 }
 

@@ -110,7 +110,7 @@ struct Options {
     std::optional<fs::path> output;
     bool quiet = false;
     bool gl = false;  // tone map on the viewer's display path (OSMesa)
-    PacketIsa kernels = PacketIsa::best;
+    LaneChoice kernels = LaneChoice::best;
     std::optional<fs::path> checkpoint, resume;
     double checkpoint_every = 60;
     bool bundled = false;  // no scene given: the bundled scenes, written under ./output/
@@ -124,7 +124,7 @@ Options parse_options(int argc, char** argv) {
         if (read_shared_flag(args, o.render)) continue;
         if (arg == "-h" || arg == "--help") throw UsageError{};
         else if (arg == "--threads") o.threads = int(parse_integer(arg, value(), 1, kMaxThreads));
-        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), packet_isa_names);
+        else if (arg == "--kernels") o.kernels = parse_name(arg, value(), lane_choice_names);
         else if (arg == "--blur") o.blur = int(parse_integer(arg, value(), 0, kMaxBlur));
         else if (arg == "-o" || arg == "--output") o.output = value();
         else if (arg == "--checkpoint") o.checkpoint = value();

@@ -15,9 +15,9 @@ struct Vec2 {
 };
 
 // sin and cos of 2 pi t, the step of sin_cos_turns that works on one double and on SIMD lanes
-// (GCC vector extensions, render/packet.cpp) alike: t = quarter/4 + r with |r| <= 1/8 turn,
+// (GCC vector extensions, render/lanes/) alike: t = quarter/4 + r with |r| <= 1/8 turn,
 // and (s, c) = (sin, cos)(2 pi r) by Taylor polynomials. Forced inline: lanes must not cross
-// a call (render/lanes.h).
+// a call (render/lanes/lanes.h).
 template <class T>
 inline __attribute__((always_inline)) void sin_cos_eighth_turn(T t, T& quarter, T& s, T& c) {
     // Nearest integer by adding and removing 1.5 * 2^52, exact for |4t| < 2^51 (ties to even):

@@ -7,7 +7,8 @@
 #include <stdexcept>
 
 #include "core/module.h"
-#include "render/lanes.h"
+#include "render/lanes/lanes.h"
+#include "render/lanes/levels.h"
 #include "render/render_scene.h"
 
 namespace kr {
@@ -594,15 +595,15 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     }
 }
 
-// Two versions of each entry point (KR_CLONES, lanes.h).
-KR_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
+// A version of each entry point per CPU level (KR_LEVEL_CLONES, lanes/levels.h).
+KR_LEVEL_CLONES int SphereBvh::closest(const Ray& ray, double& t) const {
     if (embree_) return embree_functions_->closest(*embree_, ray, t);
     if (nodes_.empty()) return -1;
     if (wide_) return traverse_wide<false>(*wide_, blocks_, ray, t);
     return scan_leaf<false>(blocks_, nodes_[0].blocks, ray, t);
 }
 
-KR_CLONES bool SphereBvh::any(const Ray& ray) const {
+KR_LEVEL_CLONES bool SphereBvh::any(const Ray& ray) const {
     if (embree_) return embree_functions_->any(*embree_, ray);
     if (nodes_.empty()) return false;
     double t;

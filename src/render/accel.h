@@ -42,11 +42,11 @@ bool embree_fits(const std::vector<SphereGeom>& spheres);
 // Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
 // well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
 // "Switch points": the sixteen single-precision lanes' scan meets Embree at about 1,800
-// spheres, the eight at about 900; the double lanes stop earlier, packet.cpp).
+// spheres, the eight at about 900; the double lanes stop earlier, lanes/targets.h).
 inline constexpr size_t kLaneTreeMaxSpheres = 1800;
 // Up to this many, AccelBackend::own builds it: above it one path down our own tree is the
 // faster (the sixteen float lanes' scan meets it at about 2,500 spheres; eight at about 1,200
-// and the double lanes at about 350 stop earlier, packet.cpp).
+// and the double lanes at about 350 stop earlier, lanes/targets.h).
 inline constexpr size_t kLaneOwnMaxSpheres = 2048;
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
@@ -55,7 +55,7 @@ struct alignas(32) SphereBlock {
     int64_t id[4];  // sphere index; 64-bit to match the lanes of the distance masks
 };
 
-// The tree the SIMD lanes walk (packet.cpp's kernels) for scenes of more than 16 spheres: our
+// The tree the SIMD lanes walk (lanes/kernels.cpp) for scenes of more than 16 spheres: our
 // BVH with small leaves, its boxes in single precision rounded outward and padded (so that a
 // box holds its spheres' hits as the lanes compute them), its spheres in leaf order in both
 // precisions.
@@ -116,7 +116,7 @@ public:
     // Whether any sphere is accepted within [tmin, tmax].
     bool any(const Ray& ray) const;
 
-    // Whether the SIMD lanes (packet.cpp) can cast this scene's rays: it is our one leaf (up
+    // Whether the SIMD lanes (lanes/kernels.cpp) can cast this scene's rays: it is our one leaf (up
     // to 16 spheres), whose spheres they test in turn, or it has a lane tree (lane_tree()).
     bool packets() const { return (!embree_ && nodes_.size() == 1) || !lane_tree_.nodes.empty(); }
     // Whether it is our one leaf, which the lanes test sphere by sphere without a box.

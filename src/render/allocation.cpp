@@ -6,13 +6,14 @@
 
 #include "core/vectorise.h"
 #include "render/allocation.h"
+#include "render/lanes/levels.h"
 #include "render/render_state.h"
 
 namespace kr {
 
 namespace {
 
-// The plan's per-pixel loops are compiled for AVX-512 and AVX2 too (KR_VECTOR_CLONES) and
+// The plan's per-pixel loops are compiled for AVX-512 and AVX2 too (KR_LOOP_CLONES) and
 // vectorised, with the same bits as the scalar ones.
 
 // The 3x3 guard on per-pixel values (variances): each value replaced by the larger of itself
@@ -20,7 +21,7 @@ namespace {
 // miss a rare bright path and show almost no variance; variance varies smoothly over the
 // image, so the neighbours guard against that. Separable, in two loops over rows: first
 // each row's 3-wide sums, then the guarded value from three rows of those sums.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void sum_three_along_row(const double* values, double* sums, size_t width) {
     if (width == 1) {
         sums[0] = (0.0 + values[0]) + 0.0;
@@ -65,7 +66,7 @@ void guard_row(const double* values, const double* sums, const double* above, co
 }
 
 // RenderState::luminance_sample_variance of a row's pixels.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void sample_variance_row(const uint32_t* __restrict count, const Color* __restrict radiance,
                          const double* __restrict luminance_sq, double* __restrict variance, size_t width) {
 KR_INDEPENDENT_ITERATIONS
@@ -75,7 +76,7 @@ KR_INDEPENDENT_ITERATIONS
 
 // A row's sampling weights: the standard deviation of each active pixel's guarded variance
 // (guard_row's value: the larger of its own and its 3x3 mean), 0 where inactive or unknown.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void weight_row(const double* __restrict values, const double* __restrict sums, const double* __restrict above,
                 const double* __restrict below, const uint8_t* __restrict on, double* __restrict weight, size_t width) {
     const GuardCells cells = guard_cells(above, below, width);
@@ -100,7 +101,7 @@ KR_INDEPENDENT_ITERATIONS
 
 // A row's samples in the next pass: each active pixel's quota (its weight plus the floor,
 // scaled) added to its credit, the whole samples taken, the rest kept.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void take_row(const double* __restrict weight, const uint8_t* __restrict on, double floor, double quota_scale,
               float* __restrict credit, uint8_t* __restrict take, size_t width) {
 KR_INDEPENDENT_ITERATIONS

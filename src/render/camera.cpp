@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "core/sampling.h"
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 
 namespace kr {
 

@@ -220,7 +220,7 @@ CheckpointKey checkpoint_key(const Scene& scene, const RenderScene& prepared, co
                    " depth=" + std::to_string(settings.max_depth) + " spp=" + std::to_string(settings.target_spp) +
                    " rr-depth=" + std::to_string(settings.rr_depth) + " seed=" + std::to_string(settings.seed) +
                    // Single- and double-precision lanes round differently.
-                   " kernels=" + word(packet_kernels_names.name(packet_kernels(prepared, settings))) +
+                   " kernels=" + word(lane_kernels_names.name(lane_kernels(prepared, settings))) +
                    // The passes it may take, the implicit cap of an open-ended render included.
                    " passes=" + std::to_string(rule.max_passes) +
                    " noise=" + number(rule.noise) + " min-samples=" + std::to_string(rule.min_samples) +

@@ -4,6 +4,7 @@
 
 #include "core/math.h"
 #include "core/vectorise.h"
+#include "render/lanes/levels.h"
 #include "render/denoise.h"
 #include "render/denoise_common.h"
 
@@ -98,7 +99,7 @@ template <bool Up, bool Down>
 
 // Row y of a pass, in up to three spans: where the left taps are outside (x < step), where
 // all are inside, where the right ones are outside (x >= w - step).
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void atrous_row(const AtrousPass& a, int y) {
     const size_t row = size_t(y) * size_t(a.w);
     const bool up = y - a.step >= 0, down = y + a.step < a.h;

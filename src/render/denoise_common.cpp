@@ -7,6 +7,7 @@
 
 #include "core/math.h"
 #include "core/vectorise.h"
+#include "render/lanes/levels.h"
 
 namespace kr::denoising {
 
@@ -83,7 +84,7 @@ namespace {
 // 3x3 binomial blur of a plane (borders renormalised): SVGF's prefilter of the variance
 // before it scales the luminance stop. Row y; inside the border the weights sum to 1 exactly
 // and the taps are added in the same order, so both loops give the same sums.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void blur3_row(const float* v, float* out, int w, int h, int y) {
     constexpr float k[3] = {0.25f, 0.5f, 0.25f};
     const auto border = [&](int x) {
@@ -134,7 +135,7 @@ namespace {
 
 // prepare's per-pixel step, pixels [i0, i1): the demodulated radiance, the variances and
 // luminances (demodulated and raw), the unit feature vector and the depth.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void prepare_pixels(const DenoiseInput& in, DenoiseWorkspace& p, size_t i0, size_t i1) {
     const Color* __restrict rad = in.radiance->pixels.data();
     const Color* __restrict variance = in.variance.data();
@@ -193,7 +194,7 @@ KR_INDEPENDENT_ITERATIONS
 // The depth gradient of row y: per axis the smaller one-sided difference (the smooth side at
 // a silhouette; a side outside the image does not count), summed over the axes so that any
 // 3x3 tap's change on a plane stays below it.
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void depth_gradient_row(const float* z_plane, float* zgrad, int w, int h, int y) {
     const size_t row = size_t(y) * size_t(w);
     const float* __restrict z = z_plane + row;
@@ -259,7 +260,7 @@ DenoiseWorkspace& prepared_planes(const DenoiseInput& input, DenoiseWorkspace* w
 namespace {
 
 // remodulate_and_fade's pixels [i0, i1).
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void remodulate_and_fade_pixels(const Image& raw, const DenoiseWorkspace& p, const float* raw_var, float t2, Image& out,
                                 size_t i0, size_t i1) {
     const DenoiseBasePlanes& b = p.base;

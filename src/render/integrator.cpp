@@ -1,12 +1,12 @@
 // The two integrators: Whitted-style recursive ray tracing and iterative path tracing, one
 // sample at a time. Path tracing of eight (float) or four (double) samples at once is
-// packet.cpp; the steps both path tracers share are in path.cpp and vertex.h.
+// lanes/kernels.cpp; the steps both path tracers share are in path.cpp and vertex.h.
 #include <algorithm>
 
 #include "render/material.h"
 #include "render/path.h"
 #include "render/trace.h"
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 
 namespace kr {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "core/sampling.h"
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 
 namespace kr {
 

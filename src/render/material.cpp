@@ -1,6 +1,6 @@
 #include "render/material.h"
 
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 
 namespace kr {
 

@@ -4,7 +4,7 @@
 
 #include "core/math.h"
 #include "core/sampling.h"
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 #include "scene/scene.h"
 
 namespace kr {

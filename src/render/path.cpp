@@ -1,5 +1,5 @@
 // The steps of path tracing that the one-path integrator (integrator.cpp) and the lanes
-// (packet.cpp) share: a ray's respawn, the weight of emission hit by chance, next-event
+// (lanes/kernels.cpp) share: a ray's respawn, the weight of emission hit by chance, next-event
 // estimation of one light, and which numbers a vertex draws.
 #include "render/path.h"
 
@@ -7,7 +7,7 @@
 
 #include "render/light.h"
 #include "render/sampler.h"
-#include "render/vertex.h"
+#include "render/lanes/vertex.h"
 
 namespace kr {
 

@@ -1,5 +1,5 @@
 // The steps of path tracing that the one-sample integrator (integrator.cpp) and the
-// lane-wise one (packet.cpp: eight float or four double lanes) share, so that both trace
+// lane-wise one (lanes/kernels.cpp: eight float or four double lanes) share, so that both trace
 // the same paths.
 #pragma once
 

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/vectorise.h"
+#include "render/lanes/levels.h"
 
 namespace kr {
 
@@ -17,7 +18,7 @@ Sampler::Sampler(Estimator estimator, uint64_t seed, uint64_t pixel, uint32_t in
     if (estimator != Estimator::sobol) rng_ = Rng::for_sample(seed, pixel, index);
 }
 
-KR_VECTOR_CLONES
+KR_LOOP_CLONES
 void Sampler::pixel_keys(uint64_t seed, uint64_t first_pixel, size_t count, uint32_t* keys) {
     KR_INDEPENDENT_ITERATIONS
     for (size_t i = 0; i < count; ++i) keys[i] = pixel_key(seed, first_pixel + i);

@@ -25,9 +25,9 @@ enum class Estimator { uniform, stratified, sobol };
 inline constexpr EnumNames<Estimator, 3> estimator_names{{"uniform", "stratified", "sobol"}};
 
 // Sobol sequence building blocks (exposed for tests), all on 32-bit binary fractions, each
-// for one word (U = uint32_t) and for SIMD lanes of words (packet.cpp) alike: integer
+// for one word (U = uint32_t) and for SIMD lanes of words (lanes/kernels.cpp) alike: integer
 // operations, so both give the same bits. Forced inline: a path vertex draws five
-// dimensions, and lanes must not cross a call (render/lanes.h).
+// dimensions, and lanes must not cross a call (render/lanes/lanes.h).
 #define KR_SOBOL_INLINE inline __attribute__((always_inline))
 
 template <class U>
@@ -36,7 +36,7 @@ KR_SOBOL_INLINE U reverse_bits(U x) {
         x = __builtin_bswap32(x);  // bytes by one instruction
     } else {
         // Bytes by two swap steps. The x86-64-v3 kernels reverse lanes with byte shuffles
-        // of their own (packet_lanes.inc); these serve the kernels for any CPU.
+        // of their own (lanes/kernels.cpp); these serve the kernels for any CPU.
         x = (x >> 16) | (x << 16);
         x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
     }
@@ -94,7 +94,7 @@ KR_SOBOL_INLINE U hash32(U x) {
     return x ^ (x >> 16);
 }
 
-// reverse_bits as SobolDimension's default way to reverse; packet.cpp's x86-64-v3 kernels
+// reverse_bits as SobolDimension's default way to reverse; lanes/kernels.cpp's x86-64-v3 kernels
 // pass one with instructions of their own.
 struct BitReverse {
     template <class U>
@@ -209,7 +209,7 @@ public:
     }
 
     // The Sobol estimator's state, for drawing four samplers' numbers in SIMD lanes
-    // (packet.cpp): the pixel's key, the index bit-reversed, and the next dimension. The
+    // (lanes/kernels.cpp): the pixel's key, the index bit-reversed, and the next dimension. The
     // lanes move each sampler on by the dimensions they drew.
     bool sobol() const { return estimator_ == Estimator::sobol; }
     uint32_t sobol_key() const { return sobol_key_; }

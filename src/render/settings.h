@@ -23,16 +23,16 @@ inline constexpr EnumNames<Integrator, 3> integrator_names{{"wrt", "pt", "pt-nai
 enum class Allocation { uniform, adaptive };
 inline constexpr EnumNames<Allocation, 2> allocation_names{{"uniform", "adaptive"}};
 
-// How camera_rays and trace_samples trace (render/trace.h, packet.cpp). `best`: in SIMD lanes
+// How camera_rays and trace_samples trace (render/trace.h, render/lanes/lanes.cpp). `best`: in SIMD lanes
 // with the kernels built for x86-64-v3 where the CPU has AVX2 and FMA, else one path at a
 // time (the kernels built for any x86-64 CPU are slower than that); paths in single precision
 // where the scene's sizes fit it (float_lanes_fit): sixteen at a time where the CPU has
 // AVX-512 (x86-64-v4), else eight; else four in double. `float8`: the eight float lanes even
 // where sixteen run; `double`: always the four double lanes where the CPU has them; `any`: in
-// lanes with the kernels for any CPU; `one_path`: one at a time. All but `best` are for tests
+// lanes with the kernels for any CPU; `off`: one path at a time. All but `best` are for tests
 // and comparisons; every choice gives the same paths up to rounding.
-enum class PacketIsa { best, double_lanes, float8, any, one_path };
-inline constexpr EnumNames<PacketIsa, 5> packet_isa_names{{"best", "double", "float8", "any", "off"}};
+enum class LaneChoice { best, double_lanes, float8, any, off };
+inline constexpr EnumNames<LaneChoice, 5> lane_choice_names{{"best", "double", "float8", "any", "off"}};
 
 struct RenderSettings {
     Integrator integrator = Integrator::pt;
@@ -43,7 +43,7 @@ struct RenderSettings {
     int target_spp = 1;         // s of the stratified estimator: e = floor(sqrt(s)) strata per axis
     int rr_depth = 3;           // Russian roulette from this many scattering events on
     uint64_t seed = 0;
-    PacketIsa kernels = PacketIsa::best;  // which SIMD kernels trace the paths
+    LaneChoice kernels = LaneChoice::best;  // which SIMD kernels trace the paths
 
     // Defaults from the scene file's renderer block.
     static RenderSettings from_scene(const RendererSettings& renderer);

@@ -1,12 +1,13 @@
 // The tracing entry points: one radiance sample for a camera ray (trace_sample,
 // integrator.cpp), and many at once in SIMD lanes where the settings' kernels and the scene
-// allow (packet.cpp). The progressive driver (render/progressive.h) calls them per pass.
+// allow (render/lanes/). The progressive driver (render/progressive.h) calls them per pass.
 #pragma once
 
 #include <cstdint>
 
 #include "core/enum_names.h"
 #include "core/math.h"
+#include "render/lanes/targets.h"
 #include "render/render_scene.h"
 #include "render/sampler.h"
 #include "render/settings.h"
@@ -25,6 +26,23 @@ inline Vec2 raster_to_camera(double x, double y, int width, int height) {
     return {(x - 0.5) / width, (y + 0.5) / height};
 }
 
+// One sample's camera ray (CameraModel::generate), its sampler giving the sub-pixel position
+// and the lens numbers (skipped for a pinhole): one path's, and the lanes' where a sampler
+// is not a Sobol one at its first dimension.
+inline Ray camera_ray(const RenderScene& scene, int width, int height, int x, int y, Sampler& sampler) {
+    const CameraModel& camera = scene.camera;
+    const Vec2 sub = sampler.pixel();
+    Vec2 lens;
+    if (camera.lens_radius > 0) lens = sampler.next_2d();
+    else sampler.skip_2d();  // a pinhole's image stays the same as a tiny lens's
+    const Vec2 film = raster_to_camera(x + sub.x, y + sub.y, width, height);
+    const CameraRay cr = camera.generate(film.x, film.y, lens.x, lens.y);
+    Ray ray;
+    ray.o = cr.origin;
+    ray.d = cr.direction;
+    return ray;
+}
+
 // One radiance sample for a camera ray, for tests and tools: the integrator the settings name.
 struct SampleResult {
     Color radiance;
@@ -36,15 +54,15 @@ SampleResult trace_sample(const RenderScene& scene, const RenderSettings& settin
                           Sampler& sampler);
 // The camera rays of `count` samples of pixels (xs[i], ys[i]) of a width x height image, each
 // sampler having given nothing yet: it gives the sub-pixel position and the lens numbers
-// (skipped for a pinhole). Four at a time in SIMD lanes (packet.cpp, where packet_kernels()
-// below has lanes) for Sobol samplers (pinhole or thin lens), each ray as one at a time gives
+// (skipped for a pinhole). Four at a time in SIMD lanes (lanes/lanes.cpp, where
+// lane_kernels() below has lanes) for Sobol samplers (pinhole or thin lens), each ray as one at a time gives
 // it up to rounding.
 void camera_rays(const RenderScene& scene, const RenderSettings& settings, int width, int height, const int* xs, const int* ys,
                  Sampler* const* samplers, int count, Ray* rays);
 
 // `count` samples at once, each as trace_sample gives it up to rounding. Path tracing takes
-// camera rays in SIMD lanes (packet.cpp: sixteen or eight paths in single precision, or four
-// in double, as packet_kernels() below says), a lane starting the next sample as its path
+// camera rays in SIMD lanes (lanes/lanes.cpp: sixteen or eight paths in single precision, or
+// four in double, as lane_kernels() below says), a lane starting the next sample as its path
 // ends, where the scene is one leaf of our BVH; anything else goes one by one through
 // trace_sample. render_pass hands it up to kSampleBatch samples: the more, the less time
 // lanes idle at the batch's end (docs/performance.md, "Design choices and their figures").
@@ -54,32 +72,30 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
 
 // camera_rays, then trace_samples: `count` camera samples at pixels (xs, ys). The
 // single-precision lanes make the camera rays themselves (pinhole or thin lens), eight at a
-// time, for Sobol samplers (the same samples; packet.cpp).
+// time, for Sobol samplers (the same samples; lanes/lanes.cpp).
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
 
-// What trace_samples runs for path tracing with these settings on this scene, as the
-// settings' kernels, the CPU and the scene decide (under `best`, each kind of lanes only up
-// to the sphere count where one path at a time becomes the faster: packet.cpp).
-enum class PacketKernels { x86_64_v3_float, x86_64_v3, x86_64, one_path, x86_64_v4_float };
-inline constexpr EnumNames<PacketKernels, 5> packet_kernels_names{
-    {"x86-64-v3 float lanes", "x86-64-v3 lanes", "x86-64 lanes", "one path", "x86-64-v4 float lanes"}};
-PacketKernels packet_kernels(const RenderScene& scene, const RenderSettings& settings);
-// The kernels this CPU runs for `isa` before a scene has a say (a scene whose sizes keep
+// What trace_samples runs for path tracing with these settings on this scene (a SIMD target
+// of render/lanes/targets.h, or one path), as the settings' kernels, the CPU and the scene
+// decide (under `best`, each target only up to the sphere count where one path at a time
+// becomes the faster: lanes/lanes.cpp).
+LaneKernels lane_kernels(const RenderScene& scene, const RenderSettings& settings);
+// The kernels this CPU runs for `choice` before a scene has a say (a scene whose sizes keep
 // the float lanes out gets the double ones): what `keithray --version` reports.
-PacketKernels cpu_kernels(PacketIsa isa);
+LaneKernels cpu_lane_kernels(LaneChoice choice);
 
-// Whether these kernels (packet_kernels' answer) make camera rays and trace paths in lanes
+// Whether these kernels (lane_kernels' answer) make camera rays and trace paths in lanes
 // straight from Sobol samples given as keys and indices (trace_sobol_camera_samples): the
 // float lanes.
-bool sobol_camera_lanes(PacketKernels kernels);
+bool sobol_camera_lanes(LaneKernels kernels);
 // trace_camera_samples for `count` samples of Sobol samplers known by their pixel keys and
 // bit-reversed sample indices, each the sampler Sampler(keys[i], reverse_bits(
-// index_reversed[i])) before it has drawn anything; `kernels` is packet_kernels' answer for
+// index_reversed[i])) before it has drawn anything; `kernels` is lane_kernels' answer for
 // the scene and settings. Where sobol_camera_lanes(kernels) holds and the batch has more
 // than one sample, no Sampler is made (render_pass's batches); otherwise the samplers are
 // made and trace_camera_samples takes them.
-void trace_sobol_camera_samples(PacketKernels kernels, const RenderScene& scene, const RenderSettings& settings,
+void trace_sobol_camera_samples(LaneKernels kernels, const RenderScene& scene, const RenderSettings& settings,
                                 int width, int height, const int* xs, const int* ys, const uint32_t* keys,
                                 const uint32_t* index_reversed, int count, SampleResult* results);
 

@@ -1,4 +1,4 @@
-// Paths in lanes (render/packet.cpp) against one path at a time: the same samples, so the
+// Paths in lanes (render/lanes/) against one path at a time: the same samples, so the
 // same images. Each sample of a batch traced together must give what trace_sample gives it
 // with the same sampler: its radiance, its first hit's distance and its ray count. Every test
 // runs three times: with the kernels for any x86-64 CPU, with the x86-64-v3 double lanes and
@@ -26,7 +26,7 @@
 using namespace kr;
 
 namespace kr {
-void PrintTo(PacketIsa isa, std::ostream* out) { *out << packet_isa_names.name(isa); }
+void PrintTo(LaneChoice isa, std::ostream* out) { *out << lane_choice_names.name(isa); }
 }  // namespace kr
 
 namespace {
@@ -44,8 +44,8 @@ bool close(double a, double b, double tolerance = 1e-9) { return std::abs(a - b)
 // 1e-4, 4 (one path of scene 3 under four light strategies) by more than 1e-3, the largest
 // by 0.7 %. A wrong factor or branch differs by far more, on many samples.
 double lane_tolerance(const RenderScene& scene, const RenderSettings& settings) {
-    const PacketKernels kernels = packet_kernels(scene, settings);
-    return kernels == PacketKernels::x86_64_v3_float || kernels == PacketKernels::x86_64_v4_float ? 1e-2 : 1e-9;
+    const LaneKernels kernels = lane_kernels(scene, settings);
+    return single_precision(kernels) ? 1e-2 : 1e-9;
 }
 
 // `batches` batches of `count` camera samples of pixels spread over the image, traced together
@@ -112,7 +112,7 @@ RenderScene brief_scene(int n) {
 }
 
 // The kernels a test runs with: its settings' `kernels`.
-class Packet : public ::testing::TestWithParam<PacketIsa> {
+class Lanes : public ::testing::TestWithParam<LaneChoice> {
 protected:
     RenderSettings settings_of(const RenderScene& scene) const {
         RenderSettings settings = RenderSettings::from_scene(scene.renderer);
@@ -123,11 +123,35 @@ protected:
 
 }  // namespace
 
-INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, PacketIsa::double_lanes, PacketIsa::float8,
-                                                             PacketIsa::best),
-                         [](const ::testing::TestParamInfo<PacketIsa>& info) {
+INSTANTIATE_TEST_SUITE_P(Kernels, Lanes, ::testing::Values(LaneChoice::any, LaneChoice::double_lanes, LaneChoice::float8,
+                                                             LaneChoice::best),
+                         [](const ::testing::TestParamInfo<LaneChoice>& info) {
                              return ::testing::PrintToString(info.param);
                          });
+
+// The names users see (`--kernels`, `--version`, the statistics' paths column) stay those of
+// the targets' rows and the choices' table; the targets' precision and width follow their rows.
+TEST(LaneNames, TargetsAndChoicesKeepTheirNames) {
+    EXPECT_EQ(lane_kernels_names.name(LaneKernels::x86_64_v4_float), "x86-64-v4 float lanes");
+    EXPECT_EQ(lane_kernels_names.name(LaneKernels::x86_64_v3_float), "x86-64-v3 float lanes");
+    EXPECT_EQ(lane_kernels_names.name(LaneKernels::x86_64_v3), "x86-64-v3 lanes");
+    EXPECT_EQ(lane_kernels_names.name(LaneKernels::x86_64), "x86-64 lanes");
+    EXPECT_EQ(lane_kernels_names.name(LaneKernels::one_path), "one path");
+    EXPECT_EQ(lane_choice_names.parse("off"), LaneChoice::off);
+    EXPECT_EQ(lane_choice_names.name(LaneChoice::off), "off");
+    EXPECT_EQ(lane_choice_names.parse("double"), LaneChoice::double_lanes);
+    EXPECT_EQ(lane_choice_names.parse("float8"), LaneChoice::float8);
+    EXPECT_TRUE(single_precision(LaneKernels::x86_64_v4_float) && single_precision(LaneKernels::x86_64_v3_float));
+    EXPECT_FALSE(single_precision(LaneKernels::x86_64_v3) || single_precision(LaneKernels::x86_64) ||
+                 single_precision(LaneKernels::one_path));
+    EXPECT_EQ(lane_count(LaneKernels::x86_64_v4_float), 16);
+    EXPECT_EQ(lane_count(LaneKernels::x86_64_v3_float), 8);
+    EXPECT_EQ(lane_count(LaneKernels::x86_64_v3), 4);
+    EXPECT_EQ(lane_count(LaneKernels::one_path), 1);
+    // The choice `off` is one path at a time on every CPU; `any` the kernels every x86-64 runs.
+    EXPECT_EQ(cpu_lane_kernels(LaneChoice::off), LaneKernels::one_path);
+    EXPECT_EQ(cpu_lane_kernels(LaneChoice::any), LaneKernels::x86_64);
+}
 
 // The switch itself. `best` is the x86-64-v3 lanes where the CPU has them (in single
 // precision where the scene fits them), else one path at a time, never the lanes for any CPU
@@ -135,38 +159,38 @@ INSTANTIATE_TEST_SUITE_P(Kernels, Packet, ::testing::Values(PacketIsa::any, Pack
 // AVX2 and FMA and built the v3 kernels (a CI machine may lack them). Scenes whose sizes single precision cannot keep (a wall of radius 1e6 beside a
 // sphere of 0.5) keep the double lanes, and scenes that are no single BVH leaf go one path at
 // a time whatever the switch says.
-TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
+TEST(LaneChoiceSwitch, BestIsTheV3LanesOrOnePath) {
     const RenderScene brief = brief_scene(6);
     RenderSettings settings = RenderSettings::from_scene(brief.renderer);
     EXPECT_TRUE(float_lanes_fit(brief));
     RenderScene wide_lens = brief;  // rays from up to 1e4 away: beyond 4096 radii of 0.5
     wide_lens.camera.lens_radius = 1e4;
     EXPECT_FALSE(float_lanes_fit(wide_lens));
-    settings.kernels = PacketIsa::any;
-    EXPECT_EQ(packet_kernels(brief, settings), PacketKernels::x86_64);
-    settings.kernels = PacketIsa::one_path;
-    EXPECT_EQ(packet_kernels(brief, settings), PacketKernels::one_path);
-    settings.kernels = PacketIsa::double_lanes;
-    const PacketKernels v3 = packet_kernels(brief, settings);
-    EXPECT_TRUE(v3 == PacketKernels::x86_64_v3 || v3 == PacketKernels::one_path);
-    settings.kernels = PacketIsa::float8;
-    const PacketKernels float8 = packet_kernels(brief, settings);
-    EXPECT_EQ(float8, v3 == PacketKernels::x86_64_v3 ? PacketKernels::x86_64_v3_float : PacketKernels::one_path);
-    settings.kernels = PacketIsa::best;
-    const PacketKernels best = packet_kernels(brief, settings);
+    settings.kernels = LaneChoice::any;
+    EXPECT_EQ(lane_kernels(brief, settings), LaneKernels::x86_64);
+    settings.kernels = LaneChoice::off;
+    EXPECT_EQ(lane_kernels(brief, settings), LaneKernels::one_path);
+    settings.kernels = LaneChoice::double_lanes;
+    const LaneKernels v3 = lane_kernels(brief, settings);
+    EXPECT_TRUE(v3 == LaneKernels::x86_64_v3 || v3 == LaneKernels::one_path);
+    settings.kernels = LaneChoice::float8;
+    const LaneKernels float8 = lane_kernels(brief, settings);
+    EXPECT_EQ(float8, v3 == LaneKernels::x86_64_v3 ? LaneKernels::x86_64_v3_float : LaneKernels::one_path);
+    settings.kernels = LaneChoice::best;
+    const LaneKernels best = lane_kernels(brief, settings);
     // The sixteen float lanes where the CPU has AVX-512, else the eight.
-    EXPECT_TRUE(best == float8 || (float8 == PacketKernels::x86_64_v3_float && best == PacketKernels::x86_64_v4_float));
-    std::printf("best on this CPU: %s\n", std::string(packet_kernels_names.name(best)).c_str());
+    EXPECT_TRUE(best == float8 || (float8 == LaneKernels::x86_64_v3_float && best == LaneKernels::x86_64_v4_float));
+    std::printf("best on this CPU: %s\n", std::string(lane_kernels_names.name(best)).c_str());
 #if KEITHRAY_V4_KERNELS_EXPECTED
     // CMake built the kernels (GCC's pragmas, or the Clang sanitizer builds' whole-file
     // -march=x86-64-v4) and saw AVX-512: so every build, sanitized ones too, runs the sixteen
     // float lanes here, and the eight where asked.
-    EXPECT_EQ(best, PacketKernels::x86_64_v4_float);
-    EXPECT_EQ(float8, PacketKernels::x86_64_v3_float);
+    EXPECT_EQ(best, LaneKernels::x86_64_v4_float);
+    EXPECT_EQ(float8, LaneKernels::x86_64_v3_float);
 #elif KEITHRAY_V3_KERNELS_EXPECTED
     // CMake built the v3 kernels (GCC's pragma, or the Clang sanitizer builds' whole-file
     // -march) and saw AVX2 and FMA: so every build, sanitized ones too, runs them here.
-    EXPECT_EQ(best, PacketKernels::x86_64_v3_float);
+    EXPECT_EQ(best, LaneKernels::x86_64_v3_float);
 #endif
 
     test::SceneBuilder b;
@@ -176,7 +200,7 @@ TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
     b.emitter({0, 3, 0}, 0.5, Color(5), grey);
     const RenderScene huge = b.build();
     EXPECT_FALSE(float_lanes_fit(huge));
-    EXPECT_EQ(packet_kernels(huge, settings), v3);  // the double lanes, where the CPU has them
+    EXPECT_EQ(lane_kernels(huge, settings), v3);  // the double lanes, where the CPU has them
     // Reaching 2001 from the origin, under 2^12 times the smallest radius (2048): single.
     b.scene.shapes[0].radius = 1000;
     b.scene.shapes[0].centre = {0, -1001, 0};
@@ -189,13 +213,13 @@ TEST(PacketIsaSwitch, BestIsTheV3LanesOrOnePath) {
     }
     RenderSettings wrt = settings;
     wrt.integrator = Integrator::wrt;
-    EXPECT_EQ(packet_kernels(brief, wrt), PacketKernels::one_path);
+    EXPECT_EQ(lane_kernels(brief, wrt), LaneKernels::one_path);
 }
 
 // The brief's path-traced scenes, with every estimator and light strategy, and naive PT.
 // The lanes round like one path except where fused multiply-adds land differently, which can
 // only turn a path that grazes a sphere: at most one sample in 500 may differ.
-TEST_P(Packet, SameSamplesAsOneByOne) {
+TEST_P(Lanes, SameSamplesAsOneByOne) {
     for (int n : {3, 4, 5, 6, 8}) {
         const RenderScene scene = brief_scene(n);
         ASSERT_TRUE(scene.bvh.packets()) << "scene " << n;
@@ -224,7 +248,7 @@ TEST_P(Packet, SameSamplesAsOneByOne) {
 // A scene with what the brief's lack: point lights beside area lights (so the light choice
 // goes both ways), a black area light, every material, shading points inside a light, and
 // batches of one to five samples (fewer than the lanes, and one more) and of a hundred.
-TEST_P(Packet, PointLightsEveryMaterialAndPartialPackets) {
+TEST_P(Lanes, PointLightsEveryMaterialAndPartialPackets) {
     test::SceneBuilder b;
     b.scene.renderer.width = b.scene.renderer.height = 32;
     const int grey = b.material(MaterialType::diffuse, Color(0.7));
@@ -297,7 +321,7 @@ RenderScene many_spheres(int n, int lights, uint64_t seed) {
     return b.build();
 }
 
-TEST_P(Packet, ManySpheresAsOneByOne) {
+TEST_P(Lanes, ManySpheresAsOneByOne) {
     for (const auto& [n, lights] : {std::pair{40, 2}, std::pair{100, 20}}) {
         const RenderScene scene = many_spheres(n, lights, uint64_t(n));
         ASSERT_TRUE(scene.bvh.packets());
@@ -329,7 +353,7 @@ TEST_P(Packet, ManySpheresAsOneByOne) {
 
 // Whole passes: the image of render_pass (which traces batches of samples in lanes) equals the image
 // of the same samples traced one by one, on scenes 3 and 8 at 64x64.
-TEST_P(Packet, RenderPassImageIsOneByOnes) {
+TEST_P(Lanes, RenderPassImageIsOneByOnes) {
     for (int n : {3, 8}) {
         const RenderScene scene = brief_scene(n);
         RenderSettings settings = settings_of(scene);
@@ -370,7 +394,7 @@ TEST_P(Packet, RenderPassImageIsOneByOnes) {
 // Camera rays four at a time (Sobol samplers and a pinhole; otherwise one by one) against one
 // by one: the same rays, and every sampler left where the one-by-one sampler is. Seven
 // samples, so the last group is partial; scene 3 also through its thin lens.
-TEST_P(Packet, CameraRaysAreOneByOnes) {
+TEST_P(Lanes, CameraRaysAreOneByOnes) {
     RenderScene scene = brief_scene(3);
     const int width = scene.renderer.width, height = scene.renderer.height;
     for (double lens_radius : {0.0, 0.2})
@@ -410,7 +434,7 @@ TEST_P(Packet, CameraRaysAreOneByOnes) {
 // traced as one path), within a lane group, across chunks of kSampleBatch, through a pinhole
 // and a thin lens. (CameraSamplesAreOneByOnes holds the samplers' entry to one path's
 // samples.)
-TEST_P(Packet, SobolSamplesAsKeysAreSamplersSamples) {
+TEST_P(Lanes, SobolSamplesAsKeysAreSamplersSamples) {
     RenderScene scene = brief_scene(3);
     const int width = scene.renderer.width, height = scene.renderer.height;
     for (double lens_radius : {0.0, 0.2})
@@ -429,7 +453,7 @@ TEST_P(Packet, SobolSamplesAsKeysAreSamplersSamples) {
                 samplers[k] = &made[k].emplace(keys[k], indices[k], reversed[k]);
             }
             std::vector<SampleResult> from_keys(n), from_samplers(n);
-            trace_sobol_camera_samples(packet_kernels(scene, settings), scene, settings, width, height, xs.data(),
+            trace_sobol_camera_samples(lane_kernels(scene, settings), scene, settings, width, height, xs.data(),
                                        ys.data(), keys.data(), reversed.data(), count, from_keys.data());
             trace_camera_samples(scene, settings, width, height, xs.data(), ys.data(), samplers.data(), count,
                                  from_samplers.data());
@@ -448,7 +472,7 @@ TEST_P(Packet, SobolSamplesAsKeysAreSamplersSamples) {
 // pinhole, the single-precision lanes make the camera rays themselves) against camera_ray and
 // trace_sample one by one: counts below, at and above a lane group and a batch, and the thin
 // lens, which always takes camera_rays' rays.
-TEST_P(Packet, CameraSamplesAreOneByOnes) {
+TEST_P(Lanes, CameraSamplesAreOneByOnes) {
     RenderScene scene = brief_scene(3);
     const int width = scene.renderer.width, height = scene.renderer.height;
     for (double lens_radius : {0.0, 0.2})

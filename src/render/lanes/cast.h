@@ -1,12 +1,16 @@
-// Ray casting in lanes, for packet_lanes.inc (included after lane_math.inc): the closest hit
-// and the shadow test of the lanes' rays against the up to 16 spheres of a one-leaf scene,
-// tested in turn, or against a larger scene's spheres down its lane tree or, in the float
-// lanes up to kLaneScanMaxSpheres, its clusters (accel.h).
+// Ray casting in lanes, for kernels.cpp (included after math.h): the closest hit and the
+// shadow test of the lanes' rays against the up to 16 spheres of a one-leaf scene, tested in
+// turn, or against a larger scene's spheres down its lane tree or, in the float lanes up to
+// kLaneScanMaxSpheres, its clusters (accel.h).
+#pragma once
+
+#include "render/lanes/math.h"
+
 // A sphere as the ray tests read it: the centre, the squared radius, |centre|_1 and its index.
 using TestSphere = LaneSphere<real>;
 
 // accepted_root (render_scene.cpp) of the lanes' rays against one sphere: the distance per lane, or
-// +inf. The rays start at tmin = 0 (trace_packet checks). kShadow: segments with an end and a
+// +inf. The rays start at tmin = 0 (trace_lanes checks). kShadow: segments with an end and a
 // target sphere; closest-hit rays have neither. Where q = 0 the roots come out as +-inf, NaN
 // and 0, none of which is accepted, as accepted_root rejects that case; where disc < 0 the
 // square root is NaN and the lane is rejected too.
@@ -65,7 +69,7 @@ KR_LANES void closest_lanes(const TestSphere* spheres, size_t count, const V3& o
     best_id = alive ? best_id : vm{} - 1;
 }
 
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
 // Whether one sphere blocks each shadow segment, accepted_root's answer without its roots (no
 // square root, division or branch): the segment, shortened as accepted_root shortens it,
 // - from outside the sphere, is blocked where its nearest point to the centre lies inside;
@@ -81,7 +85,7 @@ KR_LANES vm segment_blocked_lanes(const V3& o, const V3& d, vm from, vm into, vf
     const V3 f{o.x - sphere.x, o.y - sphere.y, o.z - sphere.z};
     const vf b = dot(f, d), f2 = dot(f, f), two_b = b + b;
     const vf end = end_base - kEndTolerance * sphere.centre_l1;
-#ifdef KR_PACKET_FLOAT16
+#ifdef KR_LANES_V4
     const vf nearest_t = _mm512_maskz_min_ps(0xffff, _mm512_maskz_max_ps(0xffff, -b, vf{}), end);  // (GCC 12 warns of the unmasked forms)
 #else
     const vf nearest_t = _mm256_min_ps(_mm256_max_ps(-b, vf{}), end);
@@ -97,7 +101,7 @@ KR_LANES vm segment_blocked_lanes(const V3& o, const V3& d, vm from, vm into, vf
 // The shadow segments' end as the eight float lanes' test takes it (segment_blocked_lanes);
 // the other lanes read tmax itself.
 KR_LANES vf segment_end(const V3& o, vf tmax) {
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
     const vf o_l1 = abs_lanes(o.x) + abs_lanes(o.y) + abs_lanes(o.z);
     return select(tmax < kInf, tmax - kEndTolerance * (tmax + o_l1), tmax);
 #else
@@ -115,7 +119,7 @@ KR_LANES vm occluded_lanes(const TestSphere* spheres, size_t count, const V3& o,
     const vf end = segment_end(o, tmax);
     vm id{};
     for (size_t s = 0; s < count; ++s, id += 1)
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
         blocked |= segment_blocked_lanes(o, d, from, into, end, to, spheres[s], id);
 #else
         blocked |= sphere_lanes<true>(o, d, from, into, end, to, spheres[s], id) < kInf;
@@ -191,7 +195,7 @@ KR_LANES vm blocked_among(const TestSphere* first, const TestSphere* last, const
                           vm into, vf end, vm to) {
     vm blocked = vm{};
     for (const TestSphere* sphere = first; sphere != last; ++sphere)
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
         blocked |= segment_blocked_lanes(o, d, from, into, end, to, *sphere, vm{} + lane_int(sphere->id));
 #else
         blocked |= sphere_lanes<true>(o, d, from, into, end, to, *sphere, vm{} + lane_int(sphere->id)) < kInf;

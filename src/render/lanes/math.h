@@ -1,18 +1,37 @@
-// The lanes' types and maths, for packet_lanes.inc (included there, in each kernel's namespace,
-// compiled with its instruction set): four doubles or eight floats, 3-vectors of lanes, and
+// The lanes' types and maths, for kernels.cpp (included there, in the target's namespace,
+// compiled for its CPU level): four doubles, eight or sixteen floats, 3-vectors of lanes, and
 // lane-wise copies of core's sampling maths, operation for operation; with them the lanes are
 // vertex.h's lane type (Lanes, at the end).
-// The lanes: four doubles, or (KR_PACKET_FLOAT8, x86-64-v3 only) eight floats, or
-// (KR_PACKET_FLOAT8 with KR_PACKET_FLOAT16, x86-64-v4 only) sixteen floats, with masks and
-// indices as integers of the same width, and 32-bit words for the Sobol numbers.
-#if defined(KR_PACKET_FLOAT16)
+#pragma once
+
+// The target's lanes (CMake names the target: KR_LANE_TARGET_<id>, targets.h): four doubles,
+// or (KR_LANES_FLOAT) eight floats for x86-64-v3 or (with KR_LANES_V4) sixteen for x86-64-v4,
+// with masks and indices as integers of the same width, and 32-bit words for the Sobol
+// numbers. KR_LANES_V3: the x86-64-v3 forms of the few steps GCC's vector extensions have no
+// good form for; KR_LANES_V4: the AVX-512 ones.
+#include <limits>
+
+#include "render/lanes/lanes.h"
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+#if defined(KR_LANE_TARGET_x86_64_v4_float)
+#define KR_LANES_FLOAT 1
+#define KR_LANES_V4 1
+#elif defined(KR_LANE_TARGET_x86_64_v3_float)
+#define KR_LANES_FLOAT 1
+#define KR_LANES_V3 1
+#elif defined(KR_LANE_TARGET_x86_64_v3)
+#define KR_LANES_V3 1
+#endif
+#if defined(KR_LANES_V4)
 using real = float;
 using lane_int = int32_t;
 typedef float vf __attribute__((vector_size(64)));
 typedef int32_t vm __attribute__((vector_size(64)));
 typedef uint32_t vw __attribute__((vector_size(64)));
 constexpr int kLanes = 16;
-#elif defined(KR_PACKET_FLOAT8)
+#elif defined(KR_LANES_FLOAT)
 using real = float;
 using lane_int = int32_t;
 typedef float vf __attribute__((vector_size(32)));
@@ -32,23 +51,23 @@ static_assert(sizeof(vf) == sizeof(vm) && sizeof(vf) == kLanes * sizeof(real));
 KR_LANES vf splat(double x) { return vf{} + real(x); }
 KR_LANES vf select(vm mask, vf a, vf b) { return mask ? a : b; }
 KR_LANES vf sqrt_lanes(vf x) {
-#if defined(KR_PACKET_FLOAT16)
+#if defined(KR_LANES_V4)
     return _mm512_maskz_sqrt_ps(0xffff, x);  // (the unmasked form's undefined start warns in GCC 12)
-#elif defined(KR_PACKET_FLOAT8)
+#elif defined(KR_LANES_FLOAT)
     return _mm256_sqrt_ps(x);
 #else
     return kr::sqrt_lanes(x);
 #endif
 }
 
-#if defined(KR_PACKET_FLOAT16)
+#if defined(KR_LANES_V4)
 // Whether any lane of a mask is set: one vptestmd into a mask register, tested.
 KR_LANES bool any_lane(vm mask) {
     __m512i bits;
     __builtin_memcpy(&bits, &mask, sizeof bits);
     return _mm512_test_epi32_mask(bits, bits) != 0;
 }
-#elif defined(KR_PACKET_TARGET_V3)
+#elif defined(KR_LANES_V3)
 // Whether any lane of a mask is set, by one vptest (lanes.h's any_lane reduces the lanes in
 // five instructions).
 KR_LANES bool any_lane(vm mask) {
@@ -60,15 +79,15 @@ KR_LANES bool any_lane(vm mask) {
 
 // A mask's lanes as bits (lane k at bit k), for loops over its set lanes only.
 KR_LANES unsigned lane_bits(vm mask) {
-#if defined(KR_PACKET_FLOAT16)
+#if defined(KR_LANES_V4)
     __m512i bits;
     __builtin_memcpy(&bits, &mask, sizeof bits);
     return _mm512_test_epi32_mask(bits, bits);
-#elif defined(KR_PACKET_FLOAT8)
+#elif defined(KR_LANES_FLOAT)
     __m256 bits;
     __builtin_memcpy(&bits, &mask, sizeof bits);
     return unsigned(_mm256_movemask_ps(bits));  // masks are all ones or zeros: their sign bits
-#elif defined(KR_PACKET_TARGET_V3)
+#elif defined(KR_LANES_V3)
     __m256d bits;
     __builtin_memcpy(&bits, &mask, sizeof bits);
     return unsigned(_mm256_movemask_pd(bits));
@@ -106,7 +125,7 @@ KR_LANES void set_lane(V3& v, int k, const Vec3& value) { v.x[k] = value.x, v.y[
 
 // sin_cos_turns (core/sampling.h): the same reduction and polynomials, then the quarter
 // turns lane-wise.
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
 // sin_cos_eighth_turn in single precision: rounding by 1.5 * 2^23, and the Taylor polynomials
 // to x^9 and x^10, whose first omitted terms are below 3e-8 at pi/4.
 KR_LANES void sin_cos_eighth_turn(vf t, vf& quarter, vf& s, vf& c) {
@@ -162,7 +181,7 @@ KR_LANES V3 to_world_lanes(const V3& n, const V3& local) {
 
 // log_normal_positive (core/sampling.h) of the lanes: a positive, finite, normal x.
 KR_LANES vf log_lanes(vf x) {
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
     // The same steps in single precision: x = 2^k m with m in [sqrt(1/2), sqrt(2)), then
     // log m = f - s (f - tail) with s = (m - 1) / (m + 1), the odd series to s^9 (its first
     // omitted term is below 1e-9 of the sum), and k ln 2.
@@ -199,7 +218,7 @@ KR_LANES vf log_positive_lanes(vf x, vm lanes) {
 // ln 2 / 2, expm1(r) by its Taylor polynomial to r^7 (the first omitted term is below 2e-8
 // relative), then 2^k expm1(r) + (2^k - 1), exact but for the last rounding where k is 0.
 KR_LANES vf expm1_lanes(vf x, vm lanes) {
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
     (void)lanes;
     constexpr float kRoundingShift = 0x1.8p23f;
     const vf clamped = select(x < -87.0f, splat(-87.0), x);  // 2^k stays normal; expm1 is -1 there

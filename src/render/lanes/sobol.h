@@ -1,8 +1,21 @@
-// Sobol numbers in lanes, for packet_lanes.inc (included after lane_math.inc): the Sobol
-// dimensions of the lanes' samplers drawn together, as Sampler (sampler.h) draws them one at a time.
-#if defined(KR_PACKET_FLOAT16)
+// Sobol numbers in lanes, for kernels.cpp (included after math.h): the Sobol dimensions of
+// the lanes' samplers drawn together, as Sampler (sampler.h) draws them one at a time.
+#pragma once
+
+#include "render/lanes/math.h"
+
+#if defined(KR_LANES_V4)
+// Whether the CPU has GFNI, for the sixteen lanes' bit reversal below (asked once).
+inline bool cpu_has_gfni() {
+    static const bool has = [] {
+        __builtin_cpu_init();
+        return __builtin_cpu_supports("gfni") != 0;
+    }();
+    return has;
+}
+
 // sampler.h's reverse_bits for sixteen lanes of words: bytes swapped by one byte shuffle, then
-// the bits of each byte reversed: where the CPU has GFNI (cpu_has_gfni, packet.cpp), by one
+// the bits of each byte reversed: where the CPU has GFNI (cpu_has_gfni), by one
 // affine byte transform whose matrix mirrors the byte (vgf2p8affineqb, by inline assembly:
 // these kernels are compiled for x86-64-v4, which has no GFNI); else by a 16-entry table per
 // nibble (vpshufb), against the generic code's 16 shift-and-mask steps. Not forced inline, as
@@ -30,12 +43,12 @@ struct LaneBitReverse16 {
     }
 };
 using LaneBitReverse = LaneBitReverse16<false>;
-#elif defined(KR_PACKET_TARGET_V3)
+#elif defined(KR_LANES_V3)
 // sampler.h's reverse_bits for lanes of words: bytes swapped by one byte shuffle, then the
 // bits of each byte reversed by a 16-entry table per nibble (vpshufb), against three
 // shift-and-mask steps. Not forced inline: sampler.h's SobolDimension, compiled for any
 // x86-64, calls it, and GCC inlines a forced call only between matching instruction sets;
-// in trace_packet it is inlined all the same.
+// in trace_lanes it is inlined all the same.
 struct LaneBitReverse {
     template <class U>
     static inline U apply(U x) {
@@ -79,7 +92,7 @@ using LaneSobol = SobolDimension<U, Reverse>;
 #define KR_LANES_LAMBDA __attribute__((always_inline))  // the lambdas' lanes cross no call either
 template <class Draw>
 KR_LANES auto with_lane_bit_reverse(Draw&& draw) {
-#if defined(KR_PACKET_FLOAT16)
+#if defined(KR_LANES_V4)
     if (cpu_has_gfni()) return draw(LaneBitReverse16<true>{});
 #endif
     return draw(LaneBitReverse{});
@@ -94,7 +107,7 @@ KR_LANES auto with_lane_bit_reverse(Draw&& draw) {
 struct VertexLanes {
     vf light_pick, light_x, light_y, lobe, bsdf_x, bsdf_y, roulette;
 };
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
 // A 32-bit binary fraction to a float in (0, 1): its first 23 bits, then the centre of that
 // 2^-23 interval (exact in single precision, so never 0 nor 1).
 KR_LANES vf unit_lanes(vw fraction) {

@@ -1,5 +1,13 @@
-// Per-lane values into lanes, for packet_lanes.inc (included after lane_math.inc): gathered
-// from per-lane records, or looked up by sphere or light index in columns.
+// Per-lane values into lanes, for kernels.cpp (included after math.h): gathered from per-lane
+// records, or looked up by sphere or light index in columns.
+#pragma once
+
+#include "render/lanes/math.h"
+
+// A one-leaf scene has at most 16 spheres: the lanes keep its per-sphere values in fixed
+// columns of 16.
+constexpr size_t kMaxLeafSpheres = 16;
+
 // Lanes from one field of the lanes' records: the records are written one lane at a time (a
 // vector stored to lane by lane would stall its next load).
 template <class V, class F, size_t... K>
@@ -43,13 +51,13 @@ KR_LANES vf gather_y(const T (&v)[kLanes], Vec2 T::*field) {
 }
 
 // Values per sphere or per area light, as columns the lanes look up by index. Up to
-// kMaxPacketSpheres of each (scenes of one leaf), fixed columns: eight float lanes look up by
+// kMaxLeafSpheres of each (scenes of one leaf), fixed columns: eight float lanes look up by
 // two register permutes (vpermps) and a blend, double lanes one load each. Larger scenes
 // (kWide) keep their columns in one buffer per batch, which eight float lanes gather from
 // (vgatherdps). Indices must be valid in every lane (dead lanes use 0).
 template <bool kWide>
 struct ColumnOf {
-    real v[kMaxPacketSpheres];
+    real v[kMaxLeafSpheres];
     real* data() { return v; }
     const real* data() const { return v; }
 };
@@ -61,7 +69,7 @@ struct ColumnOf<true> {
 };
 template <bool kWide>
 struct IndexColumnOf {
-    lane_int v[kMaxPacketSpheres];
+    lane_int v[kMaxLeafSpheres];
     lane_int* data() { return v; }
     const lane_int* data() const { return v; }
 };
@@ -76,10 +84,10 @@ struct Column3Of {
     ColumnOf<kWide> x, y, z;
     void set(size_t i, const Vec3& v) { x.data()[i] = real(v.x), y.data()[i] = real(v.y), z.data()[i] = real(v.z); }
 };
-#ifdef KR_PACKET_FLOAT16
+#ifdef KR_LANES_V4
 // Sixteen float lanes: a fixed column is one register, looked up by one vpermps (vpermd).
 // Masked forms, all lanes on: GCC 12 warns of the plain forms' undefined start.
-static_assert(kMaxPacketSpheres == 16, "one register of sixteen");
+static_assert(kMaxLeafSpheres == 16, "one register of sixteen");
 KR_LANES __m512i permute_index(vm index) {
     __m512i i;
     __builtin_memcpy(&i, &index, sizeof i);
@@ -103,8 +111,8 @@ KR_LANES vm look_up(const IndexColumnOf<true>& column, vm index) {
     __builtin_memcpy(&lanes, &v, sizeof lanes);
     return lanes;
 }
-#elif defined(KR_PACKET_FLOAT8)
-static_assert(kMaxPacketSpheres == 16, "two registers of eight");
+#elif defined(KR_LANES_FLOAT)
+static_assert(kMaxLeafSpheres == 16, "two registers of eight");
 KR_LANES __m256i permute_index(vm index) {
     __m256i i;
     __builtin_memcpy(&i, &index, sizeof i);

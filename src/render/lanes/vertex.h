@@ -4,7 +4,7 @@
 // light a sample brings with its MIS weight, the lights' densities and the MIS weight of
 // emission a BSDF-sampled ray finds, crossing a dielectric and Russian roulette. One path
 // (material.cpp, light.cpp, path.cpp, integrator.cpp) instantiates it with OnePath, one double
-// wide; the SIMD kernels (packet_lanes.inc) with their lanes, four doubles, or eight or sixteen
+// wide; the SIMD kernels (kernels.cpp) with their lanes, four doubles, or eight or sixteen
 // floats. So a new material or light is written here, once, for both.
 //
 // A lane type L gives: Real (the numbers), Scalar (one lane's number), Mask (comparisons of
@@ -18,7 +18,7 @@
 // operation for operation, so the lanes trace one path's paths up to rounding.
 //
 // The templates themselves are in vertex.inc, which this header includes into kr::vertex and
-// packet_lanes.inc into each build of the kernels (vertex.inc says why). They are forced
+// kernels.cpp into each build of the kernels (vertex.inc says why). They are forced
 // inline (KR_LANES, lanes.h): lanes must not cross a call. Their expressions keep the lanes'
 // operation order, and with it where the x86-64-v3 kernels fuse multiply-adds.
 #pragma once
@@ -28,7 +28,7 @@
 
 #include "core/math.h"
 #include "core/sampling.h"
-#include "render/lanes.h"
+#include "render/lanes/lanes.h"
 #include "render/light.h"
 #include "scene/scene.h"
 
@@ -83,7 +83,7 @@ struct OneMaterial {
     KR_LANES double roughness() const { return m.roughness; }
 };
 
-#include "render/vertex.inc"
+#include "render/lanes/vertex.inc"
 
 }  // namespace vertex
 }  // namespace kr

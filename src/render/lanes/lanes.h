@@ -1,7 +1,6 @@
 // Four lanes of doubles (GCC vector extensions) and the few operations on them that the BVH's
-// block test (accel.cpp) and the double-lane path tracer (packet.cpp) share; and KR_CLONES, which
-// compiles a function twice, for x86-64-v3 and for any x86-64 (packet.cpp does the same for
-// its kernels by including them twice, where KR_X86_64_V3 is defined).
+// block test (accel.cpp) and the double-lane kernels (kernels.cpp) share, and KR_LANES, which
+// keeps lanes from crossing a call.
 #pragma once
 
 #include <cmath>
@@ -14,9 +13,8 @@ typedef double v4d __attribute__((vector_size(32)));
 typedef int64_t v4l __attribute__((vector_size(32)));
 typedef uint64_t v4u __attribute__((vector_size(32)));  // bits, shifted without sign
 
-// Every helper taking or returning lanes is forced inline into its KR_CLONES caller (or
-// packet.cpp's kernels): a call would pass them by the default clone's ABI, not the AVX2
-// one. So no lane crosses a non-inlined call, and GCC's note on the vector ABI does not apply
+// Every helper taking or returning lanes is forced inline into its KR_LEVEL_CLONES caller
+// (levels.h) or the kernels: a call would pass them by the x86-64 ABI, not the AVX2 one. So no lane crosses a non-inlined call, and GCC's note on the vector ABI does not apply
 // (CMakeLists.txt turns it off: -Wno-psabi).
 #define KR_LANES inline __attribute__((always_inline))
 
@@ -40,15 +38,3 @@ KR_LANES bool any_lane(v4l mask) {
 }
 
 }  // namespace kr
-
-// Two versions of a function: the default x86-64 one and an AVX2/FMA one, chosen by the
-// dynamic loader from the CPU's features (GCC function multi-versioning). Not under a
-// sanitizer: the loader runs the IFUNC resolver while relocating, before the sanitizer's
-// runtime is up, and GCC instruments the resolver too (its __tsan_func_entry segfaults).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
-    !defined(__SANITIZE_THREAD__)
-#define KR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
-#define KR_X86_64_V3 1  // packet.cpp's kernels are compiled for x86-64-v3 too, and picked at run time
-#else
-#define KR_CLONES
-#endif

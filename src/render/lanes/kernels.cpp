@@ -1,30 +1,56 @@
-// The lane-wise path tracer's kernels (packet.cpp has what they do). packet.cpp includes this
-// file four times: in namespace packet_any for any x86-64 CPU (four double lanes); in
-// namespace packet_v3 under `#pragma GCC target("arch=x86-64-v3")` with KR_PACKET_TARGET_V3
-// defined, for CPUs with AVX2 and FMA (four double lanes); in namespace packet_f8, also
-// for x86-64-v3, with KR_PACKET_FLOAT8 defined: eight single-precision lanes; and in
-// namespace packet_f16 for x86-64-v4 with KR_PACKET_FLOAT8 and KR_PACKET_FLOAT16 defined:
-// sixteen single-precision lanes (AVX-512). Every function
-// here is compiled with its namespace's instruction set and lane type; the helpers below
-// under KR_PACKET_TARGET_V3 are where the v3 ones use instructions GCC's vector extensions
-// have no form for, and those under KR_PACKET_FLOAT8 where single precision needs steps of
-// its own.
-//
-// What the kernels share with one path, the physics of a path vertex, is vertex.h's (included
-// below for these lanes); the lanes' own parts are in files by concept: lane_math.inc (types
-// and sampling maths), lane_sobol.inc (Sobol numbers), lane_tables.inc (gathers and per-sphere
-// columns) and lane_trace.inc (ray casting). What is here: the path loop and its plumbing.
+// The lane-wise path tracer's kernels (lanes.cpp has what they do), compiled once per SIMD
+// target (targets.h): CMake defines KR_LANE_TARGET (the target's id, this file's namespace),
+// KR_LANE_TARGET_<id> (math.h's lane type for it) and its CPU level (levels.h), whose
+// instructions everything between KR_LEVEL_BEGIN and KR_LEVEL_END below is compiled for. The
+// lanes' parts are in headers by concept: math.h (types and sampling maths), sobol.h (Sobol
+// numbers), tables.h (gathers and per-sphere columns) and cast.h (ray casting); the physics
+// of a path vertex, which the kernels share with one path, is vertex.h's (vertex.inc,
+// compiled here again for the target's lanes). What is here: the path loop and its
+// plumbing.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
+#include "core/sampling.h"
+#include "render/accel.h"
+#include "render/lanes/lanes.h"
+#include "render/lanes/levels.h"
+#include "render/lanes/pixel_sums.h"
+#include "render/lanes/targets.h"
+#include "render/path.h"
+#include "render/precision.h"
+#include "render/trace.h"
+
+// Where this build cannot compile the target (CMakeLists.txt: Clang on a machine without its
+// level, or a GCC sanitizer build), the target is not built: its entry points are null.
+#ifdef KR_LANE_TARGET_OFF
+namespace kr::lanes::KR_LANE_TARGET {
+const TargetKernels kernels{};
+}  // namespace kr::lanes::KR_LANE_TARGET
+#else
+
+KR_LEVEL_BEGIN
+namespace kr::lanes::KR_LANE_TARGET {
+
 namespace {
 
-#include "render/lane_math.inc"
-#include "render/lane_sobol.inc"
-#include "render/lane_tables.inc"
-#include "render/lane_trace.inc"
+#include "render/lanes/math.h"
+#include "render/lanes/sobol.h"
+#include "render/lanes/tables.h"
+#include "render/lanes/cast.h"
 
 
 // vertex.h's physics, compiled for this build's instruction set and lanes.
 namespace vertex {
-#include "render/vertex.inc"
+#include "render/lanes/vertex.inc"
 }  // namespace vertex
 
 // What a path vertex's per-lane part (the light samples taken one lane at a time) hands to the
@@ -68,7 +94,7 @@ struct RayRecords {
     }
 };
 
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
 // The same for camera rays the lanes made themselves (trace_camera_lanes), as columns the
 // lanes gather by sample (padded to whole vectors): the samples' unit directions, and their
 // origins on a thin lens (a pinhole's are its position); and their Sobol samplers' keys and
@@ -80,7 +106,7 @@ struct CameraColumns {
     const float *x, *y, *z, *ox, *oy, *oz;
     const uint32_t *key, *index_reversed;
     static constexpr bool kSobolOnly = true;
-#ifdef KR_PACKET_FLOAT16
+#ifdef KR_LANES_V4
     // The started lanes' samples are consecutive: one expanding load per column (vexpandps)
     // puts them into their lanes, where a gather loads every lane one by one.
     KR_LANES static void start_columns(const float* x, const float* y, const float* z, vm start, int first, V3& v) {
@@ -147,7 +173,7 @@ template <>
 struct LaneScene<false> {
     SphereTable<false> table{};
     LightTable<false> lights{};
-    TestSphere test_spheres[kMaxPacketSpheres];
+    TestSphere test_spheres[kMaxLeafSpheres];
     size_t count;
     lane_int emitters = 0;  // a bit per sphere: whether it is an area light's
     IndexColumnOf<false> light{};  // per sphere, its area light's index, or -1
@@ -202,12 +228,12 @@ struct LaneScene<true> {
         for (size_t s = 0; s < scene.spheres.size(); ++s) light.data()[s] = lane_int(scene.sphere_light[s]);
         const LaneTree& tree = scene.bvh.lane_tree();
         nodes = tree.nodes.data();
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
         spheres = tree.spheres_f.data();
 #else
         spheres = tree.spheres_d.data();
 #endif
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
         if (!tree.clusters.empty())
             clusters = tree.clusters.data(), cluster_count = tree.clusters.size(), scan = tree.scan_f.data();
 #endif
@@ -216,7 +242,7 @@ struct LaneScene<true> {
 
 // `count` samples, a path per lane, a bounce at a time: a lane whose path ends hands in its
 // result and takes the next sample, so lanes stay busy while paths have different lengths.
-// `source` gives the samples' camera rays (RayRecords or PinholeRays).
+// `source` gives the samples' camera rays (RayRecords or CameraColumns).
 template <bool kWide, class Source>
 void trace_paths(const RenderScene& scene, const RenderSettings& settings, const Source& source,
                  Sampler* const* samplers, int count, SampleResult* results) {
@@ -241,10 +267,10 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
     auto& table = lane_scene.table;
     auto& lights = lane_scene.lights;
     // (Up to 16 materials on the stack: no allocation per batch for the brief's scenes.)
-    unsigned few_used[kMaxPacketSpheres];
+    unsigned few_used[kMaxLeafSpheres];
     std::vector<unsigned> many_used;
     unsigned* numbers_used = few_used;
-    if (scene.materials.size() > kMaxPacketSpheres) {
+    if (scene.materials.size() > kMaxLeafSpheres) {
         many_used.resize(scene.materials.size());
         numbers_used = many_used.data();
     }
@@ -520,7 +546,7 @@ void trace_paths_of(const RenderScene& scene, const RenderSettings& settings, co
     else trace_paths<false>(scene, settings, source, samplers, count, results);
 }
 
-void trace_packet(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
+void trace_lanes(const RenderScene& scene, const RenderSettings& settings, const Ray* rays, Sampler* const* samplers,
                   int count, SampleResult* results) {
     trace_paths_of(scene, settings, RayRecords{rays}, samplers, count, results);
 }
@@ -544,7 +570,7 @@ KR_LANES void camera_lanes(const CameraModel& camera, bool lens, int width, int 
     });
 }
 
-#ifdef KR_PACKET_FLOAT8
+#ifdef KR_LANES_FLOAT
 // Camera samples of Sobol samplers at their first dimension, known by their keys and
 // reversed indices: their camera rays a vector at a time in single precision (camera_lanes),
 // straight into the columns the lanes start their paths from, then trace_paths. One form per
@@ -621,7 +647,7 @@ void trace_camera_lanes(const RenderScene& scene, const RenderSettings& settings
 }
 #endif
 
-#ifndef KR_PACKET_FLOAT8  // the float lanes take the camera rays of the double ones
+#ifndef KR_LANES_FLOAT  // the float lanes take the camera rays of the double ones
 // camera_rays for a thin lens (kLens) or a pinhole: each form compiled alone.
 template <bool kLens>
 void camera_rays_of(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
@@ -660,4 +686,20 @@ void camera_rays(const RenderScene& scene, int width, int height, const int* xs,
     (scene.camera.lens_radius > 0 ? camera_rays_of<true> : camera_rays_of<false>)(scene, width, height, xs, ys,
                                                                                     samplers, count, rays);
 }
+#endif
+
+// A batch's samples added to the pixel sums, at this target's level: last, as it keeps
+// products unfused to the end of the file (KR_UNFUSED_BEGIN, levels.h).
+#include "render/lanes/accumulate.h"
+
+// This target's entry points, for lanes.cpp.
+#ifdef KR_LANES_FLOAT
+const TargetKernels kernels{true,       nullptr, trace_lanes, trace_sobol_camera_lanes, trace_camera_lanes,
+                            accumulate_batch};
+#else
+const TargetKernels kernels{true, camera_rays, trace_lanes, nullptr, nullptr, accumulate_batch};
+#endif
+
+}  // namespace kr::lanes::KR_LANE_TARGET
+KR_LEVEL_END
 #endif
