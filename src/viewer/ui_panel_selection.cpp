@@ -44,7 +44,7 @@ void panel_selection(PanelContext& ctx) {
             own.radius = shape.radius;
         }, name, name);
     // M moves it with the pointer (a left drag orbits); X, Y or Z then, or here, locks an axis.
-    ImGui::TextUnformatted("M moves it on the image; lock:");
+    ImGui::TextUnformatted("M: move; lock:");
     for (int a = -1; a < 3; ++a) {
         ImGui::SameLine();
         ImGui::RadioButton(a < 0 ? "view plane" : a == 0 ? "x" : a == 1 ? "y" : "z", &ctx.ui.axis_lock, a);
