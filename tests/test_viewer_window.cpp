@@ -395,6 +395,19 @@ std::map<std::string, std::string> drive(const fs::path& dir, const std::string&
 
 bool have_xdotool() { return std::system("command -v xdotool >/dev/null 2>&1") == 0; }
 
+// Where the status line says the image lies in the window ("image=X,Y,fitS" or "X,Y,S"): its
+// top-left corner and its scale, window pixels per image pixel.
+struct ImagePlacement {
+    double left = 0, top = 0, scale = 0;
+};
+::testing::AssertionResult image_placement(const std::string& field, ImagePlacement& out) {
+    std::smatch m;
+    if (!std::regex_match(field, m, std::regex("([0-9.]+),([0-9.]+),(fit)?([0-9.e+-]+)")))
+        return ::testing::AssertionFailure() << "image=" << field;
+    out = {std::stod(m[1]), std::stod(m[2]), std::stod(m[4])};
+    return ::testing::AssertionSuccess();
+}
+
 }  // namespace
 
 TEST_F(ViewerWindow, ClickWithOnePixelJitterLeavesTheImage) {
@@ -417,11 +430,9 @@ TEST_F(ViewerWindow, KeepTakesTheDenoisedImageOnScreen) {
     auto r = drive(dir, "keep_shown", 3);
     ASSERT_EQ(r.count("error"), 0u) << r["error"];
     EXPECT_EQ(r["psnr"], "99.0000");  // kr::psnr's figure for identical images
-    // The image's corner in the window and its scale: "X,Y,fitS" or "X,Y,S".
-    std::smatch m;
-    const std::string image = r["image"];
-    ASSERT_TRUE(std::regex_match(image, m, std::regex("([0-9.]+),([0-9.]+),(fit)?([0-9.e+-]+)"))) << image;
-    const double x0 = std::stod(m[1]), y0 = std::stod(m[2]), scale = std::stod(m[4]);
+    ImagePlacement placed;
+    ASSERT_TRUE(image_placement(r["image"], placed));
+    const double x0 = placed.left, y0 = placed.top, scale = placed.scale;
     const kr::Rgb8Image before = kr::read_ppm(dir / "render_view.ppm"), split = kr::read_ppm(dir / "split_view.ppm");
     ASSERT_EQ(before.width, split.width);
     ASSERT_EQ(before.height, split.height);
@@ -430,7 +441,7 @@ TEST_F(ViewerWindow, KeepTakesTheDenoisedImageOnScreen) {
     const int xa = int(x0 + 0.6 * full.renderer.width * scale), xb = int(x0 + 0.9 * full.renderer.width * scale);
     const int ya = int(y0 + 0.3 * full.renderer.height * scale), yb = int(y0 + 0.8 * full.renderer.height * scale);
     ASSERT_TRUE(xa >= 0 && ya >= 0 && xb <= before.width && yb <= before.height && xb > xa + 10 && yb > ya + 10)
-        << image << " in " << before.width << "x" << before.height;
+        << r["image"] << " in " << before.width << "x" << before.height;
     double sum = 0;
     int n = 0;
     for (int y = ya; y < yb; ++y)
@@ -679,10 +690,9 @@ TEST_F(ViewerWindow, WallSelectionShowsAndADragFromItOrbits) {
     // The tint: over the cells that see the wall (4x4 image pixels each, as the window draws
     // them), the window's pixels are blended with orange (255, 160, 0) at alpha 72/255;
     // elsewhere they stay. Cells whose neighbours all agree (the edges left out).
-    std::smatch match;
-    const std::string image = r["image"];
-    ASSERT_TRUE(std::regex_match(image, match, std::regex("([0-9.]+),([0-9.]+),(fit)?([0-9.]+)"))) << image;
-    const double left = std::stod(match[1]), top = std::stod(match[2]), scale = std::stod(match[4]);
+    ImagePlacement placed;
+    ASSERT_TRUE(image_placement(r["image"], placed));
+    const double left = placed.left, top = placed.top, scale = placed.scale;
     const kr::Rgb8Image before = kr::read_ppm(dir / "unselected.ppm"), after = kr::read_ppm(dir / "selected.ppm");
     ASSERT_EQ(before.width, after.width);
     const kr::Shape& ws = s.shapes[size_t(s.primitives[size_t(wall)].shape)];
