@@ -300,7 +300,7 @@ TEST(Accel, LaneClustersHoldEverySphereOnce) {
         with_backend(random_spheres(int(kLaneOwnMaxSpheres) + 8, 1.0, 7, true), AccelBackend::own);
     EXPECT_TRUE(many.bvh.lane_tree().nodes.empty());
     EXPECT_TRUE(many.bvh.lane_tree().clusters.empty());
-    EXPECT_FALSE(many.bvh.packets());
+    EXPECT_FALSE(many.bvh.lanes_cast());
 }
 
 TEST(Accel, CoincidentCentresStillSplit) {
@@ -491,7 +491,7 @@ TEST(Accel, ExtremeScalesInTheLanes) {
             const RenderScene scene = scaled_room(scale, spheres).build();
             char where[48];
             std::snprintf(where, sizeof where, "%d spheres, scale %g", spheres, scale);
-            if (spheres > 16) EXPECT_EQ(scene.bvh.packets(), scale <= 1e20) << where;  // the tree's boxes in floats
+            if (spheres > 16) EXPECT_EQ(scene.bvh.lanes_cast(), scale <= 1e20) << where;  // the tree's boxes in floats
             EXPECT_EQ(float_lanes_fit(scene), scale >= 1e-6 && scale <= 1e6) << where;
             const Image one_path = render_image(scene, 2, Integrator::pt, LaneChoice::off);
             const Image lanes = render_image(scene, 2);

@@ -54,13 +54,13 @@ Agreement compare(const RenderScene& scene, const RenderSettings& settings, int 
     Agreement a;
     const double tolerance = lane_tolerance(scene, settings);
     const int width = scene.renderer.width, height = scene.renderer.height;
-    for (int packet = 0; packet < batches; ++packet) {
+    for (int batch = 0; batch < batches; ++batch) {
         std::vector<Ray> rays(static_cast<size_t>(count));
         std::vector<std::optional<Sampler>> together(static_cast<size_t>(count)), alone(static_cast<size_t>(count));
         std::vector<Sampler*> samplers(static_cast<size_t>(count));
         for (int k = 0; k < count; ++k) {
-            const uint64_t pixel = (uint64_t(packet) * 7919 + uint64_t(k) * 104729) % uint64_t(width * height);
-            const uint32_t index = uint32_t(packet % 5);
+            const uint64_t pixel = (uint64_t(batch) * 7919 + uint64_t(k) * 104729) % uint64_t(width * height);
+            const uint32_t index = uint32_t(batch % 5);
             together[k].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
             alone[k].emplace(settings.estimator, settings.seed, pixel, index, settings.target_spp);
             const Vec2 sub = together[k]->pixel();
@@ -222,7 +222,7 @@ TEST(LaneChoiceSwitch, BestIsTheV3LanesOrOnePath) {
 TEST_P(Lanes, SameSamplesAsOneByOne) {
     for (int n : {3, 4, 5, 6, 8}) {
         const RenderScene scene = brief_scene(n);
-        ASSERT_TRUE(scene.bvh.packets()) << "scene " << n;
+        ASSERT_TRUE(scene.bvh.lanes_cast()) << "scene " << n;
         for (Estimator estimator : {Estimator::sobol, Estimator::uniform, Estimator::stratified})
             for (LightSampling light :
                  {LightSampling::brief, LightSampling::brief_area, LightSampling::cone, LightSampling::area})
@@ -279,7 +279,7 @@ TEST_P(Lanes, PointLightsEveryMaterialAndPartialPackets) {
     b.emitter({0, 0, 0}, 60, Color(0.05), b.material(MaterialType::diffuse, Color(0)));
     b.emitter({2, 5, 5}, 0.5, Color(0), grey);
     const RenderScene scene = b.build();
-    ASSERT_TRUE(scene.bvh.packets());
+    ASSERT_TRUE(scene.bvh.lanes_cast());
     ASSERT_EQ(scene.point_lights.size(), 2u);
     ASSERT_EQ(scene.area_lights.size(), 4u);
     ASSERT_EQ(scene.area_lights.back().select_prob, 0.0);
@@ -324,7 +324,7 @@ RenderScene many_spheres(int n, int lights, uint64_t seed) {
 TEST_P(Lanes, ManySpheresAsOneByOne) {
     for (const auto& [n, lights] : {std::pair{40, 2}, std::pair{100, 20}}) {
         const RenderScene scene = many_spheres(n, lights, uint64_t(n));
-        ASSERT_TRUE(scene.bvh.packets());
+        ASSERT_TRUE(scene.bvh.lanes_cast());
         ASSERT_FALSE(scene.bvh.one_leaf());
         ASSERT_FALSE(scene.bvh.lane_tree().nodes.empty());
         // The floor's far side is 2,004 from the origin, beyond 4,096 of the smallest radii;

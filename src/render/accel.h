@@ -118,7 +118,7 @@ public:
 
     // Whether the SIMD lanes (lanes/kernels.cpp) can cast this scene's rays: it is our one leaf (up
     // to 16 spheres), whose spheres they test in turn, or it has a lane tree (lane_tree()).
-    bool packets() const { return (!embree_ && nodes_.size() == 1) || !lane_tree_.nodes.empty(); }
+    bool lanes_cast() const { return (!embree_ && nodes_.size() == 1) || !lane_tree_.nodes.empty(); }
     // Whether it is our one leaf, which the lanes test sphere by sphere without a box.
     bool one_leaf() const { return !embree_ && nodes_.size() == 1; }
     // The tree the lanes walk, built beside ours or Embree's for more than 16 spheres: up to

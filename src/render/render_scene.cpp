@@ -282,7 +282,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
     if (previous && previous->accel_backend == rs.accel_backend && previous->spheres == rs.spheres) {
         rs.bvh = previous->bvh;
         rs.float_gaps_resolved = same_light_geometry(*previous, rs) ? previous->float_gaps_resolved
-                                                                    : rs.bvh.packets() && float_resolves_gaps(rs);
+                                                                    : rs.bvh.lanes_cast() && float_resolves_gaps(rs);
     } else {
         rs.build_accel();
     }
@@ -291,7 +291,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
 
 void RenderScene::build_accel() {
     bvh.build(spheres, accel_backend);
-    float_gaps_resolved = bvh.packets() && float_resolves_gaps(*this);
+    float_gaps_resolved = bvh.lanes_cast() && float_resolves_gaps(*this);
 }
 
 }  // namespace kr

@@ -74,10 +74,10 @@ LaneKernels highest(bool single) {
 LaneKernels if_runs(LaneKernels kernels) { return runs(target(kernels)) ? kernels : LaneKernels::one_path; }
 
 // Where lanes apply: path tracing on a scene whose rays the lanes can cast (one leaf of our
-// BVH, or the lane tree: SphereBvh::packets), not the plain path. Scenes with Embree's tree
+// BVH, or the lane tree: SphereBvh::lanes_cast), not the plain path. Scenes with Embree's tree
 // only cast rays one by one.
 bool lanes_apply(const RenderScene& scene, const RenderSettings& settings) {
-    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.packets();
+    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.lanes_cast();
 }
 
 // The kernels the CPU and the settings pick, before a scene has a say: under `best` the
