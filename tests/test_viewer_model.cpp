@@ -392,7 +392,8 @@ TEST(RenderThread, ReachesTargetWithTheDeterministicImage) {
 // Missing item 4: the feature views' layers. None by default (the default render makes
 // none); asked for once the render is finished, the newest frame comes again with them (the
 // denoiser's feature buffers, the same as render/outputs.h feature_buffers), and every frame
-// after, previews included (at their resolution), has them, with or without the denoiser.
+// after, previews included (at their resolution and their few samples), has them, with or
+// without the denoiser.
 TEST(RenderThread, FeatureLayersOnlyWhenAskedAlsoForAFinishedRender) {
     const auto scene = small_scene(8, 40, 30);
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
@@ -432,8 +433,17 @@ TEST(RenderThread, FeatureLayersOnlyWhenAskedAlsoForAFinishedRender) {
             EXPECT_EQ(f->features->width, f->radiance.width);
             EXPECT_EQ(f->features->height, f->radiance.height);
             EXPECT_EQ(f->hit_depth.size(), f->radiance.pixels.size());
+            // A full frame's layers are feature_buffers'; a preview's, its own few samples a
+            // pixel (kPreviewFeatureSamples) at its resolution.
             std::vector<float> a, n;
-            feature_buffers(*scene, settings, f->radiance.width, f->radiance.height, a, n);
+            if (f->scale == 1) {
+                feature_buffers(*scene, settings, f->radiance.width, f->radiance.height, a, n);
+            } else {
+                DisplayFeatures preview;
+                preview.reset(f->radiance.width, f->radiance.height);
+                preview.refine_to(RenderJob{2, scene, settings, StopRule{settings.target_spp}}, kPreviewFeatureSamples);
+                a = preview.albedo;
+            }
             EXPECT_EQ(f->features->albedo, a) << f->scale;
         }
         ASSERT_TRUE(f && f->finished);
