@@ -386,7 +386,8 @@ same_gesture)
                 kill -CONT $pid
                 ;;
             esac
-            wait_changed camera "$home" || exit 1
+            wait_changed camera "$home" ||
+                { echo "error=button $b's $way drag left the camera at home; status: $(cat "$status")"; exit 1; }
             wait_for "press=0 pointer=$((x + 120)),$y" || exit 1
             echo "camera_${b}_$way=$(field camera)"
             xdotool mousemove --window "$wid" $x $y
