@@ -48,7 +48,7 @@ void install_input_callbacks(GLFWwindow* w) {
     glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });
     glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
-    glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { app_of(win)->note_input(); });
+    glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int entered) { app_of(win)->note_enter(entered != 0); });
     glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { app_of(win)->note_input(); });
     glfwSetWindowRefreshCallback(w, [](GLFWwindow* win) { app_of(win)->note_input(); });
     glfwSetWindowCloseCallback(w, [](GLFWwindow* win) { app_of(win)->on_close_request(); });
@@ -438,6 +438,7 @@ bool ViewerApp::draw_frame() {
     if (!keys_.empty()) input_seen_ = true;  // the rest go to the next frames, drawn at once
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
+    input_.apply_pointer();
     ImGui::NewFrame();
     input_.apply_button_positions();
     glfwGetFramebufferSize(window_, &ui_.framebuffer_width, &ui_.framebuffer_height);

@@ -40,6 +40,7 @@ public:
     void note_cursor(double x, double y) { input_seen_ = true; input_.note_cursor(x, y); }
     void note_button(int button, int action) { input_seen_ = true; input_.note_button(button, action); }
     void note_wheel() { input_seen_ = true; input_.note_wheel(); }
+    void note_enter(bool entered) { input_seen_ = true; input_.note_enter(entered); }
     void on_close_request();
 
 private:

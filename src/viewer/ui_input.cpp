@@ -45,6 +45,15 @@ void InputState::note_button(int button, int action) {
     if (action == GLFW_RELEASE) release_at[button] = cursor;
 }
 
+void InputState::apply_pointer() {
+    ImGuiIO& io = ImGui::GetIO();
+    // The backend leaves -FLT_MAX where the window has no focus; held buttons keep the
+    // pointer's events coming (the implicit grab) when it leaves the window.
+    const bool held = event_down[0] || event_down[1] || event_down[2];
+    if (cursor && ImGui::IsMousePosValid(&io.MousePos) && (cursor_inside || held))
+        io.MousePos = ImVec2(float(cursor->first), float(cursor->second));
+}
+
 void InputState::apply_button_positions() {
     ImGuiIO& io = ImGui::GetIO();
     for (int b = 0; b < 3; ++b) {

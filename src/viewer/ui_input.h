@@ -46,6 +46,7 @@ struct InputState {
     // events' positions instead.
     using Point = std::pair<double, double>;  // window points
     std::optional<Point> cursor;              // none before the first motion
+    bool cursor_inside = false;               // the pointer is over the window (by its enter/leave events)
     std::optional<Point> press_at[3], release_at[3];
     std::optional<Point> released_here[3];    // where the button this frame sees released went up
     std::optional<Point> wheel_at, wheel_here;  // the pointer at the last wheel event (zoom's centre)
@@ -59,6 +60,12 @@ struct InputState {
     void note_cursor(double x, double y);
     void note_button(int button, int action);
     void note_wheel() { wheel_at = cursor; }
+    void note_enter(bool entered) { cursor_inside = entered; }
+    // After the backend's NewFrame, before ImGui::NewFrame: the frame's pointer is where the
+    // events handled so far left it. The GLFW backend reads the pointer from the X server
+    // (XQueryPointer), which on a busy machine is ahead of the events: a drag would start
+    // from a position no motion event had reached, and end a different length.
+    void apply_pointer();
     // After ImGui::NewFrame: each button ImGui sees clicked this frame gets the position of
     // its press event as io.MouseClickedPos, and each it sees released its release's as
     // released_here; the wheel's turns since the last frame, the last one's as wheel_here.
