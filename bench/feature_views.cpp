@@ -79,7 +79,7 @@ int run(int argc, char** argv) {
             RenderWorker worker;
             worker.set_features(layers);
             const auto t0 = Clock::now();
-            worker.submit({1, scene, settings, StopRule{settings.target_spp}});
+            worker.submit({1, scene, settings, StopRule{settings.target_spp}, nullptr, {}});
             std::shared_ptr<const Snapshot> f;
             while (!(f && f->finished)) f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
             (layers ? on : off).push_back(std::chrono::duration<double>(Clock::now() - t0).count());
@@ -87,6 +87,7 @@ int run(int argc, char** argv) {
     const double a = median(off), b = median(on);
     std::printf("  render thread: edit to 8 spp, feature layers off  %8.3f s\n", a);
     std::printf("  render thread: edit to 8 spp, feature layers on   %8.3f s  (x%.3f)\n", b, b / a);
+    return 0;
 }
 
 }  // namespace

@@ -82,7 +82,7 @@ int run(int argc, char** argv) {
     StopRule open_ended;
     open_ended.max_passes = kUnlimitedPasses;
     // The view before the edit, refined for a second (the render thread measures its pass).
-    worker.submit({1, std::make_shared<const RenderScene>(prepare_scene(scene)), settings, open_ended});
+    worker.submit({1, std::make_shared<const RenderScene>(prepare_scene(scene)), settings, open_ended, nullptr, {}});
     std::this_thread::sleep_for(std::chrono::seconds(1));
 
     // The orbit as the window makes it: about the target, stopping at surfaces.
@@ -161,7 +161,7 @@ int run(int argc, char** argv) {
             StopRule rule;
             rule.max_passes = target;
             const auto t0 = Clock::now();
-            timed.submit({1, moved, settings, rule});
+            timed.submit({1, moved, settings, rule, nullptr, {}});
             std::shared_ptr<const Snapshot> f;
             while (!(f && f->finished)) f = timed.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
             (boxed ? region : whole).push_back(seconds(Clock::now() - t0));
