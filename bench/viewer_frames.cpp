@@ -7,7 +7,7 @@
 // on screen at 0.25, 0.5, 1, 2, 3 and 10 s, and whether any frame was worse than the one
 // before it. Then the render thread's passes per second against ProgressiveDriver's alone.
 // Usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N]
-//                              [--size WxH] [--raw] [--dump DIR] [--no-region]
+//                              [--size WxH] [--raw] [--dump DIR] [--no-region] [--before S]
 #include <string_view>
 #include <algorithm>
 #include <chrono>
@@ -46,7 +46,7 @@ namespace {
 
 int run(int argc, char** argv) {
     const char* file = "res/scenes/assignment_03.json";
-    double orbit_px = 120, run_seconds = 10;
+    double orbit_px = 120, run_seconds = 10, before_seconds = 1;
     int settle_spp = 1024, width = 0, height = 0;
     bool raw = false, region_too = true;
     std::string dump;  // a folder: the settled image and each frame as shown, as PNG
@@ -59,6 +59,7 @@ int run(int argc, char** argv) {
         else if (a == "--raw") raw = true;
         else if (a == "--no-region") region_too = false;
         else if (a == "--dump" && i + 1 < argc) dump = argv[++i];
+        else if (a == "--before" && i + 1 < argc) before_seconds = std::atof(argv[++i]);
         else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option '" + a.substr(0, 40) + "' (--help lists them)");
         else file = argv[i];
     }
@@ -81,9 +82,9 @@ int run(int argc, char** argv) {
     worker.set_denoise(!raw);
     StopRule open_ended;
     open_ended.max_passes = kUnlimitedPasses;
-    // The view before the edit, refined for a second (the render thread measures its pass).
+    // The view before the edit, refined for --before seconds (1 by default) (the render thread measures its pass).
     worker.submit({1, std::make_shared<const RenderScene>(prepare_scene(scene)), settings, open_ended, nullptr, {}});
-    std::this_thread::sleep_for(std::chrono::seconds(1));
+    std::this_thread::sleep_for(std::chrono::duration<double>(before_seconds));
 
     // The orbit as the window makes it: about the target, stopping at surfaces.
     Camera& camera = scene.cameras[size_t(scene.camera)];
@@ -179,7 +180,7 @@ int run(int argc, char** argv) {
 int main(int argc, char** argv) {
     for (int i = 1; i < argc; ++i)
         if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
-            std::printf("usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N] [--size WxH] [--raw] [--dump DIR] [--no-region]\n");
+            std::printf("usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N] [--size WxH] [--raw] [--dump DIR] [--no-region] [--before S]\n");
             return 0;
         }
     try {

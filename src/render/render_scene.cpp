@@ -116,7 +116,7 @@ bool same_light_geometry(const RenderScene& a, const RenderScene& b) {
 
 }  // namespace
 
-bool renders_same(const RenderScene& a, const RenderScene& b) {
+bool same_world(const RenderScene& a, const RenderScene& b) {
     auto same_material = [](const Material& x, const Material& y) {
         return x.type == y.type && x.rho == y.rho && x.rho_r == y.rho_r && x.rho_t == y.rho_t && x.eta == y.eta &&
                x.roughness == y.roughness;
@@ -134,6 +134,12 @@ bool renders_same(const RenderScene& a, const RenderScene& b) {
     for (size_t i = 0; i < a.area_lights.size(); ++i)
         if (a.area_lights[i].sphere != b.area_lights[i].sphere || !(a.area_lights[i].radiance == b.area_lights[i].radiance))
             return false;
+    const RendererSettings &ra = a.renderer, &rb = b.renderer;
+    return ra.type == rb.type && ra.width == rb.width && ra.height == rb.height && ra.depth == rb.depth;
+}
+
+bool renders_same(const RenderScene& a, const RenderScene& b) {
+    if (!same_world(a, b)) return false;
     const CameraModel &ca = a.camera, &cb = b.camera;
     // A closed lens (radius 0) is a pinhole: the focal distance draws nothing (camera.cpp).
     const bool lens = ca.lens_radius > 0 || cb.lens_radius > 0;
@@ -141,9 +147,7 @@ bool renders_same(const RenderScene& a, const RenderScene& b) {
         ca.tan_half_fov != cb.tan_half_fov || ca.aspect != cb.aspect || ca.lens_radius != cb.lens_radius ||
         (lens && ca.focal_distance != cb.focal_distance))
         return false;
-    const RendererSettings &ra = a.renderer, &rb = b.renderer;
-    return ra.type == rb.type && ra.width == rb.width && ra.height == rb.height && ra.samples == rb.samples &&
-           ra.depth == rb.depth && a.accel_backend == b.accel_backend && a.linear_scan == b.linear_scan;
+    return a.renderer.samples == b.renderer.samples && a.accel_backend == b.accel_backend && a.linear_scan == b.linear_scan;
 }
 
 RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings, const RenderScene* previous) {

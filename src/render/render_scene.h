@@ -93,6 +93,9 @@ struct RenderScene {
 // The viewer restarts its render only when an edit changes this. A member that changes the
 // samples joins it.
 bool renders_same(const RenderScene& a, const RenderScene& b);
+// Whether each surface point of `a` and `b` sends the same radiance every way: renders_same
+// without the camera and what only changes the samples (the spp, the BVH kind).
+bool same_world(const RenderScene& a, const RenderScene& b);
 
 // A shadow segment towards a point light ends on that point, and the point may lie on a
 // surface (a light placed on a floor or wall). Rounding then puts the surface's crossing a

@@ -1,5 +1,7 @@
 #include "viewer/render_worker.h"
 
+#include "viewer/reproject.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -389,6 +391,42 @@ void RenderWorker::run() {
     std::shared_ptr<const FeatureBuffers> features;  // the feature views' (complete), made once
     DenoiseWorkspace denoise_planes;    // kept between frames
     std::shared_ptr<const Snapshot> last_full;  // the newest full frame made (a region's frames build on it)
+    std::shared_ptr<const RenderScene> last_full_scene;  // and its job's scene and settings
+    RenderSettings last_full_settings;
+    // The best picture of the world so far, carried across camera moves (reproject.h): the
+    // frame with the most samples of an earlier view of the same world, and what the current
+    // job takes from it (made at its first full frame; none for a lens, a region or another world).
+    std::optional<ViewHistory> history;
+    std::shared_ptr<const RenderScene> history_scene;
+    RenderSettings history_settings;
+    int history_spp = 0;
+    std::optional<Reprojection> prior;
+    bool prior_made = false;
+    // Whether the history can stand for `job`'s view: the same world, radiance estimated alike.
+    auto history_fits = [&] {
+        const RenderSettings &a = job.settings, &b = history_settings;
+        return history && history_scene && job.scene && reprojectable(*job.scene) && same_world(*history_scene, *job.scene) &&
+               a.integrator == b.integrator && a.max_depth == b.max_depth && a.rr_depth == b.rr_depth &&
+               a.light_sampling == b.light_sampling;
+    };
+    // The newest full frame becomes the history when it has more samples than the history,
+    // or the history is of another world.
+    auto keep_history = [&] {
+        if (!last_full || !last_full_scene || last_full->denoised.pixels.empty() || last_full->spp < 2 ||
+            !reprojectable(*last_full_scene) || (history && history->generation == last_full->generation))
+            return;
+        const bool other_world = !history_scene || !same_world(*history_scene, *last_full_scene);
+        if (!other_world && last_full->spp <= history_spp) return;
+        ViewHistory h;
+        h.generation = last_full->generation;
+        h.hits = view_hits(*last_full_scene, last_full->radiance.width, last_full->radiance.height);
+        h.picture = last_full->denoised;
+        h.samples = last_full->sample_count;
+        history = std::move(h);
+        history_scene = last_full_scene;
+        history_settings = last_full_settings;
+        history_spp = last_full->spp;
+    };
     // The full-resolution passes of `job` not yet in a frame, when the last frame was made and
     // what making it cost (seconds, smoothed).
     bool unpublished = false;
@@ -448,6 +486,8 @@ void RenderWorker::run() {
             }
             if (pending_) {
                 job = std::move(*pending_);
+                prior.reset();
+                prior_made = false;
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 job_start_ = job.edited;
@@ -557,6 +597,21 @@ void RenderWorker::run() {
             // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
             if (denoise_.load())
                 display_features.refine_to(job, next_display_feature_samples(display_features), region.region);
+            if (!prior_made && denoise_.load()) {
+                // The job's first full frame: the newest frame before it (an earlier job's) may
+                // be the best picture of the world yet, and this view takes what it can of it.
+                prior_made = true;
+                try {
+                    keep_history();
+                    if (!region.region && history_fits() && history->generation != job.generation)
+                        prior = reproject(*job.scene, view_hits(*job.scene, w, h), *history);
+                } catch (const std::bad_alloc&) {
+                    history.reset();  // only the carried picture is lost, not the job
+                    history_scene.reset();
+                    history_spp = 0;
+                    prior.reset();
+                }
+            }
             const auto start = Clock::now();
             make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame,
                             last_full.get(), region.region);
@@ -595,7 +650,16 @@ void RenderWorker::run() {
             frame->stopped_by = stop_reason();
             frame->finished = frame->stopped_by.has_value();
         }
-        if (frame->scale == 1) last_full = frame;
+        if (frame->scale == 1) {
+            // A frame still on its way to the job's target takes the earlier views' picture
+            // where it stands for this view; the finished frame is the engine's own.
+            if (prior && !frame->finished && !frame->denoised.pixels.empty())
+                frame->carried_pixels = blend_history(frame->denoised, *prior, frame->spp,
+                                                      frame->max_passes == kUnlimitedPasses ? 0 : frame->max_passes);
+            last_full = frame;
+            last_full_scene = job.scene;
+            last_full_settings = job.settings;
+        }
         publish(std::move(frame));
     }
 }

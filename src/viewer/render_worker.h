@@ -148,6 +148,9 @@ struct Snapshot {
     std::vector<float> hit_depth;
     RenderState::Halves halves;  // the two halves of the samples (the final denoiser's guides)
     uint64_t nonfinite_samples = 0;
+    // Pixels whose display image took an earlier view's picture (viewer/reproject.h): after a
+    // camera move, until the job nears its target.
+    size_t carried_pixels = 0;
     bool finished = false;   // a stop rule ended the refinement
     std::optional<StopReason> stopped_by;  // which, once finished
     // Not empty: the job could not be rendered (its state does not fit in memory); the frame
