@@ -110,6 +110,7 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
         // The messages and the selection of the scene shown before belong to it.
         ctx.messages.clear();
         ctx.ui.selected.reset();
+        ctx.ui.selected_light.reset();
         if (file != files.watch.file()) {
             files.watch.watch(file);
             ctx.ui.save.read_only = scene_file_read_only(file, data_dir());

@@ -86,4 +86,25 @@ bool power_fields(PanelContext& ctx, Color& power, float speed) {
     return changed || split;
 }
 
+bool material_fields(PanelContext& ctx, Material& m) {
+    bool changed = combo("type", m.type, material_type_names);
+    // The type's parameters as the file has them (scene.h's material_params).
+    for (const MaterialParam& param : material_params(m.type)) {
+        const std::string label(param.name);
+        if (param.colour) {
+            // A picker, then the numbers as the file has them.
+            changed |= colour_picker(label.c_str(), m.*param.colour);
+            ImGui::SameLine();
+            changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
+        } else
+            changed |= field(ctx, label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo, param.edit_hi);
+    }
+    return changed;
+}
+
+void mark_item(PanelContext& ctx, std::string name) {
+    const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+    ctx.ui.marks.push_back({std::move(name), 0.5f * (a.x + b.x), 0.5f * (a.y + b.y)});
+}
+
 }  // namespace kr::viewer
