@@ -83,7 +83,9 @@ void panel_outliner(PanelContext& ctx) {
         const int c = *activate;
         ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.camera = c; }, "active camera");
     }
-    ImGui::TextDisabled(".: frame the selection   numpad 1 3 7: views");
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+    ImGui::TextWrapped("\".\" frames the selection   numpad 1 3 7: views");  // wraps in a narrow panel
+    ImGui::PopStyleColor();
     if (ImGui::IsItemHovered())
         ImGui::SetTooltip(". or numpad-.: frame the selection\nnumpad 1 / 3 / 7: front / right / top view (Ctrl: back / left / bottom)");
 }

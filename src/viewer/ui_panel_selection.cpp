@@ -108,7 +108,9 @@ void panel_selection(PanelContext& ctx) {
         if (ctx.ui.selected_light && size_t(*ctx.ui.selected_light) < scene.lights.size())
             return light_section(ctx, *ctx.ui.selected_light);
         ImGui::SameLine();
-        ImGui::TextDisabled("click a sphere on the image or a row above");
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+        ImGui::TextWrapped("click a sphere on the image or a row above");  // wraps in a narrow panel
+        ImGui::PopStyleColor();
         return;
     }
     ImGui::SameLine();
