@@ -3,10 +3,12 @@
 // material_fields as the Materials panel has them), its light; and the object edits
 // (viewer/scene_edit.h): add, duplicate, delete, any material or a new one, emissive. A point
 // light selected in the outliner shows its position and power here.
+#include <algorithm>
 #include <string>
 
 #include <imgui.h>
 
+#include "core/text.h"
 #include "viewer/outliner.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_panels.h"
@@ -26,19 +28,27 @@ void heading(const char* text) {
 void light_section(PanelContext& ctx, int index) {
     const Scene& scene = ctx.model.scene();
     Light light = scene.lights[size_t(index)];
-    ImGui::TextUnformatted(light_label(light).c_str());
-    const bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
+    // On or off as the Lights panel has it; its fields greyed while off (nothing moves).
+    bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
+    if (ImGui::Checkbox(light_label(light).c_str(), &on) &&
+        ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { set_light_on(s, index, on); }, "light on/off")) {
+        const std::string unseen = on ? light_unseen_reason(ctx.model.scene(), index) : std::string();
+        ctx.messages.show_status("light " + show_user_text(light.id) + (on ? " on" : " off: it emits nothing") +
+                                 (unseen.empty() ? "" : "; it adds nothing to the picture: " + unseen));
+    }
     ImGui::SameLine();
-    ImGui::TextDisabled("%s (Lights panel: on / off)", on ? "on" : "off");
+    ImGui::TextDisabled("%s", on ? "on" : "off");
     const std::string name = "light " + light.id;
     bool changed = false;
+    ImGui::BeginDisabled(!on);
     if (light.type == LightType::point) {
         changed |= field(ctx, "position", &light.position.x, 3, 0.02f, -kHuge, kHuge);
         changed |= power_fields(ctx, light.power, 0.5f);
     } else {
         changed |= power_fields(ctx, light.power);
     }
-    if (changed) ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = light; }, name, name);
+    ImGui::EndDisabled();
+    if (changed && on) ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = light; }, name, name);
 }
 
 // The selection's material: one click on a colour recolours this object alone (a material
