@@ -1045,6 +1045,26 @@ TEST_F(ViewerWindow, OutlinerSelectsFramesAndRecolours) {
     EXPECT_EQ(vec(r["camera_front"]), cam.position);  // scene 3 looks along +z: its view is the front view
     EXPECT_EQ(r["light_selected"], "0");
     ASSERT_EQ(s.lights[0].type, kr::LightType::point);
+    // The selected point light's marker: orange pixels about its image point (inside the area
+    // light's white disc, where the render has none), none there before.
+    ImagePlacement placed;
+    ASSERT_TRUE(image_placement(r["image_light"], placed));
+    const auto point = kr::viewer::project_sphere(m.prepared()->camera, s.lights[0].position, 0);
+    ASSERT_TRUE(point);
+    const int px = int(placed.left + point->fx * s.renderer.width * placed.scale);
+    const int py = int(placed.top + point->fy * s.renderer.height * placed.scale);
+    auto orange_near = [&](const fs::path& file) {
+        const kr::Rgb8Image shot = kr::read_ppm(file);
+        int n = 0;
+        for (int y = py - 16; y <= py + 16; ++y)
+            for (int x = px - 16; x <= px + 16; ++x) {
+                const unsigned char* c = &shot.bytes[(size_t(y) * shot.width + size_t(x)) * 3];
+                n += c[0] > 200 && c[1] > 110 && c[1] < 210 && c[2] < 80;
+            }
+        return n;
+    };
+    EXPECT_EQ(orange_near(dir / "light_before.ppm"), 0);
+    EXPECT_GT(orange_near(dir / "light_selected.ppm"), 30);
     // The point light framed: the target on it, the distance kept.
     const kr::Vec3 at_light = vec(r["camera_light"]);
     EXPECT_NEAR(kr::length(at_light - s.lights[0].position), d, 1e-6);

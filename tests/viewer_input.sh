@@ -576,6 +576,7 @@ outliner)
     }
     echo "tab_first=$(field tab)"
     echo "camera_first=$(field camera)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/light_before.ppm" || { echo "error=no window shot"; exit 1; }
     # A click on sphere 01 of scene 3 (image point 344, 410): selected, as select_edit.
     img=$(field image)
     read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 344.5 * s, $2 + 410.5 * s}')
@@ -623,6 +624,8 @@ outliner)
     cam=$(field camera)
     xdotool mousemove --window "$wid" 250 330
     wait_for 'pointer=250,330' || exit 1
+    echo "image_light=$(field image)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/light_selected.ppm" || { echo "error=no window shot"; exit 1; }
     xdotool key KP_Decimal
     wait_changed camera "$cam" || exit 1
     echo "camera_light=$(field camera)"
