@@ -8,27 +8,38 @@
 
 namespace kr::viewer {
 
-std::vector<OutlinerRow> outliner_rows(const Scene& scene) {
-    std::vector<OutlinerRow> rows;
-    for (int p = 0; p < int(scene.primitives.size()); ++p) {
-        const Primitive& prim = scene.primitives[size_t(p)];
-        OutlinerRow row{OutlinerKind::object, p, primitive_label(scene, p), {}};
+OutlinerRow outliner_row(const Scene& scene, OutlinerKind kind, int index) {
+    OutlinerRow row{kind, index, {}, {}};
+    if (kind == OutlinerKind::object) {
+        const Primitive& prim = scene.primitives[size_t(index)];
+        row.label = primitive_label(scene, index);
         if (prim.material >= 0) {
             const Material& m = scene.materials[size_t(prim.material)];
             row.detail = std::string(material_type_names.name(m.type)) + " '" + m.id + "'";
         }
-        rows.push_back(std::move(row));
-    }
-    for (int l = 0; l < int(scene.lights.size()); ++l) {
-        const bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), l) != scene.active_lights.end();
-        rows.push_back({OutlinerKind::light, l, light_label(scene.lights[size_t(l)]), on ? "on" : "off"});
-    }
-    for (int c = 0; c < int(scene.cameras.size()); ++c) {
-        const Camera& cam = scene.cameras[size_t(c)];
+    } else if (kind == OutlinerKind::light) {
+        const bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
+        row.label = light_label(scene.lights[size_t(index)]);
+        row.detail = on ? "on" : "off";
+    } else {
+        const Camera& cam = scene.cameras[size_t(index)];
         const std::string type(camera_type_names.name(cam.type));
-        rows.push_back({OutlinerKind::camera, c, cam.id == type ? cam.id : cam.id + " (" + type + ")",
-                        c == scene.camera ? "active" : ""});
+        row.label = cam.id == type ? cam.id : cam.id + " (" + type + ")";
+        if (index == scene.camera) row.detail = "active";
     }
+    return row;
+}
+
+int outliner_count(const Scene& scene, OutlinerKind kind) {
+    return int(kind == OutlinerKind::object  ? scene.primitives.size()
+               : kind == OutlinerKind::light ? scene.lights.size()
+                                             : scene.cameras.size());
+}
+
+std::vector<OutlinerRow> outliner_rows(const Scene& scene) {
+    std::vector<OutlinerRow> rows;
+    for (const OutlinerKind kind : {OutlinerKind::object, OutlinerKind::light, OutlinerKind::camera})
+        for (int i = 0; i < outliner_count(scene, kind); ++i) rows.push_back(outliner_row(scene, kind, i));
     return rows;
 }
 

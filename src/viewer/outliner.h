@@ -23,6 +23,10 @@ struct OutlinerRow {
 // Objects (the primitives, in the scene block's order), then every light of the file (on or
 // off), then every camera (bookmarks included).
 std::vector<OutlinerRow> outliner_rows(const Scene& scene);
+// One of them (the panel makes only the rows it shows: a scene may hold many spheres).
+OutlinerRow outliner_row(const Scene& scene, OutlinerKind kind, int index);
+// How many rows of each kind: primitives, lights, cameras.
+int outliner_count(const Scene& scene, OutlinerKind kind);
 
 // What the window has selected: a primitive (a click on the image, or its row), or a light
 // with no primitive of its own (a point light, or an area light no primitive carries).

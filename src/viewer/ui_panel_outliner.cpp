@@ -27,51 +27,68 @@ void select_light(PanelContext& ctx, int light) {
 void panel_outliner(PanelContext& ctx) {
     if (!ImGui::CollapsingHeader("Outliner", ImGuiTreeNodeFlags_DefaultOpen)) return;
     const Scene& scene = ctx.model.scene();
-    const std::vector<OutlinerRow> rows = outliner_rows(scene);
     const auto sel = ctx.selection();
     int light = -1;  // a light selected as itself (no primitive selected)
     if (!sel && ctx.ui.selected_light && size_t(*ctx.ui.selected_light) < scene.lights.size()) light = *ctx.ui.selected_light;
-    // A list of its own, at most a third of the panel's height (at least 4 rows): it scrolls.
+    // The list: a heading, then the rows of each kind. Only the rows in view are made
+    // (ImGuiListClipper): a scene may hold many thousands of spheres.
+    static constexpr OutlinerKind kKinds[] = {OutlinerKind::object, OutlinerKind::light, OutlinerKind::camera};
+    static constexpr const char* kHeadings[] = {"Objects", "Lights", "Cameras"};
+    int counts[3], starts[3], total = 0;
+    for (int k = 0; k < 3; ++k) {
+        counts[k] = outliner_count(scene, kKinds[k]);
+        starts[k] = total;  // the heading's line; its rows follow
+        total += 1 + counts[k];
+    }
+    // The selection's line: its object, or the light selected as itself.
+    int selected_line = -1;
+    if (sel) selected_line = starts[0] + 1 + *sel;
+    else if (light >= 0) selected_line = starts[1] + 1 + light;
+    // An emissive selection's light row is highlighted too.
+    const int carried = sel && scene.primitives[size_t(*sel)].type == PrimitiveType::emissive ? scene.primitives[size_t(*sel)].light : -1;
+    // At most a third of the window's height (at least 4 rows); it scrolls.
     const float row_h = ImGui::GetTextLineHeightWithSpacing();
     const float most = std::max(4 * row_h, ImGui::GetIO().DisplaySize.y / 3);
-    const float height = std::min(most, float(rows.size() + 3) * row_h + ImGui::GetStyle().WindowPadding.y * 2);
+    const float height = std::min(most, float(total + 1) * row_h + ImGui::GetStyle().WindowPadding.y * 2);
     ImGui::BeginChild("##outliner", ImVec2(0, height), true);
-    // The selection's row scrolls into view when the selection changed (a click on the image).
-    static std::string last_selected;
-    const char* headings[] = {"Objects", "Lights", "Cameras"};
-    int heading = -1;
+    // A new selection (a click on the image, say) scrolls its row into view.
+    if (selected_line != ctx.ui.outliner_shown_line) {
+        ctx.ui.outliner_shown_line = selected_line;
+        if (selected_line >= 0) {
+            const float y = float(selected_line) * row_h, top = ImGui::GetScrollY(), view = ImGui::GetWindowHeight() - 2 * row_h;
+            if (y < top || y > top + view) ImGui::SetScrollY(std::max(0.0f, y - 0.5f * view));
+        }
+    }
     std::optional<Selection> picked;
     std::optional<int> activate;
-    for (const OutlinerRow& row : rows) {
-        if (int(row.kind) != heading) {
-            heading = int(row.kind);
-            ImGui::TextDisabled("%s", headings[heading]);
+    ImGuiListClipper clipper;
+    clipper.Begin(total, row_h);
+    while (clipper.Step())
+        for (int line = clipper.DisplayStart; line < clipper.DisplayEnd; ++line) {
+            int k = 2;
+            while (line < starts[k]) --k;
+            if (line == starts[k]) {
+                ImGui::TextDisabled("%s", kHeadings[k]);
+                continue;
+            }
+            const int index = line - starts[k] - 1;
+            const OutlinerRow row = outliner_row(scene, kKinds[k], index);
+            const bool selected = line == selected_line || (k == 1 && index == carried);
+            std::string key(1, "olc"[k]);  // "o3": object 3; "l0": light 0; "c1": camera 1
+            key += std::to_string(index);
+            ImGui::PushID(key.c_str());
+            const std::string text = "  " + row.label;
+            if (ImGui::Selectable(text.c_str(), selected)) {
+                if (row.kind == OutlinerKind::camera) activate = row.index;
+                else picked = row_selection(scene, row);
+            }
+            if (ImGui::IsItemVisible()) mark_item(ctx, "row:" + key);  // rows scrolled away are not there to click
+            if (!row.detail.empty()) {
+                ImGui::SameLine();
+                ImGui::TextDisabled("%s", row.detail.c_str());
+            }
+            ImGui::PopID();
         }
-        const bool selected = (row.kind == OutlinerKind::object && sel == row.index) ||
-                              (row.kind == OutlinerKind::light && light == row.index) ||
-                              (row.kind == OutlinerKind::light && sel &&
-                               scene.primitives[size_t(*sel)].type == PrimitiveType::emissive &&
-                               scene.primitives[size_t(*sel)].light == row.index);  // the active camera: "active"
-        std::string key(1, "olc"[heading]);  // "o3": object 3; "l0": light 0; "c1": camera 1
-        key += std::to_string(row.index);
-        ImGui::PushID(key.c_str());
-        const std::string text = "  " + row.label;
-        if (ImGui::Selectable(text.c_str(), selected)) {
-            if (row.kind == OutlinerKind::camera) activate = row.index;
-            else picked = row_selection(scene, row);
-        }
-        if (ImGui::IsItemVisible()) mark_item(ctx, "row:" + key);  // rows scrolled away are not there to click
-        if (!row.detail.empty()) {
-            ImGui::SameLine();
-            ImGui::TextDisabled("%s", row.detail.c_str());
-        }
-        if (selected && last_selected != key) {
-            ImGui::SetScrollHereY(0.5f);
-            last_selected = key;
-        }
-        ImGui::PopID();
-    }
-    if (!sel && light < 0) last_selected.clear();
     ImGui::EndChild();
     if (picked) {
         if (picked->primitive) select_primitive(ctx, picked->primitive);
