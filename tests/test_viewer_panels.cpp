@@ -30,6 +30,7 @@
 #include "viewer/save_dialog.h"
 #include "viewer/scene_edit.h"
 #include "viewer/status.h"
+#include "viewer/ui_panels.h"  // the panel list and its tabs (a header: no GL)
 
 namespace kr {
 namespace {
@@ -484,6 +485,31 @@ TEST(SelectionMaterial, RecolourChangesThisSphereOnly) {
     const Material& tinted = glass.materials[size_t(glass.primitives[size_t(a)].material)];
     EXPECT_EQ(tinted.rho_t, red);
     EXPECT_EQ(tinted.rho_r, rho_r);
+}
+
+// The panel list's tabs: every panel has a tab or sits above them (the outliner), every tab
+// shows a panel, and the list keeps its order within a tab (Selection first in Object).
+TEST(PanelTabs, EveryPanelHasATabAndEveryTabPanels) {
+    using viewer::PanelTab;
+    [[maybe_unused]] constexpr bool always = true, with_scene = false;
+    [[maybe_unused]] constexpr PanelTab top = PanelTab::top, scene = PanelTab::scene, object = PanelTab::object,
+                                        camera = PanelTab::camera, render = PanelTab::render, compare = PanelTab::compare;
+    std::vector<std::pair<std::string, PanelTab>> panels;
+#define KR_LIST_PANEL(name, when, tab) panels.emplace_back(#name, tab);
+    KR_VIEWER_PANELS(KR_LIST_PANEL)
+#undef KR_LIST_PANEL
+    ASSERT_EQ(panels.front(), std::make_pair(std::string("outliner"), PanelTab::top));
+    for (int t = 0; t < viewer::kPanelTabs; ++t)
+        EXPECT_TRUE(std::any_of(panels.begin(), panels.end(), [&](auto& p) { return p.second == PanelTab(t); }))
+            << viewer::kPanelTabNames[t];
+    auto first_of = [&](PanelTab t) {
+        return std::find_if(panels.begin(), panels.end(), [&](auto& p) { return p.second == t; })->first;
+    };
+    EXPECT_EQ(first_of(PanelTab::object), "selection");
+    EXPECT_EQ(first_of(PanelTab::scene), "scene");
+    EXPECT_EQ(first_of(PanelTab::camera), "camera");
+    EXPECT_EQ(first_of(PanelTab::compare), "compare");
+    EXPECT_EQ(viewer::kPanelTabNames[int(PanelTab::object)], "Object");
 }
 
 }  // namespace

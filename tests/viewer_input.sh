@@ -645,6 +645,7 @@ outliner)
     gen=$(field generation)
     click_at "row:c1" || exit 1
     wait_changed generation "$gen" || exit 1
+    wait_for 'tab=camera' || exit 1  # its properties' tab
     echo "camera_row=1"
     # The tabs.
     click_at "tab:render" || exit 1

@@ -1,7 +1,7 @@
 // The Outliner, above the tabs: every object, light and camera of the scene. A click on a row
 // selects what the image's click selects (the same ctx.ui.selected; a point light, which has
 // no sphere to click, as ctx.ui.selected_light) and shows the Object tab; a camera's row makes
-// it the active camera (an undoable camera edit). "." or numpad-. frames the selection.
+// it the active camera (an undoable camera edit) and shows the Camera tab. "." or numpad-. frames the selection.
 #include <algorithm>
 #include <string>
 
@@ -95,10 +95,13 @@ void panel_outliner(PanelContext& ctx) {
         else if (picked->light) select_light(ctx, *picked->light);
         show_panel_tab(ctx, PanelTab::object);
     }
-    if (activate && *activate != scene.camera) {
-        ctx.model.seal_undo_step();
-        const int c = *activate;
-        ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.camera = c; }, "active camera");
+    if (activate) {
+        show_panel_tab(ctx, PanelTab::camera);  // its properties
+        if (*activate != scene.camera) {
+            ctx.model.seal_undo_step();
+            const int c = *activate;
+            ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.camera = c; }, "active camera");
+        }
     }
     ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
     ImGui::TextWrapped("\".\" frames the selection   numpad 1 3 7: views");  // wraps in a narrow panel
