@@ -151,7 +151,7 @@ double median(std::vector<double> v) {
 
 int cost(int rounds, const std::string& scene_file, int final_rounds) {
     final_rounds = std::min(rounds, final_rounds);
-    for (const auto [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
+    for (const auto& [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
         const Prepared p = prepare(scene_file, w, h, false);
         const RenderState state = render(p, 4, 1);
         RenderEstimates est = render_estimates(state, kAllLayers);

@@ -3,6 +3,7 @@
 // (per frame), medians of 15 at the scene's resolution; then the render thread from an edit to
 // its finished 8 spp, with the feature layers off (the default) and on, interleaved, medians
 // of 5 each. Usage: keithray_bench_features [SCENE.json] (default res/scenes/assignment_03.json).
+#include <string_view>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -39,7 +40,9 @@ double median_ms(int runs, const std::function<void()>& step) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
     const char* file = argc > 1 ? argv[1] : "res/scenes/assignment_03.json";
     const auto scene = std::make_shared<const RenderScene>(prepare_scene(load_scene_file(file).scene));
     RenderSettings settings = RenderSettings::from_scene(scene->renderer);
@@ -76,7 +79,7 @@ int main(int argc, char** argv) {
             RenderWorker worker;
             worker.set_features(layers);
             const auto t0 = Clock::now();
-            worker.submit({1, scene, settings, StopRule{settings.target_spp}});
+            worker.submit({1, scene, settings, StopRule{settings.target_spp}, nullptr, {}});
             std::shared_ptr<const Snapshot> f;
             while (!(f && f->finished)) f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
             (layers ? on : off).push_back(std::chrono::duration<double>(Clock::now() - t0).count());
@@ -84,4 +87,22 @@ int main(int argc, char** argv) {
     const double a = median(off), b = median(on);
     std::printf("  render thread: edit to 8 spp, feature layers off  %8.3f s\n", a);
     std::printf("  render thread: edit to 8 spp, feature layers on   %8.3f s  (x%.3f)\n", b, b / a);
+    return 0;
+}
+
+}  // namespace
+
+// A bad argument or scene file is one line on stderr and exit status 1, not an abort.
+int main(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i)
+        if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
+            std::printf("usage: keithray_bench_features [SCENE.json]\n");
+            return 0;
+        }
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "keithray_bench_features: %s\n", e.what());
+        return 1;
+    }
 }

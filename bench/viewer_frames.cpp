@@ -8,6 +8,7 @@
 // before it. Then the render thread's passes per second against ProgressiveDriver's alone.
 // Usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N]
 //                              [--size WxH] [--raw] [--dump DIR] [--no-region]
+#include <string_view>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -41,7 +42,9 @@ struct Recorded {
 
 }  // namespace
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
     const char* file = "res/scenes/assignment_03.json";
     double orbit_px = 120, run_seconds = 10;
     int settle_spp = 1024, width = 0, height = 0;
@@ -56,6 +59,7 @@ int main(int argc, char** argv) {
         else if (a == "--raw") raw = true;
         else if (a == "--no-region") region_too = false;
         else if (a == "--dump" && i + 1 < argc) dump = argv[++i];
+        else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option '" + a.substr(0, 40) + "' (--help lists them)");
         else file = argv[i];
     }
     Scene scene = load_scene_file(file).scene;
@@ -78,12 +82,12 @@ int main(int argc, char** argv) {
     StopRule open_ended;
     open_ended.max_passes = kUnlimitedPasses;
     // The view before the edit, refined for a second (the render thread measures its pass).
-    worker.submit({1, std::make_shared<const RenderScene>(prepare_scene(scene)), settings, open_ended});
+    worker.submit({1, std::make_shared<const RenderScene>(prepare_scene(scene)), settings, open_ended, nullptr, {}});
     std::this_thread::sleep_for(std::chrono::seconds(1));
 
     // The orbit as the window makes it: about the target, stopping at surfaces.
     Camera& camera = scene.cameras[size_t(scene.camera)];
-    camera = orbit_step(scene, camera, camera, camera.target, orbit_px, 0, true);
+    camera = orbit_step(scene, camera, camera.target, orbit_px, 0, true);
     const auto moved = std::make_shared<const RenderScene>(prepare_scene(scene));
     {
         std::lock_guard lock(mutex);
@@ -157,7 +161,7 @@ int main(int argc, char** argv) {
             StopRule rule;
             rule.max_passes = target;
             const auto t0 = Clock::now();
-            timed.submit({1, moved, settings, rule});
+            timed.submit({1, moved, settings, rule, nullptr, {}});
             std::shared_ptr<const Snapshot> f;
             while (!(f && f->finished)) f = timed.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
             (boxed ? region : whole).push_back(seconds(Clock::now() - t0));
@@ -167,4 +171,21 @@ int main(int argc, char** argv) {
     std::printf("  to %d spp: whole image %.2f s, a region of %.1f %% of it %.2f s (%.1fx sooner)\n", target, whole[1],
                 100.0 * (box.x1 - box.x0) * (box.y1 - box.y0) / (double(w) * h), region[1], whole[1] / region[1]);
     return 0;
+}
+
+}  // namespace
+
+// A bad argument or scene file is one line on stderr and exit status 1, not an abort.
+int main(int argc, char** argv) {
+    for (int i = 1; i < argc; ++i)
+        if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
+            std::printf("usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N] [--size WxH] [--raw] [--dump DIR] [--no-region]\n");
+            return 0;
+        }
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "keithray_bench_frames: %s\n", e.what());
+        return 1;
+    }
 }

@@ -6,6 +6,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
+# The benchmarks are built only when asked for: built here, none breaks unseen.
+cmake --build build -j"$(nproc)" --target keithray_benches
 (cd build && ctest --output-on-failure -j"$(nproc)" "$@")
 if [ "${KEITHRAY_SANITIZERS:-1}" != 0 ]; then
   scripts/check_sanitizers.sh

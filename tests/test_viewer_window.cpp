@@ -745,6 +745,20 @@ TEST_F(ViewerWindow, SameGestureSameCameraWhateverTheFrames) {
     }
 }
 
+// Shift+click and Shift+wheel go by their own events' modifiers: sent behind a backlog of
+// keys (the key queue hands ImGui Shift's press frames after the click and the wheel reach
+// it), the click still locks the probe and selects nothing, and the wheel dollies (a camera
+// edit) without zooming the image.
+TEST_F(ViewerWindow, ShiftClickAndShiftWheelBehindQueuedKeys) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "modifier_backlog", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_NE(r["probe"], "none");
+    EXPECT_EQ(r["selected"], "none");
+    EXPECT_NE(r["image_after_wheel"].find(",fit"), std::string::npos) << r["image_after_wheel"];
+    EXPECT_EQ(r["dirty_after_wheel"], "1");
+}
+
 // The command line's edits apply in an interactive run as in a scripted one (they were
 // taken and ignored): --select selects sphere 01 of scene 3, --region sets the region.
 TEST_F(ViewerWindow, StartEditsApplyInAnInteractiveRun) {

@@ -558,6 +558,29 @@ esc_f1_one_frame)
     wait_for 'dirty=1 .*question=none' || exit 1
     kill -0 $pid 2>/dev/null && echo "running_after_esc=1"
     ;;
+modifier_backlog)
+    # Keys queued behind one another (each tap of F12, which does nothing, takes a frame of
+    # its own), then Shift+click and Shift+wheel, all sent while the viewer is stopped: the
+    # click and the wheel reach the frame at once, Shift's press frames later. They go by
+    # the modifiers of their own events: the click locks the probe (no selection), the wheel
+    # dollies (no zoom). V last (the next view; it opens no window that would hold the
+    # pointer a frame): every key before it was handled once the view changes.
+    kill -STOP $pid
+    xdotool key F12 F12 F12 F12 keydown shift click 1 keyup shift key v
+    kill -CONT $pid
+    wait_for 'view=reference' || exit 1
+    echo "probe=$(field probe)"
+    echo "selected=$(field selected)"
+    g=$(field generation)
+    echo "generation_before_wheel=$g"
+    kill -STOP $pid
+    xdotool key F12 F12 F12 F12 keydown shift click 4 keyup shift key v
+    kill -CONT $pid
+    wait_for 'view=split' || exit 1
+    wait_changed generation "$g" || exit 1
+    echo "image_after_wheel=$(field image)"
+    echo "dirty_after_wheel=$(field dirty)"
+    ;;
 outliner)
     # Issue 47 C: the outliner and the image select the same thing; one click on a colour
     # recolours the selected sphere; "." frames the selection and numpad 7 gives the top view

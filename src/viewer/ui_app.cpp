@@ -43,7 +43,7 @@ ViewerApp* app_of(GLFWwindow* w) { return static_cast<ViewerApp*>(glfwGetWindowU
 // Installed before ImGui's (which chain to them): any input wakes a redraw.
 void install_input_callbacks(GLFWwindow* w) {
     glfwSetCursorPosCallback(w, [](GLFWwindow* win, double x, double y) { app_of(win)->note_cursor(x, y); });
-    glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int button, int action, int) { app_of(win)->note_button(button, action); });
+    glfwSetMouseButtonCallback(w, [](GLFWwindow* win, int button, int action, int mods) { app_of(win)->note_button(button, action, mods); });
     glfwSetScrollCallback(w, [](GLFWwindow* win, double, double) { app_of(win)->note_wheel(); });
     glfwSetKeyCallback(w, [](GLFWwindow* win, int key, int, int action, int mods) { app_of(win)->note_key(key, action, mods); });
     glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { app_of(win)->note_input(); });

@@ -36,9 +36,13 @@ public:
     // The GLFW callbacks.
     void note_input() { input_seen_ = true; }
     void note_key(int key, int action, int mods);
-    void queue_key(const KeyEvent& e) { input_seen_ = true; keys_.push(e); }
+    void queue_key(const KeyEvent& e) {
+        input_seen_ = true;
+        if (!e.text) input_.note_key_event(e.key, e.action);
+        keys_.push(e);
+    }
     void note_cursor(double x, double y) { input_seen_ = true; input_.note_cursor(x, y); }
-    void note_button(int button, int action) { input_seen_ = true; input_.note_button(button, action); }
+    void note_button(int button, int action, int mods) { input_seen_ = true; input_.note_button(button, action, mods); }
     void note_wheel() { input_seen_ = true; input_.note_wheel(); }
     void note_enter(bool entered) { input_seen_ = true; input_.note_enter(entered); }
     void on_close_request();

@@ -26,6 +26,10 @@ void InputState::note_key(int key, int action, int mods) {
     if (action == GLFW_RELEASE || (action == GLFW_PRESS && !chord)) chord_keys.erase(std::remove(chord_keys.begin(), chord_keys.end(), key), chord_keys.end());
 }
 
+void InputState::note_key_event(int key, int action) {
+    if (key == GLFW_KEY_LEFT_SHIFT || key == GLFW_KEY_RIGHT_SHIFT) shift_down = action != GLFW_RELEASE;
+}
+
 void InputState::note_cursor(double x, double y) {
     cursor = {x, y};
     for (int b = 0; b < 3; ++b)
@@ -33,7 +37,7 @@ void InputState::note_cursor(double x, double y) {
             drag_from[b] = cursor;
 }
 
-void InputState::note_button(int button, int action) {
+void InputState::note_button(int button, int action, int mods) {
     if (button < 0 || button >= 3) return;
     if (action == GLFW_PRESS) {
         event_down[button] = true;
@@ -42,7 +46,10 @@ void InputState::note_button(int button, int action) {
     }
     if (action == GLFW_RELEASE) event_down[button] = false;
     // The first press since the last frame is the one ImGui sees as the click.
-    if (action == GLFW_PRESS && !press_at[button]) press_at[button] = cursor;
+    if (action == GLFW_PRESS && !press_at[button]) {
+        press_at[button] = cursor;
+        press_mods[button] = mods;
+    }
     if (action == GLFW_PRESS) release_at[button].reset();
     if (action == GLFW_RELEASE) release_at[button] = cursor;
 }
@@ -60,10 +67,17 @@ void InputState::apply_button_positions() {
     ImGuiIO& io = ImGui::GetIO();
     for (int b = 0; b < 3; ++b) {
         if (io.MouseClicked[b] && press_at[b]) io.MouseClickedPos[b] = ImVec2(float(press_at[b]->first), float(press_at[b]->second));
+        if (io.MouseClicked[b]) {
+            // The click's modifiers: its press event's, else (no event seen) the frame's.
+            const int frame_mods = (io.KeyShift ? GLFW_MOD_SHIFT : 0) | (io.KeyCtrl ? GLFW_MOD_CONTROL : 0) |
+                                   (io.KeyAlt ? GLFW_MOD_ALT : 0) | (io.KeySuper ? GLFW_MOD_SUPER : 0);
+            clicked_mods[b] = press_at[b] ? press_mods[b] : frame_mods;
+        }
         press_at[b].reset();
         released_here[b].reset();
         if (io.MouseReleased[b]) released_here[b] = std::exchange(release_at[b], std::nullopt);
     }
+    wheel_shift_here = wheel_at ? wheel_shift : io.KeyShift;
     wheel_here = std::exchange(wheel_at, std::nullopt);
 }
 
@@ -211,7 +225,7 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     if (io.WantCaptureMouse || !over_image) {
         for (int b = 0; b < 3; ++b)
             if (ImGui::IsMouseClicked(b)) in.drags[b].release();  // a press on a panel drags nothing
-        if (!io.WantCaptureMouse && inside(area) && !io.KeyShift && io.MouseWheel != 0)
+        if (!io.WantCaptureMouse && inside(area) && !in.wheel_shift_here && io.MouseWheel != 0)
             tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, wx, wy);
     } else if (ctx.ui.drawing_region && (ImGui::IsMouseClicked(ImGuiMouseButton_Left) || ctx.ui.region_draft)) {
         // B, then a left drag: the box from the press to the pointer, in image pixels.
@@ -232,7 +246,9 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
             in.press_pick = model.prepared() ? pick_primitive(model.scene(), model.prepared()->camera, fx, fy) : std::nullopt;
         }
         const double divider_x = rect.x + tool.comparison.settings.split * rect.width;
-        if (left_click && io.KeyShift) {
+        const bool shift_click = left_click && (in.clicked_mods[0] & GLFW_MOD_SHIFT);
+        const bool ctrl_click = left_click && (in.clicked_mods[0] & GLFW_MOD_CONTROL);
+        if (shift_click) {
             in.drags[0].release();  // Shift+click locks the inspector on a pixel, or frees it
             const std::pair<int, int> pixel{int(std::floor((px - rect.x) / image_scale)),
                                             int(std::floor((py - rect.y) / image_scale))};
@@ -241,7 +257,7 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         } else if (left_click && tool.comparison.settings.mode == ViewMode::split && std::abs(px - divider_x) <= 6 * to_fb) {
             in.drags[0].release();  // the split view's divider, never an orbit
             in.divider_drag = true;
-        } else if (left_click && (io.KeyCtrl || ctx.ui.pick_focus)) {
+        } else if (ctrl_click || (left_click && ctx.ui.pick_focus)) {
             in.drags[0].release();  // a focus click, never an orbit
             const Vec2 film = raster_to_camera((px - rect.x) / rect.width * w, (py - rect.y) / rect.height * h, w, h);
             if (!model.focus_at(film.x, film.y)) ctx.messages.show_error("click-to-focus: nothing there to focus on");
@@ -250,12 +266,12 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
         }
         if (ImGui::IsMouseClicked(ImGuiMouseButton_Middle)) {
             // The middle button pans the image, as the wheel zooms it; Shift+middle dollies.
-            in.middle_pans = !io.KeyShift;
+            in.middle_pans = !(in.clicked_mods[2] & GLFW_MOD_SHIFT);
             in.pan_last_x = in.pan_last_y = 0;
         }
         if (io.MouseWheel != 0) {
             // The wheel zooms the image about the pointer (samples kept); Shift+wheel dollies.
-            if (!io.KeyShift) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, wx, wy);
+            if (!in.wheel_shift_here) tool.view.zoom_steps(area, w, h, io.MouseWheel > 0 ? 1 : -1, wx, wy);
             else
                 ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) {
                     Camera& cam = s.cameras[size_t(s.camera)];

@@ -48,18 +48,32 @@ struct InputState {
     std::optional<Point> cursor;              // none before the first motion
     bool cursor_inside = false;               // the pointer is over the window (by its enter/leave events)
     std::optional<Point> press_at[3], release_at[3];
+    // The modifiers (GLFW_MOD_*) of each button's first press since the last frame, by its
+    // event, and of the press this frame sees as a click: Shift+click and Ctrl+click go by the
+    // press's own modifiers, not the keys ImGui has been handed by the frame (the key queue
+    // can hold a modifier's release, or lag behind a burst of input).
+    int press_mods[3] = {0, 0, 0};
+    int clicked_mods[3] = {0, 0, 0};
     std::optional<Point> released_here[3];    // where the button this frame sees released went up
     std::optional<Point> wheel_at, wheel_here;  // the pointer at the last wheel event (zoom's centre)
+    // Shift held, by the key events (not the keys the queue has handed ImGui yet), and as it
+    // was at the last wheel event: Shift+wheel dollies, the wheel zooms.
+    bool shift_down = false, wheel_shift = false, wheel_shift_here = false;
     // By the events, not the frames: each button held, where it went down, and where the
     // pointer's motion first went more than kDragThresholdPixels from there (the drag's start).
     bool event_down[3] = {false, false, false};
     Point event_press[3];
     std::optional<Point> drag_from[3];
 
+    // A key as the frame's queue hands it over (note_key), and as GLFW reports it (note_key_event).
     void note_key(int key, int action, int mods = 0);
+    void note_key_event(int key, int action);
     void note_cursor(double x, double y);
-    void note_button(int button, int action);
-    void note_wheel() { wheel_at = cursor; }
+    void note_button(int button, int action, int mods = 0);
+    void note_wheel() {
+        wheel_at = cursor;
+        wheel_shift = shift_down;
+    }
     void note_enter(bool entered) { cursor_inside = entered; }
     // After the backend's NewFrame, before ImGui::NewFrame: the frame's pointer is where the
     // events handled so far left it. The GLFW backend reads the pointer from the X server
