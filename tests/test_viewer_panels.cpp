@@ -370,6 +370,24 @@ TEST(Outliner, ListsEveryObjectLightAndCamera) {
     }
 }
 
+// The outliner's filter: case-insensitive, in the label or the detail, ends' spaces ignored.
+TEST(Outliner, FilterMatchesNamesAndDetails) {
+    const Scene s = test::brief_scene(3, 8);
+    const auto rows = viewer::outliner_rows(s);
+    auto matching = [&](std::string_view filter) {
+        std::vector<std::string> out;
+        for (const auto& r : rows)
+            if (viewer::outliner_row_matches(r, filter)) out.push_back(r.label);
+        return out;
+    };
+    EXPECT_EQ(matching("").size(), rows.size());
+    EXPECT_EQ(matching("   ").size(), rows.size());
+    EXPECT_EQ(matching(" SPHERE 0 "), (std::vector<std::string>{"sphere 01", "sphere 02"}));
+    EXPECT_EQ(matching("Fresnel"), (std::vector<std::string>{"sphere 01"}));  // its material
+    EXPECT_EQ(matching("off"), (std::vector<std::string>{"point light"}));    // its state
+    EXPECT_TRUE(matching("no such thing").empty());
+}
+
 // "Frame selected" looks at the selection from the direction the camera looks, at the
 // distance where it fills kFrameFill of the half field of view; a render shows it centred
 // and whole. A point light keeps the distance; a lens focuses on what it frames.

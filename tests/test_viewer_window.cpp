@@ -1041,6 +1041,8 @@ TEST_F(ViewerWindow, OutlinerSelectsFramesAndRecolours) {
     EXPECT_EQ(s.primitives[size_t(sphere)].id, "sphere 01");
     EXPECT_EQ(r["selected_by_row"], "0");
     EXPECT_EQ(r["selected_by_row_again"], r["selected_on_image"]);
+    EXPECT_EQ(r["filtered"], "2");  // "SPHERE 0": sphere 01 and sphere 02
+    EXPECT_EQ(r["unfiltered"], "1");
     auto vec = [](const std::string& text) {
         kr::Vec3 v;
         EXPECT_EQ(std::sscanf(text.c_str(), "%lf,%lf,%lf", &v.x, &v.y, &v.z), 3) << text;

@@ -617,6 +617,14 @@ outliner)
     click_at "row:o$sel" || exit 1
     wait_for "selected=$sel .*tab=object" || exit 1
     echo "selected_by_row_again=$(field selected)"
+    # The filter (case-insensitive): "SPHERE 0" lists sphere 01 and 02 only; cleared, all again.
+    click_at "outliner:filter" || exit 1
+    xdotool type "SPHERE 0"
+    wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o6:[0-9-]+,[0-9-]+;row:o7:[0-9-]+,[0-9-]+;tab:scene" || exit 1
+    echo "filtered=$(field at | tr ';' '\n' | grep -c '^row:')"
+    xdotool key ctrl+a BackSpace Return
+    wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o0:" || exit 1
+    echo "unfiltered=1"
     # One click on red: the sphere is recoloured (the scene is edited, the render restarts).
     gen=$(field generation)
     click_at "palette:red" || exit 1

@@ -1,6 +1,7 @@
 #include "viewer/outliner.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <numbers>
 
@@ -41,6 +42,18 @@ std::vector<OutlinerRow> outliner_rows(const Scene& scene) {
     for (const OutlinerKind kind : {OutlinerKind::object, OutlinerKind::light, OutlinerKind::camera})
         for (int i = 0; i < outliner_count(scene, kind); ++i) rows.push_back(outliner_row(scene, kind, i));
     return rows;
+}
+
+bool outliner_row_matches(const OutlinerRow& row, std::string_view filter) {
+    const size_t first = filter.find_first_not_of(' '), last = filter.find_last_not_of(' ');
+    if (first == std::string_view::npos) return true;
+    filter = filter.substr(first, last - first + 1);
+    auto lower = [](unsigned char c) { return char(std::tolower(c)); };
+    auto contains = [&](const std::string& text) {
+        return std::search(text.begin(), text.end(), filter.begin(), filter.end(),
+                           [&](char a, char b) { return lower(a) == lower(b); }) != text.end();
+    };
+    return contains(row.label) || contains(row.detail);
 }
 
 Selection row_selection(const Scene& scene, const OutlinerRow& row) {

@@ -5,6 +5,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scene/scene.h"
@@ -27,6 +28,11 @@ std::vector<OutlinerRow> outliner_rows(const Scene& scene);
 OutlinerRow outliner_row(const Scene& scene, OutlinerKind kind, int index);
 // How many rows of each kind: primitives, lights, cameras.
 int outliner_count(const Scene& scene, OutlinerKind kind);
+
+// Whether a row matches the outliner's filter: `filter`'s text (case-insensitive, spaces at
+// its ends ignored) in its label or its detail ("glass", "off", "emissive"); an empty filter
+// matches every row.
+bool outliner_row_matches(const OutlinerRow& row, std::string_view filter);
 
 // What the window has selected: a primitive (a click on the image, or its row), or a light
 // with no primitive of its own (a point light, or an area light no primitive carries).

@@ -139,6 +139,7 @@ struct UiState {
     int panel_tab = 1;                       // the panel's tab (ui_panels.h: PanelTab; Object first)
     bool show_tab = true;                    // bring panel_tab to the front this frame (the first: Object)
     int outliner_shown_line = -1;            // the outliner line last scrolled to (the selection's)
+    std::string outliner_filter;             // the outliner lists the rows that match it
     // Named widgets' centres in window points, this frame (the status file's at=, for the
     // window tests that click them).
     struct Mark {
