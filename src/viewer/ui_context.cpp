@@ -90,7 +90,7 @@ void add_sphere_at_target(PanelContext& ctx) {
             free_sphere_place(s, cam.position, cam.target, std::max(1e-3, 0.05 * length(cam.target - cam.position)));
         added = add_sphere(s, at.centre, at.radius);
     }, "add sphere");
-    if (added >= 0) ctx.ui.selected = added;
+    if (added >= 0) ctx.ui.selected = added, ctx.ui.selected_light.reset();  // the new sphere is the selection
 }
 
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
