@@ -3,12 +3,10 @@
 // material_fields as the Materials panel has them), its light; and the object edits
 // (viewer/scene_edit.h): add, duplicate, delete, any material or a new one, emissive. A point
 // light selected in the outliner shows its position and power here.
-#include <algorithm>
 #include <string>
 
 #include <imgui.h>
 
-#include "core/text.h"
 #include "viewer/outliner.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_panels.h"
@@ -29,13 +27,7 @@ void light_section(PanelContext& ctx, int index) {
     const Scene& scene = ctx.model.scene();
     Light light = scene.lights[size_t(index)];
     // On or off as the Lights panel has it; its fields greyed while off (nothing moves).
-    bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
-    if (ImGui::Checkbox(light_label(light).c_str(), &on) &&
-        ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { set_light_on(s, index, on); }, "light on/off")) {
-        const std::string unseen = on ? light_unseen_reason(ctx.model.scene(), index) : std::string();
-        ctx.messages.show_status("light " + show_user_text(light.id) + (on ? " on" : " off: it emits nothing") +
-                                 (unseen.empty() ? "" : "; it adds nothing to the picture: " + unseen));
-    }
+    const bool on = light_checkbox(ctx, index);
     ImGui::SameLine();
     ImGui::TextDisabled("%s", on ? "on" : "off");
     const std::string name = "light " + light.id;

@@ -33,6 +33,11 @@ bool power_fields(PanelContext& ctx, Color& power, float speed = 0.1f);
 // panel and the Selection panel both edit materials through it.
 bool material_fields(PanelContext& ctx, Material& m);
 
+// Light `index`'s on/off checkbox, labelled with light_label: checking it switches the light
+// on or off (set_light_on, one undoable edit) and says so in the status line, with why a light
+// switched on adds nothing to the picture (light_unseen_reason). Returns whether it is on now.
+bool light_checkbox(PanelContext& ctx, int index);
+
 // Records the last item's centre under `name` for this frame (UiState::marks: the status
 // file's at=, which the window tests click).
 void mark_item(PanelContext& ctx, std::string name);
