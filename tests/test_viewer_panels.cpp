@@ -1,4 +1,5 @@
-// Issue 47 B1, B4-B6: the panels, the status bar and the files, at the model (GL-free).
+// Issue 47 B1, B4-B6 and C (the outliner, the selection's properties, the views): the panels,
+// the status bar and the files, at the model (GL-free).
 // A light switched off emits nothing (in the render, in the saved file, in `keithray render`
 // of it); a light that cannot be seen says why; an edit that leaves the image as it was keeps
 // its samples; colours are written as the decimals the user picked; the status bar's fields
@@ -24,10 +25,12 @@
 #include "viewer/edit.h"
 #include "viewer/inspect.h"
 #include "viewer/model.h"
+#include "viewer/outliner.h"
 #include "viewer/render_worker.h"
 #include "viewer/save_dialog.h"
 #include "viewer/scene_edit.h"
 #include "viewer/status.h"
+#include "viewer/ui_panels.h"  // the panel list and its tabs (a header: no GL)
 
 namespace kr {
 namespace {
@@ -331,6 +334,200 @@ TEST(BundledScenes, AreNeverSavedOver) {
     EXPECT_EQ(viewer::SavePaths::for_scene(s, true).scene, "assignment_03.json");
     const fs::path mine = temp_path("mine.json");
     EXPECT_FALSE(viewer::scene_file_read_only(mine, data));
+}
+
+// Issue 47 C: the outliner lists every object, every light (on or off) and every camera; a
+// light's row selects the sphere that carries it, a point light itself.
+TEST(Outliner, ListsEveryObjectLightAndCamera) {
+    const Scene s = test::brief_scene(3, 8);
+    const auto rows = viewer::outliner_rows(s);
+    auto count = [&](viewer::OutlinerKind k) { return size_t(std::count_if(rows.begin(), rows.end(), [&](auto& r) { return r.kind == k; })); };
+    EXPECT_EQ(count(viewer::OutlinerKind::object), s.primitives.size());
+    EXPECT_EQ(count(viewer::OutlinerKind::light), s.lights.size());
+    EXPECT_EQ(count(viewer::OutlinerKind::camera), s.cameras.size());
+    ASSERT_EQ(rows.size(), s.primitives.size() + s.lights.size() + s.cameras.size());
+    // Objects first, in the scene's order, each with its material; the active camera marked.
+    for (size_t p = 0; p < s.primitives.size(); ++p) {
+        EXPECT_EQ(rows[p].index, int(p));
+        EXPECT_EQ(rows[p].label, viewer::primitive_label(s, int(p)));
+        EXPECT_NE(rows[p].detail.find(s.materials[size_t(s.primitives[p].material)].id), std::string::npos) << rows[p].detail;
+    }
+    for (const auto& r : rows) {
+        if (r.kind == viewer::OutlinerKind::camera) EXPECT_EQ(r.detail == "active", r.index == s.camera);
+        const viewer::Selection sel = viewer::row_selection(s, r);
+        if (r.kind == viewer::OutlinerKind::object) EXPECT_EQ(sel.primitive, r.index);
+        if (r.kind == viewer::OutlinerKind::camera) EXPECT_FALSE(sel.primitive || sel.light);
+        if (r.kind == viewer::OutlinerKind::light) {
+            const Light& l = s.lights[size_t(r.index)];
+            if (l.type == LightType::point) {
+                EXPECT_EQ(sel.light, r.index);  // no sphere to click: the light itself
+                EXPECT_FALSE(sel.primitive);
+            } else {
+                ASSERT_TRUE(sel.primitive) << r.label;  // the emissive sphere that carries it
+                EXPECT_EQ(s.primitives[size_t(*sel.primitive)].light, r.index);
+            }
+        }
+    }
+}
+
+// The outliner's filter: case-insensitive, in the label or the detail, ends' spaces ignored.
+TEST(Outliner, FilterMatchesNamesAndDetails) {
+    const Scene s = test::brief_scene(3, 8);
+    const auto rows = viewer::outliner_rows(s);
+    auto matching = [&](std::string_view filter) {
+        std::vector<std::string> out;
+        for (const auto& r : rows)
+            if (viewer::outliner_row_matches(r, filter)) out.push_back(r.label);
+        return out;
+    };
+    EXPECT_EQ(matching("").size(), rows.size());
+    EXPECT_EQ(matching("   ").size(), rows.size());
+    EXPECT_EQ(matching(" SPHERE 0 "), (std::vector<std::string>{"sphere 01", "sphere 02"}));
+    EXPECT_EQ(matching("Fresnel"), (std::vector<std::string>{"sphere 01"}));  // its material
+    EXPECT_EQ(matching("off"), (std::vector<std::string>{"point light"}));    // its state
+    EXPECT_TRUE(matching("no such thing").empty());
+}
+
+// "Frame selected" looks at the selection from the direction the camera looks, at the
+// distance where it fills kFrameFill of the half field of view; a render shows it centred
+// and whole. A point light keeps the distance; a lens focuses on what it frames.
+TEST(FrameSelected, CentresTheSphereAndFitsIt) {
+    ViewerModel m = test::brief_model(3);
+    const Scene& s = m.scene();
+    int sphere = -1;
+    for (size_t p = 0; p < s.primitives.size(); ++p)
+        if (s.primitives[p].id == "sphere 01") sphere = int(p);
+    ASSERT_GE(sphere, 0);
+    const auto ball = viewer::selection_ball(s, viewer::Selection{sphere, std::nullopt});
+    ASSERT_TRUE(ball);
+    const Camera before = m.camera();
+    const Camera c = viewer::framed(before, *ball);
+    EXPECT_EQ(c.target, ball->centre);
+    // Same direction of view.
+    const Vec3 d0 = normalize(before.target - before.position), d1 = normalize(c.target - c.position);
+    EXPECT_NEAR(dot(d0, d1), 1.0, 1e-12);
+    // Its angular radius is kFrameFill of the half field of view (square image: fov both ways).
+    const double half = before.fov * 3.14159265358979323846 / 360;
+    EXPECT_NEAR(std::asin(ball->radius / length(c.position - ball->centre)), viewer::kFrameFill * half, 1e-12);
+    // Undoable camera edit, as the keys make it.
+    ASSERT_TRUE(m.edit(Edit::camera, [&](Scene& sc, ViewerSettings&) { sc.cameras[size_t(sc.camera)] = c; }));
+    EXPECT_EQ(viewer::pick_primitive(m.scene(), m.prepared()->camera, 0.5, 0.5), sphere);
+    // The image's edges see something else: the sphere fits whole.
+    for (auto [fx, fy] : {std::pair{0.02, 0.5}, {0.98, 0.5}, {0.5, 0.02}, {0.5, 0.98}})
+        EXPECT_NE(viewer::pick_primitive(m.scene(), m.prepared()->camera, fx, fy), sphere) << fx << "," << fy;
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(m.camera().position, before.position);
+    EXPECT_EQ(m.camera().target, before.target);
+    // A point light: looked at from the same distance.
+    Camera lens = before;
+    lens.type = CameraType::lens;
+    const viewer::Ball point{Vec3(1, 2, 3), 0};
+    const Camera p = viewer::framed(lens, point);
+    EXPECT_EQ(p.target, point.centre);
+    EXPECT_NEAR(length(p.position - p.target), length(before.target - before.position), 1e-9);
+    EXPECT_NEAR(p.focal_distance, length(p.position - p.target), 1e-12);
+}
+
+// Numpad 1 / 3 / 7 (Ctrl: the other side): along the world axes about the target, at the
+// same distance; the top view is a valid camera (the straight-down basis).
+TEST(AxisViews, LookAlongTheWorldAxesAboutTheTarget) {
+    Camera c;
+    c.position = Vec3(3, 4, -12);
+    c.target = Vec3(1, 1, 1);
+    const double d = length(c.target - c.position);
+    const std::pair<viewer::AxisView, Vec3> cases[] = {
+        {viewer::AxisView::front, Vec3(0, 0, 1)},  {viewer::AxisView::back, Vec3(0, 0, -1)},
+        {viewer::AxisView::right, Vec3(-1, 0, 0)}, {viewer::AxisView::left, Vec3(1, 0, 0)},
+        {viewer::AxisView::top, Vec3(0, -1, 0)},   {viewer::AxisView::bottom, Vec3(0, 1, 0)},
+    };
+    for (const auto& [view, forward] : cases) {
+        const Camera v = viewer::axis_view(c, view);
+        EXPECT_EQ(v.target, c.target) << viewer::axis_view_name(view);
+        EXPECT_NEAR(length(v.target - v.position), d, 1e-12);
+        EXPECT_NEAR(dot(normalize(v.target - v.position), forward), 1.0, 1e-12) << viewer::axis_view_name(view);
+        const CameraModel model = CameraModel::from(v);
+        EXPECT_NEAR(length(model.right), 1.0, 1e-9) << viewer::axis_view_name(view);
+    }
+}
+
+// Recolouring the selected sphere recolours it alone: a material it shares is copied for it
+// (one undo step), one of its own is changed in place; a dielectric's tint is its rhoT.
+TEST(SelectionMaterial, RecolourChangesThisSphereOnly) {
+    ViewerModel m = test::brief_model(3);
+    const Scene& s = m.scene();
+    // Two spheres sharing one material: give sphere 01 sphere 02's.
+    int a = -1, b = -1;
+    for (size_t p = 0; p < s.primitives.size(); ++p) {
+        if (s.primitives[p].id == "sphere 02") a = int(p);  // glossy: its tint is rho
+        if (s.primitives[p].id == "sphere 01") b = int(p);
+    }
+    ASSERT_GE(a, 0);
+    ASSERT_GE(b, 0);
+    ASSERT_TRUE(m.edit(Edit::object, [&](Scene& sc, ViewerSettings&) { sc.primitives[size_t(b)].material = sc.primitives[size_t(a)].material; }));
+    m.seal_undo_step();
+    const int shared = s.primitives[size_t(a)].material;
+    ASSERT_EQ(viewer::material_users(s, shared), 2);
+    const Material before = s.materials[size_t(shared)];
+    const size_t materials = s.materials.size();
+    const Color red = viewer::kPalette[2].rho;
+    ASSERT_TRUE(m.edit(Edit::material, [&](Scene& sc, ViewerSettings&) { EXPECT_TRUE(viewer::recolour_primitive(sc, a, red)); }));
+    m.seal_undo_step();
+    EXPECT_EQ(s.materials.size(), materials + 1);
+    const int own = s.primitives[size_t(a)].material;
+    EXPECT_NE(own, shared);
+    EXPECT_EQ(s.primitives[size_t(b)].material, shared);
+    EXPECT_EQ(s.materials[size_t(shared)].rho, before.rho);  // the other sphere keeps its colour
+    EXPECT_EQ(s.materials[size_t(own)].rho, red);
+    EXPECT_EQ(s.materials[size_t(own)].type, before.type);
+    // Again: its own material now, changed in place.
+    const Color blue = viewer::kPalette[6].rho;
+    ASSERT_TRUE(m.edit(Edit::material, [&](Scene& sc, ViewerSettings&) { viewer::recolour_primitive(sc, a, blue); }));
+    m.seal_undo_step();
+    EXPECT_EQ(s.materials.size(), materials + 1);
+    EXPECT_EQ(s.materials[size_t(own)].rho, blue);
+    // One undo step each.
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(s.materials[size_t(s.primitives[size_t(a)].material)].rho, red);
+    ASSERT_TRUE(m.undo());
+    EXPECT_EQ(s.materials.size(), materials);
+    EXPECT_EQ(s.primitives[size_t(a)].material, shared);
+    // A dielectric's tint is what it transmits.
+    Scene glass = test::brief_scene(3, 8);
+    int g = -1;
+    for (size_t i = 0; i < glass.materials.size(); ++i)
+        if (glass.materials[i].type == MaterialType::dielectric) g = int(i);
+    ASSERT_GE(g, 0);
+    glass.primitives[size_t(a)].material = g;
+    const Color rho_r = glass.materials[size_t(g)].rho_r;
+    ASSERT_TRUE(viewer::recolour_primitive(glass, a, red));
+    const Material& tinted = glass.materials[size_t(glass.primitives[size_t(a)].material)];
+    EXPECT_EQ(tinted.rho_t, red);
+    EXPECT_EQ(tinted.rho_r, rho_r);
+}
+
+// The panel list's tabs: every panel has a tab or sits above them (the outliner), every tab
+// shows a panel, and the list keeps its order within a tab (Selection first in Object).
+TEST(PanelTabs, EveryPanelHasATabAndEveryTabPanels) {
+    using viewer::PanelTab;
+    [[maybe_unused]] constexpr bool always = true, with_scene = false;
+    [[maybe_unused]] constexpr PanelTab top = PanelTab::top, scene = PanelTab::scene, object = PanelTab::object,
+                                        camera = PanelTab::camera, render = PanelTab::render, compare = PanelTab::compare;
+    std::vector<std::pair<std::string, PanelTab>> panels;
+#define KR_LIST_PANEL(name, when, tab) panels.emplace_back(#name, tab);
+    KR_VIEWER_PANELS(KR_LIST_PANEL)
+#undef KR_LIST_PANEL
+    ASSERT_EQ(panels.front(), std::make_pair(std::string("outliner"), PanelTab::top));
+    for (int t = 0; t < viewer::kPanelTabs; ++t)
+        EXPECT_TRUE(std::any_of(panels.begin(), panels.end(), [&](auto& p) { return p.second == PanelTab(t); }))
+            << viewer::kPanelTabNames[t];
+    auto first_of = [&](PanelTab t) {
+        return std::find_if(panels.begin(), panels.end(), [&](auto& p) { return p.second == t; })->first;
+    };
+    EXPECT_EQ(first_of(PanelTab::object), "selection");
+    EXPECT_EQ(first_of(PanelTab::scene), "scene");
+    EXPECT_EQ(first_of(PanelTab::camera), "camera");
+    EXPECT_EQ(first_of(PanelTab::compare), "compare");
+    EXPECT_EQ(viewer::kPanelTabNames[int(PanelTab::object)], "Object");
 }
 
 }  // namespace

@@ -26,6 +26,7 @@
 #include "viewer/compare_view.h"
 #include "viewer/inspect.h"
 #include "viewer/navigation.h"
+#include "viewer/outliner.h"
 #include "viewer/scene_edit.h"
 #include "render/outputs.h"
 #include "render/render_scene.h"
@@ -1019,4 +1020,87 @@ TEST_F(ViewerWindow, StatusFileThatCannotBeWrittenFailsTheRun) {
                                true);
     EXPECT_EQ(v.status, 1) << v.err;
     EXPECT_NE(v.err.find("--status-file"), std::string::npos) << v.err;
+}
+
+// Issue 47 C, in a real window with real input: the outliner's rows and a click on the image
+// are one selection; one click on a colour recolours the selected sphere alone (a new
+// material of its own, saved with Ctrl+S); "." frames the selection and Ctrl+Z undoes it;
+// numpad 7 and 1 give the top and front views about the target; a point light's row selects
+// the light, which "." (numpad-.) frames; the tabs switch.
+TEST_F(ViewerWindow, OutlinerSelectsFramesAndRecolours) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path copy = dir / "scene3.json";
+    fs::copy_file(scene(3), copy);
+    auto r = drive(dir, "outliner", 3, copy);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    const kr::viewer::ViewerModel m = kr::test::brief_model(3);
+    const kr::Scene& s = m.scene();
+    EXPECT_EQ(r["tab_first"], "object");
+    ASSERT_NE(r["selected_on_image"], "none");
+    const int sphere = std::stoi(r["selected_on_image"]);
+    EXPECT_EQ(s.primitives[size_t(sphere)].id, "sphere 01");
+    EXPECT_EQ(r["selected_by_row"], "0");
+    EXPECT_EQ(r["selected_by_row_again"], r["selected_on_image"]);
+    EXPECT_EQ(r["filtered"], "2");  // "SPHERE 0": sphere 01 and sphere 02
+    EXPECT_EQ(r["unfiltered"], "1");
+    auto vec = [](const std::string& text) {
+        kr::Vec3 v;
+        EXPECT_EQ(std::sscanf(text.c_str(), "%lf,%lf,%lf", &v.x, &v.y, &v.z), 3) << text;
+        return v;
+    };
+    const kr::Camera& cam = m.camera();
+    EXPECT_EQ(vec(r["camera_first"]), cam.position);
+    // Framed: looking at sphere 01's centre along the same direction, kFrameFill of the half fov.
+    const kr::Shape& ball = s.shapes[size_t(s.primitives[size_t(sphere)].shape)];
+    const kr::Camera want = kr::viewer::framed(cam, {ball.centre, ball.radius});
+    const kr::Vec3 framed = vec(r["camera_framed"]);
+    EXPECT_NEAR(kr::length(framed - want.position), 0, 1e-6);
+    EXPECT_EQ(vec(r["camera_undone"]), cam.position);
+    const double d = kr::length(cam.target - cam.position);
+    EXPECT_NEAR(kr::length(vec(r["camera_top"]) - (cam.target + kr::Vec3(0, d, 0))), 0, 1e-6);
+    EXPECT_EQ(vec(r["camera_front"]), cam.position);  // scene 3 looks along +z: its view is the front view
+    EXPECT_EQ(r["light_selected"], "0");
+    ASSERT_EQ(s.lights[0].type, kr::LightType::point);
+    // The selected point light's marker: orange pixels about its image point (inside the area
+    // light's white disc, where the render has none), none there before.
+    ImagePlacement placed;
+    ASSERT_TRUE(image_placement(r["image_light"], placed));
+    const auto point = kr::viewer::project_sphere(m.prepared()->camera, s.lights[0].position, 0);
+    ASSERT_TRUE(point);
+    const int px = int(placed.left + point->fx * s.renderer.width * placed.scale);
+    const int py = int(placed.top + point->fy * s.renderer.height * placed.scale);
+    auto orange_near = [&](const fs::path& file) {
+        const kr::Rgb8Image shot = kr::read_ppm(file);
+        int n = 0;
+        for (int y = py - 16; y <= py + 16; ++y)
+            for (int x = px - 16; x <= px + 16; ++x) {
+                const unsigned char* c = &shot.bytes[(size_t(y) * shot.width + size_t(x)) * 3];
+                n += c[0] > 200 && c[1] > 110 && c[1] < 210 && c[2] < 80;
+            }
+        return n;
+    };
+    EXPECT_EQ(orange_near(dir / "light_before.ppm"), 0);
+    EXPECT_GT(orange_near(dir / "light_selected.ppm"), 30);
+    // The point light framed: the target on it, the distance kept.
+    const kr::Vec3 at_light = vec(r["camera_light"]);
+    EXPECT_NEAR(kr::length(at_light - s.lights[0].position), d, 1e-6);
+    EXPECT_EQ(r["camera_row"], "1");
+    EXPECT_EQ(r["tab_last"], "camera");
+    ASSERT_EQ(r["saved"], "1");
+    // The saved file: the second camera active (its row); the first where "." left it on the
+    // point light; sphere 01 (glass) tinted red; every other object as it was.
+    const kr::Scene saved = kr::load_scene_file(copy).scene;
+    EXPECT_EQ(saved.camera, 1);
+    EXPECT_EQ(saved.cameras[0].position, at_light);
+    ASSERT_EQ(saved.primitives.size(), s.primitives.size());
+    const kr::Material& red = saved.materials[size_t(saved.primitives[size_t(sphere)].material)];
+    ASSERT_EQ(red.type, kr::MaterialType::dielectric);
+    EXPECT_EQ(red.rho_t, kr::viewer::kPalette[2].rho);  // a dielectric's tint: what it transmits
+    for (size_t p = 0; p < s.primitives.size(); ++p) {
+        if (int(p) == sphere) continue;
+        const kr::Material& was = s.materials[size_t(s.primitives[p].material)];
+        const kr::Material& now = saved.materials[size_t(saved.primitives[p].material)];
+        EXPECT_EQ(now.id, was.id) << s.primitives[p].id;
+        EXPECT_EQ(now.rho, was.rho) << s.primitives[p].id;
+    }
 }

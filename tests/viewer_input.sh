@@ -581,6 +581,118 @@ modifier_backlog)
     echo "image_after_wheel=$(field image)"
     echo "dirty_after_wheel=$(field dirty)"
     ;;
+outliner)
+    # Issue 47 C: the outliner and the image select the same thing; one click on a colour
+    # recolours the selected sphere; "." frames the selection and numpad 7 gives the top view
+    # (camera edits: Ctrl+Z undoes them); a point light's row selects the light; the tabs.
+    # Widgets are clicked where the status line's at= says they are (window points).
+    at_of() { field at | tr ';' '\n' | sed -nE "s/^$1:([0-9-]+),([0-9-]+)$/\1 \2/p" | head -1; }
+    click_at() {  # click_at NAME: click the widget NAME, after the pointer is seen there
+        local xy
+        wait_for "at=.*$1:" || return 1  # drawn (a tab just brought to the front draws a frame later)
+        xy=$(at_of "$1")
+        [[ -n $xy ]] || { echo "error=no widget $1 in at=$(field at)"; return 1; }
+        read -r cx cy <<<"$xy"
+        xdotool mousemove --window "$wid" "$cx" "$cy"
+        wait_for "pointer=$cx,$cy" || return 1
+        xdotool click 1
+    }
+    echo "tab_first=$(field tab)"
+    echo "camera_first=$(field camera)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/light_before.ppm" || { echo "error=no window shot"; exit 1; }
+    # A click on sphere 01 of scene 3 (image point 344, 410): selected, as select_edit.
+    img=$(field image)
+    read -r x y < <(echo "$img" | awk -F, '{s = $3; sub("fit", "", s); printf "%d %d\n", $1 + 344.5 * s, $2 + 410.5 * s}')
+    xdotool mousemove --window "$wid" $x $y
+    wait_for "pointer=$x,$y" || exit 1
+    xdotool click 1
+    wait_for 'selected=[0-9]+' || exit 1
+    sel=$(field selected)
+    echo "selected_on_image=$sel"
+    # Its outliner row is the selected one; the first object's row selects that object.
+    click_at "row:o0" || exit 1
+    wait_for 'selected=0 ' || exit 1
+    echo "selected_by_row=$(field selected)"
+    # Back to sphere 01 by its row; the Object tab shows its properties.
+    click_at "row:o$sel" || exit 1
+    wait_for "selected=$sel .*tab=object" || exit 1
+    echo "selected_by_row_again=$(field selected)"
+    # The filter (case-insensitive): "SPHERE 0" lists sphere 01 and 02 only; cleared, all again.
+    click_at "outliner:filter" || exit 1
+    xdotool type "SPHERE 0"
+    wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o6:[0-9-]+,[0-9-]+;row:o7:[0-9-]+,[0-9-]+;tab:scene" || exit 1
+    echo "filtered=$(field at | tr ';' '\n' | grep -c '^row:')"
+    xdotool key ctrl+a BackSpace Return
+    wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o0:" || exit 1
+    echo "unfiltered=1"
+    # One click on red: the sphere is recoloured (the scene is edited, the render restarts).
+    gen=$(field generation)
+    click_at "palette:red" || exit 1
+    wait_for 'dirty=1' || exit 1
+    wait_changed generation "$gen" || exit 1
+    echo "recoloured=1"
+    # "." frames the selection; Ctrl+Z puts the camera back.
+    cam=$(field camera)
+    xdotool mousemove --window "$wid" 250 330
+    wait_for 'pointer=250,330' || exit 1
+    xdotool key period
+    wait_changed camera "$cam" || exit 1
+    echo "camera_framed=$(field camera)"
+    xdotool key ctrl+z
+    wait_for "camera=$cam " || exit 1
+    echo "camera_undone=$(field camera)"
+    # Numpad 7: the top view about the target.
+    xdotool key KP_7
+    wait_changed camera "$cam" || exit 1
+    echo "camera_top=$(field camera)"
+    xdotool key KP_1
+    wait_for "camera=$cam " || exit 1  # the front view of scene 3 is its own view
+    echo "camera_front=$(field camera)"
+    # The point light's row: the light is the selection, no primitive; numpad-. frames it.
+    click_at "row:l0" || exit 1  # scene 3's point light
+    wait_for 'selected=none .*light=0 ' || exit 1
+    echo "light_selected=$(field light)"
+    cam=$(field camera)
+    xdotool mousemove --window "$wid" 250 330
+    wait_for 'pointer=250,330' || exit 1
+    echo "image_light=$(field image)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/light_selected.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool key KP_Decimal
+    wait_changed camera "$cam" || exit 1
+    echo "camera_light=$(field camera)"
+    # The second camera's row, below the list's fold: the wheel over the list scrolls it into
+    # view (the first row shown changes each turn), and its click makes that camera the active one.
+    xy=$(at_of "row:o0")
+    read -r ox oy <<<"$xy"
+    xdotool mousemove --window "$wid" "$ox" "$oy"
+    wait_for "pointer=$ox,$oy" || exit 1
+    for _ in 1 2 3 4 5 6 7 8 9 10; do
+        [[ -n $(at_of "row:c1") ]] && break
+        first=$(field at | tr ';' '\n' | grep -m1 '^row:')
+        xdotool click 5
+        end=$((SECONDS + limit))
+        while [[ $(field at | tr ';' '\n' | grep -m1 '^row:') == "$first" ]] && ((SECONDS < end)); do sleep 0.1; done
+    done
+    gen=$(field generation)
+    click_at "row:c1" || exit 1
+    wait_changed generation "$gen" || exit 1
+    wait_for 'tab=camera' || exit 1  # its properties' tab
+    echo "camera_row=1"
+    # The tabs.
+    click_at "tab:render" || exit 1
+    wait_for 'tab=render' || exit 1
+    click_at "tab:compare" || exit 1
+    wait_for 'tab=compare' || exit 1
+    click_at "tab:camera" || exit 1
+    wait_for 'tab=camera' || exit 1
+    echo "tab_last=$(field tab)"
+    # Esc clears the light's selection (the window stays); Ctrl+S saves the copy.
+    xdotool key Escape
+    wait_for 'light=none' || exit 1
+    xdotool key ctrl+s
+    wait_for 'dirty=0' || exit 1
+    echo "saved=1"
+    ;;
 esac
 echo "generation_after=$(field generation)"
 echo "spp_after=$(field spp)"

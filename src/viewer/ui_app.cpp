@@ -348,7 +348,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
         std::snprintf(camera, sizeof camera, "%.9g,%.9g,%.9g", model_.camera().position.x, model_.camera().position.y,
                       model_.camera().position.z);
     char line[1000];
-    std::snprintf(line, sizeof line,
+    int n = std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
                   "view=%s split=%.3f image=%g,%g,%s%g probe=%s b=%s psnr=%s bar=%s fly=%d inside=%s selected=%s primitives=%zu region=%s "
                   "feature=%s draft=%s question=%s grab=%d camera=%s\n",
@@ -361,10 +361,22 @@ void ViewerApp::write_status_file(const RunStatus& status) {
                   ui_.status_fields.empty() ? "none" : ui_.status_fields.c_str(), int(ui_.nav.fly),
                   inside.c_str(), selected.c_str(), model_.has_scene() ? model_.scene().primitives.size() : size_t(0), region,
                   feature.c_str(), draft, open_question(), int(input_.grab.has_value()), camera);
-    if (line == status_line_ || status_file_failed_) return;
+    // tab: the panel's tab; light: a light selected in the outliner ("none"); at: named
+    // widgets' centres in window points, name:x,y;... (ui_widgets.h mark_item).
+    std::string full(line, size_t(std::clamp(n, 0, int(sizeof line) - 1)));
+    if (!full.empty() && full.back() == '\n') full.pop_back();
+    full += " tab=" + std::string(panel_tab_key(ui_.panel_tab)) + " light=" +
+            (ui_.selected_light && !sel ? std::to_string(*ui_.selected_light) : std::string("none")) + " at=";
+    for (const UiState::Mark& m : ui_.marks) {
+        std::string name = m.name;
+        std::replace(name.begin(), name.end(), ' ', '_');
+        full += name + ":" + std::to_string(int(std::lround(m.x))) + "," + std::to_string(int(std::lround(m.y))) + ";";
+    }
+    full += "\n";
+    if (full == status_line_ || status_file_failed_) return;
     try {
-        write_file_atomic(*options_.status_file, line);
-        status_line_ = line;
+        write_file_atomic(*options_.status_file, full);
+        status_line_ = full;
     } catch (const std::exception& e) {
         // Said once; a script waiting on the file would wait in vain, so a scripted run ends.
         std::fprintf(stderr, "error: --status-file: %s\n", e.what());
@@ -374,6 +386,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
 }
 
 void ViewerApp::draw_panels() {
+    ui_.marks.clear();
     if (!ui_.panel_visible) return;
     const ImGuiIO& io = ImGui::GetIO();
     const float bar_h = float(ctx_.status_bar_height() / std::max(1.0f, io.DisplayFramebufferScale.y));

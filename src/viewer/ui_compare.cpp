@@ -264,6 +264,37 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
             draw->AddPolyline(points.data(), int(points.size()), IM_COL32(255, 160, 0, 255), ImDrawFlags_Closed, 2.0f);
         draw->PopClipRect();
     }
+    // A light selected as itself in the outliner (a point light): a marker where it is, as
+    // a light gizmo (drawn over whatever hides it), or its name where it is off the image.
+    if (const auto l = ctx.ui.selected_light;
+        l && !ctx.selection() && model.prepared() && size_t(*l) < model.scene().lights.size()) {
+        const Light& light = model.scene().lights[size_t(*l)];
+        const Vec3 at = light.type == LightType::point || light.shape < 0 ? light.position
+                                                                          : model.scene().shapes[size_t(light.shape)].centre;
+        const auto p = project_sphere(model.prepared()->camera, at, 0);
+        const PixelRect view = ctx.view_area();
+        const ImU32 orange = IM_COL32(255, 160, 0, 255);
+        if (p && p->fx >= 0 && p->fx <= 1 && p->fy >= 0 && p->fy <= 1) {
+            const ImVec2 c(float(rect.x + p->fx * rect.width) * to_points, float(rect.y + p->fy * rect.height) * to_points);
+            draw->AddCircle(c, 8, orange, 24, 2.0f);
+            for (const auto& [dx, dy] : {std::pair{1.0f, 0.0f}, {0.0f, 1.0f}}) {
+                draw->AddLine(ImVec2(c.x - 14 * dx, c.y - 14 * dy), ImVec2(c.x - 9 * dx, c.y - 9 * dy), orange, 2.0f);
+                draw->AddLine(ImVec2(c.x + 9 * dx, c.y + 9 * dy), ImVec2(c.x + 14 * dx, c.y + 14 * dy), orange, 2.0f);
+            }
+            const ImVec2 size = ImGui::CalcTextSize(light.id.c_str()), text_at(c.x + 12, c.y + 8);
+            draw->AddRectFilled(ImVec2(text_at.x - 2, text_at.y - 1), ImVec2(text_at.x + size.x + 2, text_at.y + size.y + 1),
+                                IM_COL32(0, 0, 0, 170));
+            draw->AddText(text_at, orange, light.id.c_str());
+        } else {
+            const std::string label = "selected: " + light.id + " (off the image)";
+            const ImVec2 size = ImGui::CalcTextSize(label.c_str());
+            const float right = float(std::min(rect.x + rect.width, view.x + view.width)) * to_points;
+            const ImVec2 text_at(right - size.x - 9, float(std::max(rect.y, view.y) + 6) * to_points);
+            draw->AddRectFilled(ImVec2(text_at.x - 3, text_at.y - 2), ImVec2(text_at.x + size.x + 3, text_at.y + size.y + 2),
+                                IM_COL32(0, 0, 0, 170));
+            draw->AddText(text_at, orange, label.c_str());
+        }
+    }
     // The render region (cyan), or the box being drawn (white).
     for (const auto& [box, colour] : {std::pair{ctx.ui.region, IM_COL32(0, 220, 255, 255)},
                                       std::pair{ctx.ui.region_draft, IM_COL32(255, 255, 255, 255)}})

@@ -90,7 +90,7 @@ void add_sphere_at_target(PanelContext& ctx) {
             free_sphere_place(s, cam.position, cam.target, std::max(1e-3, 0.05 * length(cam.target - cam.position)));
         added = add_sphere(s, at.centre, at.radius);
     }, "add sphere");
-    if (added >= 0) ctx.ui.selected = added;
+    if (added >= 0) ctx.ui.selected = added, ctx.ui.selected_light.reset();  // the new sphere is the selection
 }
 
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file) {
@@ -110,6 +110,7 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
         // The messages and the selection of the scene shown before belong to it.
         ctx.messages.clear();
         ctx.ui.selected.reset();
+        ctx.ui.selected_light.reset();
         if (file != files.watch.file()) {
             files.watch.watch(file);
             ctx.ui.save.read_only = scene_file_read_only(file, data_dir());

@@ -135,6 +135,18 @@ struct UiState {
     bool pick_focus = false;                 // the next click on the image focuses the lens
     NavigationSettings nav;                  // orbit or fly, speed, stop at surfaces
     std::optional<int> selected;             // the selected primitive (index in Scene::primitives)
+    std::optional<int> selected_light;       // else a light with no primitive of its own (a point light), from the outliner
+    int panel_tab = 1;                       // the panel's tab (ui_panels.h: PanelTab; Object first)
+    bool show_tab = true;                    // bring panel_tab to the front this frame (the first: Object)
+    int outliner_shown_line = -1;            // the outliner line last scrolled to (the selection's)
+    std::string outliner_filter;             // the outliner lists the rows that match it
+    // Named widgets' centres in window points, this frame (the status file's at=, for the
+    // window tests that click them).
+    struct Mark {
+        std::string name;
+        float x = 0, y = 0;
+    };
+    std::vector<Mark> marks;
     std::string status_fields;               // the status bar's fields shown ("state,spp,...": the status file's bar=)
     int axis_lock = -1;                      // moving the selection: along x, y or z only (-1: the view plane)
     // Where the selection is seen (sphere_coverage), for its tint where its outline is off

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "render/trace.h"
+#include "viewer/outliner.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
+#include "viewer/ui_panels.h"
 
 #include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
 #include <imgui.h>
@@ -203,10 +205,8 @@ void handle_mouse(PanelContext& ctx, InputState& in, const PixelRect& rect) {
     const bool over_image = inside(area) && inside(rect);
     // A left press and release that never became a drag is a click: it selects the sphere
     // under it, or clears the selection.
-    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && in.drags[0].pressed && !in.drags[0].dragging) {
-        ctx.ui.selected = in.press_pick;
-        ctx.ui.axis_lock = -1;
-    }
+    if (ImGui::IsMouseReleased(ImGuiMouseButton_Left) && in.drags[0].pressed && !in.drags[0].dragging)
+        select_primitive(ctx, in.press_pick);  // the outliner's selection too
     // Where the pointer is for button b: where it went up on the frame that sees its release.
     auto pointer_of = [&](int b) {
         return in.released_here[b] ? InputState::Point{in.released_here[b]->first * to_fb, in.released_here[b]->second * to_fb}
@@ -367,7 +367,7 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         if (key == GLFW_KEY_EQUAL || key == GLFW_KEY_KP_ADD) tool.view.zoom_steps(area, w, h, 1, px, py);
         else if (key == GLFW_KEY_MINUS || key == GLFW_KEY_KP_SUBTRACT) tool.view.zoom_steps(area, w, h, -1, px, py);
         else if (key == GLFW_KEY_0 || key == GLFW_KEY_KP_0) tool.view.fit();
-        else if (key == GLFW_KEY_1 || key == GLFW_KEY_KP_1) tool.view.one_to_one(area, w, h);
+        else if (key == GLFW_KEY_1) tool.view.one_to_one(area, w, h);  // (numpad 1: the front view)
         else if (key == GLFW_KEY_V) {
             auto& mode = tool.comparison.settings.mode;
             mode = ViewMode((int(mode) + 1) % int(view_mode_names.names.size()));
@@ -378,6 +378,45 @@ bool zoom_keys(PanelContext& ctx, InputState& in) {
         } else acted = false;
     }
     return acted;
+}
+
+// "." or numpad-.: frame the selection; numpad 1 / 3 / 7: the front, right and top views
+// (Ctrl: back, left, bottom), as Blender's. Camera edits, each one undo step.
+void view_keys(PanelContext& ctx, InputState& in) {
+    for (size_t i = 0; i < in.key_presses.size(); ++i) {
+        const int key = in.key_presses[i];
+        const bool ctrl = in.key_mods[i] & GLFW_MOD_CONTROL;
+        std::optional<AxisView> axis;
+        if (key == GLFW_KEY_KP_1) axis = ctrl ? AxisView::back : AxisView::front;
+        if (key == GLFW_KEY_KP_3) axis = ctrl ? AxisView::left : AxisView::right;
+        if (key == GLFW_KEY_KP_7) axis = ctrl ? AxisView::bottom : AxisView::top;
+        const bool frame = !ctrl && (key == GLFW_KEY_PERIOD || key == GLFW_KEY_KP_DECIMAL);
+        if (!axis && !frame) continue;
+        const Scene& scene = ctx.model.scene();
+        Camera cam = ctx.model.camera();
+        std::string what;
+        if (axis) {
+            cam = axis_view(cam, *axis);
+            what = std::string(axis_view_name(*axis)) + " view";
+        } else {
+            const auto sel = ctx.selection();
+            Selection what_is;  // the selected primitive, else a light selected in the outliner
+            what_is.primitive = sel;
+            if (!sel) what_is.light = ctx.ui.selected_light;
+            const auto ball = selection_ball(scene, what_is);
+            if (!ball) {
+                ctx.messages.show_status(". frames the selection: select an object (click it, or its outliner row) first");
+                continue;
+            }
+            cam = framed(cam, *ball);
+            what = "frame selected";
+        }
+        ctx.model.seal_undo_step();
+        const int active = scene.camera;
+        if (ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { s.cameras[size_t(active)] = cam; }, what))
+            ctx.messages.show_status(what + " (Ctrl+Z undoes it)");
+        ctx.model.seal_undo_step();
+    }
 }
 
 // The window's own keys, with or without a scene (a broken starting scene must not freeze
@@ -400,7 +439,8 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
             // drop-down or a question (its safe answer); then quits.
             if (in.grab) end_grab(ctx, in, false);
             else if (ui.help_visible) ui.help_visible = false;
-            else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && ui.selected) ui.selected.reset();
+            else if (ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId) == false && (ui.selected || ui.selected_light))
+                select_primitive(ctx, std::nullopt);
             else if (!ImGui::IsPopupOpen(nullptr, ImGuiPopupFlags_AnyPopupId)) requests.quit = true;
             else if (!ImGui::GetTopMostPopupModal()) ImGui::ClosePopupToLevel(0, true);  // a drop-down
             else requests.cancel_question = true;
@@ -476,6 +516,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
             ctx.edit(Edit::camera, [&](Scene& s, ViewerSettings&) { recall_bookmark(s, n); }, name);
         }
     }
+    view_keys(ctx, in);
     if (pressed(GLFW_KEY_HOME) || pressed(GLFW_KEY_R)) {
         model.seal_undo_step();
         model.reset_view();

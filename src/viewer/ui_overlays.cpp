@@ -19,7 +19,7 @@ namespace {
 constexpr const char* kHelpRows[][2] = {
     {"left drag", "orbit about the surface under the pointer (else the target), also from the selection; stops at surfaces"},
     {"left drag (fly mode)", "look around"},
-    {"click", "select the sphere under the pointer (Esc: none); shown outlined, or tinted"},
+    {"click", "select the sphere under the pointer (Esc: none); shown outlined, or tinted; also in the outliner"},
     {"M", "move the selection with the pointer: click or Return places it, Esc or right click puts it back"},
     {"M, then X / Y / Z", "move along world x, y or z only (again: the view plane)"},
     {"right drag", "pan"},
@@ -37,6 +37,8 @@ constexpr const char* kHelpRows[][2] = {
     {"W / S", "dolly in / out (fly mode: forward / back)"},
     {"A / D / Q / E", "pan left / right / down / up (fly mode: fly)"},
     {"Home or R", "reset the view to the file's camera (the lens stays)"},
+    {". or numpad-.", "frame the selection (an object or a light; Ctrl+Z undoes it)"},
+    {"numpad 1 / 3 / 7", "front / right / top view about the target (Ctrl: back / left / bottom)"},
     {"Ctrl+1..9 / Shift+1..9", "store the view as bookmark N (saved with the cameras) / go to it"},
     {"B, then a left drag / Shift+B", "render region: only its pixels refine / the whole image"},
     {"Ctrl+D / Delete", "duplicate / delete the selection"},

@@ -46,7 +46,7 @@ void panel_compare(PanelContext& ctx) {
     const bool asked = tool.open_panel;
     tool.open_panel = false;
     if (asked) ImGui::SetNextItemOpen(true);
-    if (!ImGui::CollapsingHeader("Inspect and compare")) return;
+    if (!ImGui::CollapsingHeader("Inspect and compare", ImGuiTreeNodeFlags_DefaultOpen)) return;  // its tab's one panel
     if (asked) ImGui::SetScrollHereY(0.0f);
     const int w = ctx.model.scene().renderer.width, h = ctx.model.scene().renderer.height;
     const PixelRect area = ctx.view_area();

@@ -1,10 +1,8 @@
 // The Lights panel: each active light's position and power; an area light's sphere.
-#include <algorithm>
 #include <string>
 
 #include <imgui.h>
 
-#include "core/text.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_panels.h"
 #include "viewer/ui_widgets.h"
@@ -20,15 +18,8 @@ void panel_lights(PanelContext& ctx) {
     for (int index = 0; index < int(scene.lights.size()); ++index) {
         const Light light = scene.lights[size_t(index)];  // a copy: an edit replaces the scene
         ImGui::PushID(index);
-        bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
-        const std::string label = light_label(light);
-        if (ImGui::Checkbox(label.c_str(), &on) &&
-            ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { set_light_on(s, index, on); }, "light on/off")) {
-            const std::string unseen = on ? light_unseen_reason(ctx.model.scene(), index) : std::string();
-            ctx.messages.show_status("light " + show_user_text(light.id) + (on ? " on" : " off: it emits nothing") +
-                                     (unseen.empty() ? "" : "; it adds nothing to the picture: " + unseen));
-        }
-        const std::string unseen = on ? light_unseen_reason(scene, index) : std::string();
+        const bool on = light_checkbox(ctx, index);
+        const std::string unseen = on ? light_unseen_reason(ctx.model.scene(), index) : std::string();
         ImGui::SameLine();
         if (!unseen.empty()) {
             ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "not seen (?)");

@@ -83,7 +83,7 @@ void plot_convergence(PanelContext& ctx) {
 }  // namespace
 
 void panel_stats(PanelContext& ctx) {
-    if (!ImGui::CollapsingHeader("Stats")) return;
+    if (!ImGui::CollapsingHeader("Stats", ImGuiTreeNodeFlags_DefaultOpen)) return;
     // A fixed set of lines: what is live (spp, rate, noise) is in the status bar.
     const Scene& scene = ctx.model.scene();
     ImGui::Text("image %dx%d, UI %.0f frames/s (%.1f ms of work each)", scene.renderer.width, scene.renderer.height,

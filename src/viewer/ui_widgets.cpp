@@ -5,6 +5,7 @@
 
 #include <imgui_internal.h>  // TempInputIsActive: a drag field in its typed-text mode
 
+#include "core/text.h"
 #include "viewer/scene_edit.h"
 
 namespace kr::viewer {
@@ -84,6 +85,41 @@ bool power_fields(PanelContext& ctx, Color& power, float speed) {
     split |= field(ctx, "strength", &cs.strength, 1, speed, 0.0, kHuge);
     if (split) power = join_power(cs);
     return changed || split;
+}
+
+bool material_fields(PanelContext& ctx, Material& m) {
+    bool changed = combo("type", m.type, material_type_names);
+    // The type's parameters as the file has them (scene.h's material_params).
+    for (const MaterialParam& param : material_params(m.type)) {
+        const std::string label(param.name);
+        if (param.colour) {
+            // A picker, then the numbers as the file has them.
+            changed |= colour_picker(label.c_str(), m.*param.colour);
+            ImGui::SameLine();
+            changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
+        } else
+            changed |= field(ctx, label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo, param.edit_hi);
+    }
+    return changed;
+}
+
+bool light_checkbox(PanelContext& ctx, int index) {
+    const Scene& scene = ctx.model.scene();
+    const Light light = scene.lights[size_t(index)];  // a copy: an edit replaces the scene
+    bool on = std::find(scene.active_lights.begin(), scene.active_lights.end(), index) != scene.active_lights.end();
+    if (ImGui::Checkbox(light_label(light).c_str(), &on) &&
+        ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { set_light_on(s, index, on); }, "light on/off")) {
+        const std::string unseen = on ? light_unseen_reason(ctx.model.scene(), index) : std::string();
+        ctx.messages.show_status("light " + show_user_text(light.id) + (on ? " on" : " off: it emits nothing") +
+                                 (unseen.empty() ? "" : "; it adds nothing to the picture: " + unseen));
+    }
+    const auto& active = ctx.model.scene().active_lights;
+    return std::find(active.begin(), active.end(), index) != active.end();
+}
+
+void mark_item(PanelContext& ctx, std::string name) {
+    const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+    ctx.ui.marks.push_back({std::move(name), 0.5f * (a.x + b.x), 0.5f * (a.y + b.y)});
 }
 
 }  // namespace kr::viewer

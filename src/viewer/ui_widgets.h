@@ -1,5 +1,5 @@
 // The panels' widgets: number fields that apply a drag live and a typed value on Enter or
-// focus loss (after check_typed_value), and combos over an enum's name table.
+// focus loss (after check_typed_value), combos over an enum's name table, a material's fields.
 #pragma once
 
 #include <cstddef>
@@ -27,6 +27,20 @@ bool colour_picker(const char* label, Color& c);
 // A light's power as the file has it ("power"), and the same split as a colour (a picker,
 // its largest component 1) times a "strength" (split_power): editing either sets the power.
 bool power_fields(PanelContext& ctx, Color& power, float speed = 0.1f);
+
+// A material's type and its parameters as the file has them (scene.h's material_params):
+// colour parameters as a picker and three numbers. True when `m` was changed. The Materials
+// panel and the Selection panel both edit materials through it.
+bool material_fields(PanelContext& ctx, Material& m);
+
+// Light `index`'s on/off checkbox, labelled with light_label: checking it switches the light
+// on or off (set_light_on, one undoable edit) and says so in the status line, with why a light
+// switched on adds nothing to the picture (light_unseen_reason). Returns whether it is on now.
+bool light_checkbox(PanelContext& ctx, int index);
+
+// Records the last item's centre under `name` for this frame (UiState::marks: the status
+// file's at=, which the window tests click).
+void mark_item(PanelContext& ctx, std::string name);
 
 template <typename Enum, size_t N>
 bool combo(const char* label, Enum& value, const EnumNames<Enum, N>& names) {
