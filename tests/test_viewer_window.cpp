@@ -1073,8 +1073,8 @@ TEST_F(ViewerWindow, OpenAndSaveAsBrowseFoldersAndKeepRecentFiles) {
     keep_shot(dir, "browser.ppm");
 }
 
-// A drop (--drop: the drop callback's path, as a real XDND drop cannot be made under Xvfb by
-// xdotool): the image became image B, the text file was refused with an error, the bundled
+// A drop by --drop (the drop callback's path; FilesDroppedThroughXdnd... drops for real):
+// the image became image B, the text file was refused with an error, the bundled
 // example (a link to it) opened read-only: Ctrl+S asks where.
 TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
@@ -1091,6 +1091,25 @@ TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) 
     EXPECT_EQ(r["opened"], "example.json");
     EXPECT_EQ(r["asked"], "save-where");
     keep_shot(dir, "drop.ppm");
+}
+
+// A real drop: the X drag-and-drop protocol (XDND) as a file manager speaks it
+// (tests/x_drop.py), GLFW's drop callback, the same actions: the image is image B, the
+// text file refused with an error, the example then opens (image B, chosen by the user, stays).
+TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
+    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
+    const auto examples = kr::example_scenes();
+    ASSERT_FALSE(examples.empty());
+    fs::create_symlink(examples.front(), dir / "example.json");
+    auto r = drive(dir, "xdnd_drop", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["b"], "reference");
+    EXPECT_EQ(r["error_shown"], "1");
+    EXPECT_EQ(r["opened"], "example.json");
+    EXPECT_EQ(r["b_after"], "reference");
 }
 
 // tev's exposure keys: E / Shift+E by half a stop, each one undo step; fly mode's E flies

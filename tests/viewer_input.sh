@@ -22,7 +22,9 @@ export XDG_CONFIG_HOME="$dir/config" KEITHRAY_FILE_CHOOSER=builtin
 [[ $scenario == ui_scale ]] && xprop -root -f RESOURCE_MANAGER 8s -set RESOURCE_MANAGER "Xft.dpi:	144"
 "$keithray" view "$scene" --spp 2 "${start_edits[@]}" --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
 pid=$!
-trap 'kill $pid 2>/dev/null' EXIT
+# On the way out the viewer is ended and waited for: the test then removes the work folder,
+# which a viewer still writing its status file would race.
+trap 'kill $pid 2>/dev/null; wait $pid 2>/dev/null' EXIT
 
 # wait_for REGEX: until the status line matches (or the viewer exits, or the limit passes).
 wait_for() {
@@ -662,6 +664,18 @@ exposure_keys)
     wait_changed camera "$camera" || exit 1
     xdotool keyup Page_Up
     echo "page_up_exposure=$(field exposure)"
+    ;;
+xdnd_drop)
+    # Issue 47 C: files dropped on the window as a file manager drops them (XDND, x_drop.py):
+    # the image and a text file, then the bundled example (a link to it).
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/mine/ref.ppm" "$dir/mine/notes.txt" || { echo "error=drop failed"; exit 1; }
+    wait_for 'b=reference .*error=1' || exit 1
+    echo "b=$(field b)"
+    echo "error_shown=$(field error)"
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/example.json" || { echo "error=drop failed"; exit 1; }
+    wait_for 'file=example.json ' || exit 1
+    echo "opened=$(field file)"
+    echo "b_after=$(field b)"
     ;;
 ui_scale)
     # Issue 47 C: the UI follows the monitor's content scale (1.5 here) times the UI scale
