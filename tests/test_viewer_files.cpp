@@ -256,7 +256,7 @@ TEST_F(ViewerFiles, PlatformChooserRunsAsAChildAndItsAnswerIsTheFile) {
     EXPECT_NE(std::find(args.begin(), args.end(), "--file-filter=Scenes | *.json"), args.end());
     const auto open_args = zenity_arguments(FilePurpose::open_image, dir, "");
     EXPECT_EQ(std::find(open_args.begin(), open_args.end(), "--save"), open_args.end());
-    EXPECT_NE(std::find(open_args.begin(), open_args.end(), "--filename=" + (dir / "").string() + "/"), open_args.end());
+    EXPECT_NE(std::find(open_args.begin(), open_args.end(), "--filename=" + dir.string() + "/"), open_args.end());
 
     // A stand-in zenity: answers what its first argument's file says, exits with the second's status.
     fs::create_directories(dir / "bin");

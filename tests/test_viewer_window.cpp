@@ -1112,6 +1112,31 @@ TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
     EXPECT_EQ(r["b_after"], "reference");
 }
 
+// The platform's chooser in the window: a stand-in zenity on PATH (KEITHRAY_FILE_CHOOSER=zenity)
+// that waits for the test's word, then answers a file. Ctrl+O starts it with the scene's
+// folder and the scenes' filter; the window stays live while it runs; its answer opens.
+TEST_F(ViewerWindow, OpenRunsThePlatformsChooserAndKeepsTheWindowLive) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    own_scene(dir, "mine/sub/b.json");
+    fs::create_directories(dir / "bin");
+    {
+        std::ofstream zenity(dir / "bin" / "zenity");
+        zenity << "#!/bin/sh\nprintf '%s\\n' \"$@\" > '" << (dir / "zenity.args").string() << "'\n"
+               << "while [ ! -e '" << (dir / "go").string() << "' ]; do sleep 0.05; done\n"
+               << "echo '" << (dir / "mine" / "sub" / "b.json").string() << "'\n";
+    }
+    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    auto r = drive(dir, "chooser", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["live_while_choosing"], "1");
+    EXPECT_EQ(r["opened"], "b.json");
+    const std::string args = kr::test::read_file(dir / "zenity.args");
+    EXPECT_NE(args.find("--file-selection\n"), std::string::npos) << args;
+    EXPECT_NE(args.find("--filename=" + (dir / "mine").string() + "/\n"), std::string::npos) << args;
+    EXPECT_NE(args.find("--file-filter=Scenes | *.json"), std::string::npos) << args;
+}
+
 // tev's exposure keys: E / Shift+E by half a stop, each one undo step; fly mode's E flies
 // up and leaves the exposure; Page Up pans out of fly mode.
 TEST_F(ViewerWindow, ExposureKeysStepUndoAndLeaveFlyModesE) {

@@ -17,6 +17,8 @@ start_edits=()
 # The viewer's settings file (recent files, UI scale) in the work folder, never the user's;
 # the built-in file browser, whatever is installed (issue 47 C).
 export XDG_CONFIG_HOME="$dir/config" KEITHRAY_FILE_CHOOSER=builtin
+# The platform's chooser: a stand-in zenity on PATH (tests write it), asked for by name.
+[[ $scenario == chooser ]] && export KEITHRAY_FILE_CHOOSER=zenity PATH="$dir/bin:$PATH"
 [[ $scenario == drop ]] && start_edits=(--drop "$dir/mine/ref.ppm" --drop "$dir/mine/notes.txt" --drop "$dir/example.json")
 # A monitor at 144 dpi: GLFW reports a content scale of 1.5 (Xft.dpi, as desktops set it).
 [[ $scenario == ui_scale ]] && xprop -root -f RESOURCE_MANAGER 8s -set RESOURCE_MANAGER "Xft.dpi:	144"
@@ -664,6 +666,18 @@ exposure_keys)
     wait_changed camera "$camera" || exit 1
     xdotool keyup Page_Up
     echo "page_up_exposure=$(field exposure)"
+    ;;
+chooser)
+    # Issue 47 C: Ctrl+O runs the chooser as a child; the window keeps drawing while it is
+    # open (a pointer move is seen), and its answer opens the scene.
+    xdotool key ctrl+o
+    wait_for 'dialog=chooser' || exit 1
+    xdotool mousemove --window "$wid" 252 330
+    wait_for 'pointer=252,330 .*dialog=chooser' || exit 1
+    echo "live_while_choosing=1"
+    touch "$dir/go"  # the stand-in answers
+    wait_for 'file=b.json .*dialog=none' || exit 1
+    echo "opened=$(field file)"
     ;;
 xdnd_drop)
     # Issue 47 C: files dropped on the window as a file manager drops them (XDND, x_drop.py):

@@ -353,7 +353,9 @@ std::vector<std::string> zenity_arguments(FilePurpose purpose, const fs::path& f
     std::vector<std::string> args{"zenity", "--file-selection", std::string("--title=keithray: ") + purpose_title(purpose)};
     if (purpose_saves(purpose)) args.push_back("--save");
     // zenity opens the folder of --filename; a trailing slash names the folder itself.
-    args.push_back("--filename=" + (folder / name).string() + (name.empty() ? "/" : ""));
+    std::string start = name.empty() ? folder.string() : (folder / name).string();
+    if (name.empty() && (start.empty() || start.back() != '/')) start += '/';
+    args.push_back("--filename=" + start);
     std::string patterns;
     if (is_scene_purpose(purpose)) patterns = "*.json";
     else
