@@ -4,6 +4,8 @@
 // platform's chooser run as a child process (a stand-in zenity script on PATH).
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -224,6 +226,11 @@ TEST_F(ViewerFiles, ADropOpensOneSceneAndOneImageAndRefusesTheRestByName) {
     EXPECT_NE(actions[4].error.find("a folder"), std::string::npos);
     EXPECT_EQ(actions[5].kind, DropAction::refused);  // a second image
     for (const DropAction& a : actions) EXPECT_EQ(a.error.find('\n'), std::string::npos);
+    // A file that is not there, and one that is not a regular file (a FIFO would block).
+    ASSERT_EQ(::mkfifo((dir / "pipe.json").c_str(), 0600), 0);
+    const auto odd = plan_drop({dir / "gone.png", dir / "pipe.json"});
+    EXPECT_NE(odd[0].error.find("gone.png\": no such file"), std::string::npos) << odd[0].error;
+    EXPECT_NE(odd[1].error.find("pipe.json\": not a regular file"), std::string::npos) << odd[1].error;
 }
 
 // A bundled example opened by any path (browser, recent, drop) is read-only to Save: Save

@@ -1095,7 +1095,8 @@ TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) 
 
 // A real drop: the X drag-and-drop protocol (XDND) as a file manager speaks it
 // (tests/x_drop.py), GLFW's drop callback, the same actions: the image is image B, the
-// text file refused with an error, the example then opens (image B, chosen by the user, stays).
+// text file refused with an error, the example then opens (image B, chosen by the user,
+// stays); with unsaved edits a dropped scene asks first.
 TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
     const fs::path scene = own_scene(dir, "mine/a.json");
@@ -1110,6 +1111,10 @@ TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
     EXPECT_EQ(r["error_shown"], "1");
     EXPECT_EQ(r["opened"], "example.json");
     EXPECT_EQ(r["b_after"], "reference");
+    // With unsaved edits, a dropped scene asks first; Esc keeps the scene and the edits.
+    EXPECT_EQ(r["asked"], "discard");
+    EXPECT_EQ(r["kept"], "example.json");
+    EXPECT_EQ(r["dirty_kept"], "1");
 }
 
 // The platform's chooser in the window: a stand-in zenity on PATH (KEITHRAY_FILE_CHOOSER=zenity)

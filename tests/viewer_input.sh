@@ -690,6 +690,17 @@ xdnd_drop)
     wait_for 'file=example.json ' || exit 1
     echo "opened=$(field file)"
     echo "b_after=$(field b)"
+    # With unsaved edits a dropped scene asks first (the discard question); Esc keeps them.
+    xdotool keydown Right
+    wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/mine/a.json" || { echo "error=drop failed"; exit 1; }
+    wait_for 'question=discard' || exit 1
+    echo "asked=discard"
+    xdotool key Escape
+    wait_for 'question=none' || exit 1
+    echo "kept=$(field file)"
+    echo "dirty_kept=$(field dirty)"
     ;;
 ui_scale)
     # Issue 47 C: the UI follows the monitor's content scale (1.5 here) times the UI scale

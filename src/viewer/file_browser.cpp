@@ -307,6 +307,11 @@ std::vector<DropAction> plan_drop(const std::vector<fs::path>& files) {
         const std::string name = quoted_path(f);
         if (fs::is_directory(f, ec)) {
             a.error = name + ": a folder; drop a scene (*.json) or an image";
+        } else if (!fs::exists(f, ec)) {
+            a.error = name + ": no such file";
+        } else if (!fs::is_regular_file(f, ec)) {
+            // A FIFO or a device would block the window's thread on its first read.
+            a.error = name + ": not a regular file; nothing opened";
         } else if (matches_filter(f, FilePurpose::open_scene)) {
             if (scene) a.error = name + ": one scene opens at a time; not opened";
             else a.kind = DropAction::scene, scene = true;

@@ -112,7 +112,8 @@ void write_settings_file(const std::filesystem::path& file, const ViewerSettings
 
 // What a file dropped on the window does: a scene (*.json) opens as from Open (asking first
 // with unsaved edits), an image becomes image B as the reference; anything else is refused
-// with a one-line error naming the file.
+// with a one-line error naming the file (so are a folder, a missing file and one that is
+// not a regular file: a FIFO would block the window on its first read).
 struct DropAction {
     enum Kind { scene, image, refused };
     Kind kind = refused;

@@ -5,6 +5,7 @@
 #include <system_error>
 
 #include <imgui.h>
+#include <imgui_internal.h>  // GetTopMostPopupModal: never a dialog over an open question
 #include <imgui_stdlib.h>
 
 #include "core/file_write.h"
@@ -84,7 +85,8 @@ void set_ui_scale(PanelContext& ctx, double scale) {
 
 void open_file_dialog(PanelContext& ctx, FilePurpose purpose) {
     SceneFiles& files = ctx.ui.files;
-    if (files.browser || (files.chooser && files.chooser->running())) return;  // one at a time
+    // One at a time, and never over a question (opening it would close the question unanswered).
+    if (files.browser || (files.chooser && files.chooser->running()) || ImGui::GetTopMostPopupModal()) return;
     const auto [folder, name] = dialog_start(ctx, purpose);
     if (const std::string chooser = native_chooser(); !chooser.empty()) {
         files.chooser = std::make_shared<ChildChooser>();
@@ -140,7 +142,9 @@ bool poll_file_chooser(PanelContext& ctx) {
 
 void handle_drops(PanelContext& ctx) {
     SceneFiles& files = ctx.ui.files;
-    if (files.drops.empty()) return;
+    // While a question or a dialog is open the drop waits for its answer (opening another
+    // question now would close it unanswered).
+    if (files.drops.empty() || ImGui::GetTopMostPopupModal() || files.browser) return;
     const std::vector<fs::path> dropped = std::move(files.drops);
     files.drops.clear();
     std::string refused;

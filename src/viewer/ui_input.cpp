@@ -543,7 +543,7 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         in.key_orbit.reset();
         return;
     }
-    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
+    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D and Page Up/Down pan.
     // A chord's key stays no camera key until it is released (Ctrl let go before the S).
     auto held = [&](int key) { return int(ImGui::IsKeyDown(key) && !in.held_in_chord(key)); };
     KeyMotion keys;
