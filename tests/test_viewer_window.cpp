@@ -32,6 +32,7 @@
 #include "render/render_scene.h"
 #include "render/render_state.h"
 #include "scene/load.h"
+#include "scene/scene_list.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -1103,4 +1104,167 @@ TEST_F(ViewerWindow, OutlinerSelectsFramesAndRecolours) {
         EXPECT_EQ(now.id, was.id) << s.primitives[p].id;
         EXPECT_EQ(now.rho, was.rho) << s.primitives[p].id;
     }
+}
+
+// ---- Issue 47 C: files as users expect, and scale ----
+
+namespace {
+
+// Scene 3 as a user's own file (not under scenes/: no automatic reference), at `rel` in dir.
+fs::path own_scene(const fs::path& dir, const fs::path& rel) {
+    fs::create_directories((dir / rel).parent_path());
+    fs::copy_file(kr::test::brief_scene_file(3), dir / rel, fs::copy_options::overwrite_existing);
+    return dir / rel;
+}
+
+void keep_shot(const fs::path& dir, const char* name) {
+    if (const char* keep = std::getenv("KEITHRAY_KEEP_SHOTS"))
+        fs::copy_file(dir / name, fs::path(keep) / name, fs::copy_options::overwrite_existing);
+}
+
+}  // namespace
+
+// Ctrl+O: the folder browser (KEITHRAY_FILE_CHOOSER=builtin), driven by the keyboard: a
+// folder's name enters it, a file's name opens it and it joins the recent files (the bad
+// settings file met at the start is said, then replaced by a good one); Ctrl+Shift+S saves as
+// into another folder, the file becoming the scene's; Esc closes the dialog, not the viewer.
+// The settings file is in the test's folder ($XDG_CONFIG_HOME), never the user's.
+TEST_F(ViewerWindow, OpenAndSaveAsBrowseFoldersAndKeepRecentFiles) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    own_scene(dir, "mine/sub/b.json");
+    const fs::path settings = dir / "config" / "keithray" / "viewer.json";
+    fs::create_directories(settings.parent_path());
+    std::ofstream(settings) << "{not json";
+    auto r = drive(dir, "open_dialog", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["error_start"], "1");  // the bad settings file, said
+    EXPECT_EQ(r["folder_start"], fs::weakly_canonical(dir / "mine").string());
+    EXPECT_EQ(r["folder_sub"], fs::weakly_canonical(dir / "mine" / "sub").string());
+    EXPECT_EQ(r["opened"], "b.json");
+    EXPECT_EQ(r["saved_as"], "saved.json");
+    EXPECT_EQ(r["dirty_after_save"], "0");
+    EXPECT_EQ(r["running_after_esc"], "1");
+    ASSERT_TRUE(fs::exists(dir / "mine" / "saved.json"));
+    EXPECT_NO_THROW(kr::load_scene_file(dir / "mine" / "saved.json"));
+    // The recent scenes, newest first: saved.json, b.json, a.json (the one started with).
+    const auto kept = nlohmann::json::parse(kr::test::read_file(settings));
+    ASSERT_TRUE(kept["recent_scenes"].is_array());
+    ASSERT_GE(kept["recent_scenes"].size(), 3u);
+    EXPECT_EQ(fs::path(kept["recent_scenes"][0].get<std::string>()).filename(), "saved.json");
+    EXPECT_EQ(fs::path(kept["recent_scenes"][1].get<std::string>()).filename(), "b.json");
+    EXPECT_EQ(fs::path(kept["recent_scenes"][2].get<std::string>()).filename(), "a.json");
+    keep_shot(dir, "browser.ppm");
+}
+
+// A drop by --drop (the drop callback's path; FilesDroppedThroughXdnd... drops for real):
+// the image became image B, the text file was refused with an error, the bundled
+// example (a link to it) opened read-only: Ctrl+S asks where.
+TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
+    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
+    const auto examples = kr::example_scenes();
+    ASSERT_FALSE(examples.empty());
+    fs::create_symlink(examples.front(), dir / "example.json");
+    auto r = drive(dir, "drop", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["b"], "reference");
+    EXPECT_EQ(r["error_shown"], "1");
+    EXPECT_EQ(r["opened"], "example.json");
+    EXPECT_EQ(r["asked"], "save-where");
+    keep_shot(dir, "drop.ppm");
+}
+
+// A real drop: the X drag-and-drop protocol (XDND) as a file manager speaks it
+// (tests/x_drop.py), GLFW's drop callback, the same actions: the image is image B, the
+// text file refused with an error, the example then opens (image B, chosen by the user,
+// stays); with unsaved edits a dropped scene asks first.
+TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
+    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
+    const auto examples = kr::example_scenes();
+    ASSERT_FALSE(examples.empty());
+    fs::create_symlink(examples.front(), dir / "example.json");
+    auto r = drive(dir, "xdnd_drop", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["b"], "reference");
+    EXPECT_EQ(r["error_shown"], "1");
+    EXPECT_EQ(r["opened"], "example.json");
+    EXPECT_EQ(r["b_after"], "reference");
+    // With unsaved edits, a dropped scene asks first; Esc keeps the scene and the edits.
+    EXPECT_EQ(r["asked"], "discard");
+    EXPECT_EQ(r["kept"], "example.json");
+    EXPECT_EQ(r["dirty_kept"], "1");
+}
+
+// The platform's chooser in the window: a stand-in zenity on PATH (KEITHRAY_FILE_CHOOSER=zenity)
+// that waits for the test's word, then answers a file. Ctrl+O starts it with the scene's
+// folder and the scenes' filter; the window stays live while it runs; its answer opens.
+TEST_F(ViewerWindow, OpenRunsThePlatformsChooserAndKeepsTheWindowLive) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path scene = own_scene(dir, "mine/a.json");
+    own_scene(dir, "mine/sub/b.json");
+    fs::create_directories(dir / "bin");
+    {
+        std::ofstream zenity(dir / "bin" / "zenity");
+        zenity << "#!/bin/sh\nprintf '%s\\n' \"$@\" > '" << (dir / "zenity.args").string() << "'\n"
+               << "while [ ! -e '" << (dir / "go").string() << "' ]; do sleep 0.05; done\n"
+               << "echo '" << (dir / "mine" / "sub" / "b.json").string() << "'\n";
+    }
+    fs::permissions(dir / "bin" / "zenity", fs::perms::owner_all);
+    auto r = drive(dir, "chooser", 3, scene);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["live_while_choosing"], "1");
+    EXPECT_EQ(r["opened"], "b.json");
+    const std::string args = kr::test::read_file(dir / "zenity.args");
+    EXPECT_NE(args.find("--file-selection\n"), std::string::npos) << args;
+    EXPECT_NE(args.find("--filename=" + (dir / "mine").string() + "/\n"), std::string::npos) << args;
+    EXPECT_NE(args.find("--file-filter=Scenes | *.json"), std::string::npos) << args;
+}
+
+// tev's exposure keys: E / Shift+E by half a stop, each one undo step; fly mode's E flies
+// up and leaves the exposure; Page Up pans out of fly mode.
+TEST_F(ViewerWindow, ExposureKeysStepUndoAndLeaveFlyModesE) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    auto r = drive(dir, "exposure_keys", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["after_e"], "0.50");
+    EXPECT_EQ(r["after_shift_e"], "-0.50");
+    EXPECT_EQ(r["after_undo"], "0.00");
+    EXPECT_EQ(r["fly_exposure"], "0.00");
+    EXPECT_EQ(r["page_up_exposure"], "0.00");
+}
+
+// The UI at the monitor's content scale (Xft.dpi 144: 1.5) times the kept UI scale (1.5):
+// the window shots differ (bigger text and widgets); Ctrl+= raises the scale, Ctrl+0 sets
+// it back to 1, and the settings file keeps it.
+TEST_F(ViewerWindow, UiFollowsTheMonitorsScaleAndTheUiScaleSetting) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    const fs::path settings = dir / "config" / "keithray" / "viewer.json";
+    fs::create_directories(settings.parent_path());
+    std::ofstream(settings) << R"({"ui_scale": 1.5})";
+    auto r = drive(dir, "ui_scale", 3);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["content_scale"], "1.50");
+    EXPECT_EQ(r["ui_scale_start"], "1.50");
+    EXPECT_EQ(r["ui_scale_after"], "1.75");
+    const auto kept = nlohmann::json::parse(kr::test::read_file(settings));
+    EXPECT_EQ(kept["ui_scale"].get<double>(), 1.0);
+    const kr::ImageFile scaled = kr::read_image_file(dir / "scaled.ppm");
+    const kr::ImageFile unscaled = kr::read_image_file(dir / "unscaled.ppm");
+    ASSERT_EQ(scaled.rgb8.width, unscaled.rgb8.width);
+    // At 2.25 the status bar is taller than at 1.5: the view above it is shorter, and the
+    // image fitted in it (as wide: the panel takes its largest share, half the window,
+    // at both) sits higher.
+    ImagePlacement big_ui, small_ui;
+    ASSERT_TRUE(image_placement(r["image_scaled"], big_ui));
+    ASSERT_TRUE(image_placement(r["image_unscaled"], small_ui));
+    EXPECT_LT(big_ui.top, small_ui.top);
+    EXPECT_NE(max_channel_difference(scaled.rgb8, unscaled.rgb8), 0);
+    keep_shot(dir, "scaled.ppm");
+    keep_shot(dir, "unscaled.ppm");
 }

@@ -14,9 +14,19 @@ limit=${VIEWER_INPUT_LIMIT:-240}  # seconds for any one condition, on a loaded m
 # The command line's edits apply in an interactive run too (start_edits).
 start_edits=()
 [[ $scenario == start_edits ]] && start_edits=(--select 344,410 --region 100,120 300,260)
+# The viewer's settings file (recent files, UI scale) in the work folder, never the user's;
+# the built-in file browser, whatever is installed (issue 47 C).
+export XDG_CONFIG_HOME="$dir/config" KEITHRAY_FILE_CHOOSER=builtin
+# The platform's chooser: a stand-in zenity on PATH (tests write it), asked for by name.
+[[ $scenario == chooser ]] && export KEITHRAY_FILE_CHOOSER=zenity PATH="$dir/bin:$PATH"
+[[ $scenario == drop ]] && start_edits=(--drop "$dir/mine/ref.ppm" --drop "$dir/mine/notes.txt" --drop "$dir/example.json")
+# A monitor at 144 dpi: GLFW reports a content scale of 1.5 (Xft.dpi, as desktops set it).
+[[ $scenario == ui_scale ]] && xprop -root -f RESOURCE_MANAGER 8s -set RESOURCE_MANAGER "Xft.dpi:	144"
 "$keithray" view "$scene" --spp 2 "${start_edits[@]}" --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
 pid=$!
-trap 'kill $pid 2>/dev/null' EXIT
+# On the way out the viewer is ended and waited for: the test then removes the work folder,
+# which a viewer still writing its status file would race.
+trap 'kill $pid 2>/dev/null; wait $pid 2>/dev/null' EXIT
 
 # wait_for REGEX: until the status line matches (or the viewer exits, or the limit passes).
 wait_for() {
@@ -692,6 +702,134 @@ outliner)
     xdotool key ctrl+s
     wait_for 'dirty=0' || exit 1
     echo "saved=1"
+    ;;
+open_dialog)
+    # Issue 47 C: Ctrl+O opens the folder browser (dialog= once it has the keyboard); a
+    # folder's name and Return enter it, a file's name and Return open it, and it is
+    # kept in the recent files. Ctrl+Shift+S saves as: "../saved" is saved.json in the folder
+    # above, which becomes the scene's. Esc closes a dialog and nothing else.
+    echo "error_start=$(field error)"
+    xdotool key ctrl+o
+    wait_for 'dialog=open-scene' || exit 1
+    echo "folder_start=$(field folder)"
+    xdotool type sub
+    xdotool key Return
+    wait_for 'folder=[^ ]*/sub ' || exit 1
+    echo "folder_sub=$(field folder)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/browser.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool type b.json
+    xdotool key Return
+    wait_for 'file=b.json .*dialog=none' || exit 1
+    echo "opened=$(field file)"
+    echo "recent=$(field recent)"
+    xdotool key ctrl+shift+s
+    wait_for 'dialog=save-scene' || exit 1
+    xdotool key ctrl+a
+    xdotool type ../saved
+    xdotool key Return
+    wait_for 'file=saved.json .*dialog=none' || exit 1
+    echo "saved_as=$(field file)"
+    echo "dirty_after_save=$(field dirty)"
+    xdotool key ctrl+o
+    wait_for 'dialog=open-scene' || exit 1
+    xdotool key Escape
+    wait_for 'dialog=none' || exit 1
+    kill -0 $pid 2>/dev/null && echo "running_after_esc=1"
+    ;;
+drop)
+    # Issue 47 C: --drop takes the path a file dropped on the window takes: the image became
+    # image B (the reference), the text file is refused with an error, the bundled example
+    # opened, read-only: Ctrl+S asks where.
+    echo "b=$(field b)"
+    echo "error_shown=$(field error)"
+    echo "opened=$(field file)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/drop.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool key ctrl+s
+    wait_for 'question=save-where' || exit 1
+    echo "asked=save-where"
+    xdotool key Escape
+    wait_for 'question=none' || exit 1
+    ;;
+exposure_keys)
+    # Issue 47 C: E / Shift+E change the exposure by half a stop, each an undo step; in fly
+    # mode E flies up and leaves the exposure; out of it Page Up pans.
+    xdotool key e
+    wait_for 'exposure=0.50 ' || exit 1
+    echo "after_e=$(field exposure)"
+    xdotool key shift+e
+    wait_for 'exposure=0.00 ' || exit 1
+    xdotool key shift+e
+    wait_for 'exposure=-0.50 ' || exit 1
+    echo "after_shift_e=$(field exposure)"
+    xdotool key ctrl+z
+    wait_for 'exposure=0.00 ' || exit 1
+    echo "after_undo=$(field exposure)"
+    xdotool key g
+    wait_for 'fly=1' || exit 1
+    camera=$(field camera)
+    xdotool keydown e
+    wait_changed camera "$camera" || exit 1
+    xdotool keyup e
+    echo "fly_exposure=$(field exposure)"
+    xdotool key g
+    wait_for 'fly=0' || exit 1
+    camera=$(field camera)
+    xdotool keydown Page_Up
+    wait_changed camera "$camera" || exit 1
+    xdotool keyup Page_Up
+    echo "page_up_exposure=$(field exposure)"
+    ;;
+chooser)
+    # Issue 47 C: Ctrl+O runs the chooser as a child; the window keeps drawing while it is
+    # open (a pointer move is seen), and its answer opens the scene.
+    xdotool key ctrl+o
+    wait_for 'dialog=chooser' || exit 1
+    xdotool mousemove --window "$wid" 252 330
+    wait_for 'pointer=252,330 .*dialog=chooser' || exit 1
+    echo "live_while_choosing=1"
+    touch "$dir/go"  # the stand-in answers
+    wait_for 'file=b.json .*dialog=none' || exit 1
+    echo "opened=$(field file)"
+    ;;
+xdnd_drop)
+    # Issue 47 C: files dropped on the window as a file manager drops them (XDND, x_drop.py):
+    # the image and a text file, then the bundled example (a link to it).
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/mine/ref.ppm" "$dir/mine/notes.txt" || { echo "error=drop failed"; exit 1; }
+    wait_for 'b=reference .*error=1' || exit 1
+    echo "b=$(field b)"
+    echo "error_shown=$(field error)"
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/example.json" || { echo "error=drop failed"; exit 1; }
+    wait_for 'file=example.json ' || exit 1
+    echo "opened=$(field file)"
+    echo "b_after=$(field b)"
+    # With unsaved edits a dropped scene asks first (the discard question); Esc keeps them.
+    xdotool keydown Right
+    wait_for 'dirty=1' || exit 1
+    xdotool keyup Right
+    python3 "$(dirname "$0")/x_drop.py" "$wid" "$dir/mine/a.json" || { echo "error=drop failed"; exit 1; }
+    wait_for 'question=discard' || exit 1
+    echo "asked=discard"
+    xdotool key Escape
+    wait_for 'question=none' || exit 1
+    echo "kept=$(field file)"
+    echo "dirty_kept=$(field dirty)"
+    ;;
+ui_scale)
+    # Issue 47 C: the UI follows the monitor's content scale (1.5 here) times the UI scale
+    # kept in the settings file (1.5); Ctrl+= raises it by a quarter and keeps it.
+    echo "content_scale=$(field content_scale)"
+    echo "ui_scale_start=$(field ui_scale)"
+    echo "image_scaled=$(field image)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/scaled.ppm" || { echo "error=no window shot"; exit 1; }
+    xdotool key ctrl+equal
+    wait_for 'ui_scale=1.75 ' || exit 1
+    echo "ui_scale_after=$(field ui_scale)"
+    xdotool key ctrl+0
+    wait_for 'ui_scale=1.00 ' || exit 1
+    xdotool mousemove --window "$wid" 251 330  # a frame drawn at the new scale
+    wait_for 'pointer=251,330' || exit 1
+    echo "image_unscaled=$(field image)"
+    python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/unscaled.ppm" || { echo "error=no window shot"; exit 1; }
     ;;
 esac
 echo "generation_after=$(field generation)"

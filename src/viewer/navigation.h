@@ -94,7 +94,7 @@ struct DragGesture {
 // the same whatever the frame rate.
 struct KeyMotion {
     int orbit_x = 0, orbit_y = 0;  // arrows: yaw, pitch
-    int pan_x = 0, pan_y = 0;      // A/D, Q/E
+    int pan_x = 0, pan_y = 0;      // A/D; Page Up/Down (fly mode: Q/E)
     int dolly = 0;                 // W (in, -1) / S (out, +1)
     bool any() const { return orbit_x || orbit_y || pan_x || pan_y || dolly; }
 };

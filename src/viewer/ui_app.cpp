@@ -18,6 +18,7 @@
 #include "scene/load.h"
 #include "viewer/navigation.h"
 #include "viewer/ui_compare.h"
+#include "viewer/ui_file_dialog.h"
 #include "viewer/ui_overlays.h"
 #include "viewer/ui_panels.h"
 
@@ -52,6 +53,8 @@ void install_input_callbacks(GLFWwindow* w) {
     glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { app_of(win)->note_input(); });
     glfwSetWindowRefreshCallback(w, [](GLFWwindow* win) { app_of(win)->note_input(); });
     glfwSetWindowCloseCallback(w, [](GLFWwindow* win) { app_of(win)->on_close_request(); });
+    glfwSetDropCallback(w, [](GLFWwindow* win, int count, const char** paths) { app_of(win)->note_drop(count, paths); });
+    glfwSetWindowContentScaleCallback(w, [](GLFWwindow* win, float, float) { app_of(win)->note_input(); });
 }
 
 double seconds(std::chrono::steady_clock::duration d) { return std::chrono::duration<double>(d).count(); }
@@ -82,6 +85,13 @@ ViewerApp::ViewerApp(ViewOptions options, SharedPasses* ranks)
     if (model_.has_scene()) ui_.save.paths = SavePaths::for_scene(model_.scene(), ui_.save.read_only);
     if (model_.has_scene() && ui_.save.read_only)
         messages_.show_status("a bundled scene, opened as it ships: Save asks where to save your copy");
+    // The recent files and the UI scale (never for a scripted run: its output must not depend
+    // on the user's settings, nor write them); --ui-scale overrides the kept scale.
+    load_viewer_settings(ctx_, !options_.scripted());
+    if (options_.ui_scale) ui_.files.ui_scale = *options_.ui_scale;
+    if (model_.has_scene() && !options_.scripted()) note_recent_file(ctx_, FilePurpose::open_scene, options_.scene);
+    // --drop: as files dropped on the window, at the first frame.
+    ui_.files.drops = options_.drop;
     CompareTool& tool = ui_.compare;
     tool.comparison.settings = options_.compare;
     tool.locked_probe = options_.probe;
@@ -256,6 +266,34 @@ void ViewerApp::note_key(int key, int action, int mods) {
     input_.note_key(key, action, mods);
 }
 
+void ViewerApp::note_drop(int count, const char** paths) {
+    input_seen_ = true;
+    for (int i = 0; i < count; ++i) ui_.files.drops.emplace_back(paths[i]);
+}
+
+void ViewerApp::apply_ui_scale() {
+    float xs = 1, ys = 1;
+    glfwGetWindowContentScale(window_, &xs, &ys);
+    content_scale_ = xs > 0 ? xs : 1;
+    const float scale = std::clamp(content_scale_ * float(ui_.files.ui_scale), 0.5f, 6.0f);
+    if (scale == applied_scale_) return;
+    // ImGui's own font (ProggyClean) rasterised at the size, at whole pixels; the style's sizes
+    // (padding, spacing, rounding) from the default's; the panel keeps its share of the window.
+    ImGuiIO& io = ImGui::GetIO();
+    io.Fonts->Clear();
+    ImFontConfig font;
+    font.SizePixels = std::round(13.0f * scale);
+    io.Fonts->AddFontDefault(&font);
+    ImGui_ImplOpenGL3_DestroyFontsTexture();
+    ImGui_ImplOpenGL3_CreateFontsTexture();
+    ImGuiStyle style;
+    ImGui::StyleColorsDark(&style);
+    style.ScaleAllSizes(scale);
+    ImGui::GetStyle() = style;
+    ui_.panel_width *= scale / applied_scale_;
+    applied_scale_ = scale;
+}
+
 void ViewerApp::request_quit() {
     if (model_.dirty()) quit_asked_ = true;
     else glfwSetWindowShouldClose(window_, GLFW_TRUE);
@@ -347,6 +385,21 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     if (model_.has_scene())
         std::snprintf(camera, sizeof camera, "%.9g,%.9g,%.9g", model_.camera().position.x, model_.camera().position.y,
                       model_.camera().position.z);
+    // file: the scene file shown; exposure: the display's EV; ui_scale: the UI scale set and
+    // content_scale the monitor's; dialog: a file dialog open (file_dialog_word), folder:
+    // the browser's; error: an error message shows; recent: the recent scenes kept.
+    auto spaceless = [](std::string s) {
+        std::replace(s.begin(), s.end(), ' ', '_');
+        return s.empty() ? std::string("none") : s.substr(0, 200);
+    };
+    const std::string file = spaceless(ui_.files.watch.file().filename().string());
+    const std::string folder = spaceless(ui_.files.browser ? ui_.files.browser->folder().string() : "");
+    char files_fields[600];
+    std::snprintf(files_fields, sizeof files_fields,
+                  " file=%s exposure=%.2f ui_scale=%.2f content_scale=%.2f dialog=%s folder=%s error=%d recent=%zu",
+                  file.c_str(), model_.settings().tone.exposure, ui_.files.ui_scale, double(content_scale_),
+                  file_dialog_word(ui_).c_str(), folder.c_str(), int(!messages_.error.empty()),
+                  ui_.files.settings.scenes.size());
     char line[1000];
     int n = std::snprintf(line, sizeof line,
                   "state=%s spp=%d target=%d generation=%llu shown=%s dirty=%d help=%d panel=%d press=%d pointer=%d,%d "
@@ -365,6 +418,7 @@ void ViewerApp::write_status_file(const RunStatus& status) {
     // widgets' centres in window points, name:x,y;... (ui_widgets.h mark_item).
     std::string full(line, size_t(std::clamp(n, 0, int(sizeof line) - 1)));
     if (!full.empty() && full.back() == '\n') full.pop_back();
+    full += files_fields;
     full += " tab=" + std::string(panel_tab_key(ui_.panel_tab)) + " light=" +
             (ui_.selected_light && !sel ? std::to_string(*ui_.selected_light) : std::string("none")) + " at=";
     for (const UiState::Mark& m : ui_.marks) {
@@ -399,7 +453,7 @@ void ViewerApp::draw_panels() {
     ImGui::Begin("keithray", nullptr,
                  ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoTitleBar | ImGuiWindowFlags_NoResize);
     // Labels keep their room: the fields narrow instead.
-    ImGui::PushItemWidth(-kPanelLabelWidth);
+    ImGui::PushItemWidth(-std::min(kPanelLabelWidth * applied_scale_, 0.4f * width));
     draw_panel_list(ctx_);
     ImGui::PopItemWidth();
     ImGui::End();
@@ -434,10 +488,12 @@ void ViewerApp::draw_questions(bool cancel, bool confirm) {
     const bool answered = answer != QuitAnswer::none;
     discard_popup(ctx_, cancel && !answered);
     overwrite_popup(ctx_, cancel && !answered, confirm && !answered);
+    file_dialog_popup(ctx_, cancel && !answered, confirm && !answered);
     if (quit_after_save_) {
         // Saved: quit. Still asking (where, overwrite): wait. Else the save failed or was
         // cancelled (its message in the status bar): stay.
-        const bool asking = ui_.save.ask_where || ui_.save.ask_overwrite || std::string_view(open_question()) != "none";
+        const bool asking = ui_.save.ask_where || ui_.save.ask_overwrite || std::string_view(open_question()) != "none" ||
+                            file_dialog_word(ui_) != "none";
         if (!model_.dirty()) glfwSetWindowShouldClose(window_, GLFW_TRUE);
         if (!model_.dirty() || !asking) quit_after_save_ = false;
     }
@@ -449,6 +505,7 @@ bool ViewerApp::draw_frame() {
         else ImGui_ImplGlfw_KeyCallback(window_, e.key, e.scancode, e.action, e.mods);
     }
     if (!keys_.empty()) input_seen_ = true;  // the rest go to the next frames, drawn at once
+    apply_ui_scale();
     ImGui_ImplOpenGL3_NewFrame();
     ImGui_ImplGlfw_NewFrame();
     input_.apply_pointer();
@@ -476,6 +533,7 @@ bool ViewerApp::draw_frame() {
     const WindowRequests requests = handle_input(ctx_, input_);
     if (requests.toggle_fullscreen) toggle_fullscreen();
     if (requests.quit) request_quit();
+    handle_drops(ctx_);
     sync_worker();
     update_title();
     update_pictures(ctx_, *display_);
@@ -512,6 +570,7 @@ int ViewerApp::run() {
     while (!done && !glfwWindowShouldClose(window_)) {
         if (ranks_ && (stop_signal() || !ranks_->lost().empty())) end_with_the_job();
         poll_watch();
+        if (poll_file_chooser(ctx_)) input_seen_ = true;
         sync_worker();
         if (options_.measure_idle > 0 && script_.idle_step(ctx_, [this] {
                 sync_worker();

@@ -46,6 +46,8 @@ public:
     void note_wheel() { input_seen_ = true; input_.note_wheel(); }
     void note_enter(bool entered) { input_seen_ = true; input_.note_enter(entered); }
     void on_close_request();
+    // Files dropped on the window (glfwSetDropCallback): handled at the next frame (ui_file_dialog.h).
+    void note_drop(int count, const char** paths);
 
 private:
     // Steps of one UI frame.
@@ -60,6 +62,8 @@ private:
     bool animating() const;  // something moves without input: redraw at the frame rate
     void request_quit();
     void toggle_fullscreen();
+    // The fonts and sizes at the monitor's content scale times the UI scale, when that changed.
+    void apply_ui_scale();
     Rgb8Image read_image_region(const PixelRect& rect) const;
     // The MPI job is ending (a stop signal): says so in the window and on standard error, then
     // ends the process with status 1 at once (the render thread may be waiting on a dead rank).
@@ -93,6 +97,8 @@ private:
     // The window.
     bool fullscreen_ = false;
     int windowed_x_ = 0, windowed_y_ = 0, windowed_w_ = 0, windowed_h_ = 0;
+    float content_scale_ = 1;  // the monitor's, as GLFW reports it
+    float applied_scale_ = 1;  // the scale the fonts and the style are at
     std::string title_;
     std::string status_line_;  // last written to --status-file
     bool failed_ = false;              // a write of --status-file or a render failed: the run exits 1

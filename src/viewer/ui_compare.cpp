@@ -14,11 +14,13 @@
 #include "viewer/status.h"
 #include "viewer/ui_compare.h"
 
+#include "viewer/ui_file_dialog.h"
+
 namespace kr::viewer {
 
 namespace fs = std::filesystem;
 
-void load_reference(PanelContext& ctx, const fs::path& file, bool automatic) {
+bool load_reference(PanelContext& ctx, const fs::path& file, bool automatic) {
     CompareTool& tool = ctx.ui.compare;
     try {
         tool.comparison.set_reference(kr::viewer::load_reference(file));
@@ -27,7 +29,10 @@ void load_reference(PanelContext& ctx, const fs::path& file, bool automatic) {
         tool.picture_key.clear();
     } catch (const std::exception& e) {
         ctx.messages.show_error(std::string("reference: ") + e.what());
+        return false;
     }
+    if (!automatic) note_recent_file(ctx, FilePurpose::open_image, file);
+    return true;
 }
 
 void keep_image_b(PanelContext& ctx, const Snapshot& frame) {

@@ -11,8 +11,9 @@
 
 namespace kr::viewer {
 
-// Reads image B's reference; a failure becomes the error message.
-void load_reference(PanelContext& ctx, const std::filesystem::path& file, bool automatic);
+// Reads image B's reference; a failure becomes the error message (false). One the user chose
+// (not `automatic`) is noted in the recent images (ui_file_dialog.h).
+bool load_reference(PanelContext& ctx, const std::filesystem::path& file, bool automatic);
 // Keeps `frame` as image B (K, the panel's button).
 void keep_image_b(PanelContext& ctx, const Snapshot& frame);
 // Pixel (x, y) of the frame on screen.

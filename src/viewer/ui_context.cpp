@@ -8,6 +8,7 @@
 #include "scene/load.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
+#include "viewer/ui_file_dialog.h"
 
 namespace kr::viewer {
 
@@ -113,6 +114,7 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
         ctx.ui.selected_light.reset();
         if (file != files.watch.file()) {
             files.watch.watch(file);
+            note_recent_file(ctx, FilePurpose::open_scene, file);
             ctx.ui.save.read_only = scene_file_read_only(file, data_dir());
             ctx.ui.save.paths = SavePaths::for_scene(ctx.model.scene(), ctx.ui.save.read_only);
             if (ctx.ui.save.read_only)

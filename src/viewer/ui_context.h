@@ -18,6 +18,7 @@
 
 #include "viewer/compare_view.h"
 #include "viewer/convergence_log.h"
+#include "viewer/file_browser.h"
 #include "viewer/files.h"
 #include "viewer/image_view.h"
 #include "viewer/inspect.h"
@@ -99,6 +100,20 @@ struct SceneFiles {
     std::vector<SceneChoice> choices;
     std::optional<std::filesystem::path> pending_open;  // an open or reload awaiting the discard question
     bool ask_discard = false;                           // open that question this frame
+    // The file dialogs (ui_file_dialog.h): the ImGui browser shown (none: closed), opened
+    // this frame, the platform's chooser running, the files dropped on the window.
+    std::optional<FileBrowser> browser;
+    bool open_browser = false;
+    bool focus_name = false;   // give its name field the keyboard again (after Return entered a folder)
+    int browser_frames = 0;    // frames its popup has been drawn (the name field has the keyboard from the second)
+    std::string browser_name;  // the Save image dialog's format: its extension by default
+    std::shared_ptr<ChildChooser> chooser;
+    std::vector<std::filesystem::path> drops;
+    // The settings file (file_browser.h): the recent files and the UI scale the user chose
+    // (times the monitor's content scale); `settings_file` empty: none read or written.
+    ViewerSettingsFile settings;
+    std::filesystem::path settings_file;
+    double ui_scale = 1;
 };
 
 // The questions' popup names (ImGui IDs, begun at the top level by ViewerApp::draw_questions).

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "render/trace.h"
 #include "viewer/outliner.h"
 #include "viewer/scene_edit.h"
 #include "viewer/ui_compare.h"
+#include "viewer/ui_file_dialog.h"
 #include "viewer/ui_panels.h"
 
 #include <GLFW/glfw3.h>  // after ui_compare.h: gl_functions.h includes the GL headers it needs first
@@ -107,6 +110,15 @@ PixelBox region_box(double ax, double ay, double bx, double by, const PixelRect&
     auto px = [&](double x) { return std::clamp(int(std::lround((x - rect.x) / rect.width * w)), 0, w); };
     auto py = [&](double y) { return std::clamp(int(std::lround((y - rect.y) / rect.height * h)), 0, h); };
     return {std::min(px(ax), px(bx)), std::min(py(ay), py(by)), std::max(px(ax), px(bx)), std::max(py(ay), py(by))};
+}
+
+constexpr double kExposureKeyStep = 0.5;  // stops per E / Shift+E, as tev's
+
+// "+1.50", "-0.50", "0.00": an exposure in stops.
+std::string format_ev(double ev) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, ev > 0 ? "+%.2f" : "%.2f", ev == 0 ? 0.0 : ev);
+    return buf;
 }
 
 constexpr const char* kGrabGroup = "grab";  // the undo step of one move (M)
@@ -433,6 +445,9 @@ void window_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         // Return answers an open question, typed into or not (a tap between frames included).
         else if ((key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) && ImGui::GetTopMostPopupModal())
             requests.confirm_question = true;
+        // Esc in a question's or a dialog's text field cancels it at once, as desktops do.
+        else if (key == GLFW_KEY_ESCAPE && typing && ImGui::GetTopMostPopupModal())
+            requests.cancel_question = true;
         else if (typing) continue;
         else if (key == GLFW_KEY_ESCAPE) {
             // Esc closes what is open first: a move (put back), the help, the selection, a
@@ -487,10 +502,23 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
             if (in.key_presses[i] == key && (in.key_mods[i] & GLFW_MOD_SHIFT)) return true;
         return io.KeyShift;
     };
+    // Files (ui_file_dialog.h): Ctrl+O opens a scene, Ctrl+Shift+S saves the scene as.
+    if (ctrl_pressed(GLFW_KEY_O)) {
+        open_file_dialog(ctx, FilePurpose::open_scene);
+        return;
+    }
+    if (ctrl_pressed(GLFW_KEY_S) && shift_with(GLFW_KEY_S)) {
+        open_file_dialog(ctx, FilePurpose::save_scene);
+        return;
+    }
     if (ctrl_pressed(GLFW_KEY_S)) {
         save_scene_in_place(ctx);
         return;
     }
+    // The UI's size: Ctrl+= / Ctrl+- by a quarter, Ctrl+0 back to 1 (kept in the settings file).
+    if (ctrl_pressed(GLFW_KEY_EQUAL) || ctrl_pressed(GLFW_KEY_KP_ADD)) set_ui_scale(ctx, ui.files.ui_scale + 0.25);
+    if (ctrl_pressed(GLFW_KEY_MINUS) || ctrl_pressed(GLFW_KEY_KP_SUBTRACT)) set_ui_scale(ctx, ui.files.ui_scale - 0.25);
+    if (ctrl_pressed(GLFW_KEY_0) || ctrl_pressed(GLFW_KEY_KP_0)) set_ui_scale(ctx, 1);
     if (ctrl_pressed(GLFW_KEY_D)) {
         duplicate_selection(ctx);
         return;
@@ -530,6 +558,17 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         start_grab(ctx, in);
         if (in.grab) return;
     }
+    // E / Shift+E: the display's exposure up / down by half a stop, as tev's keys (one undo
+    // step each, a display edit as the Tone map panel's). In fly mode E flies up instead.
+    if (!ui.nav.fly && !io.KeyCtrl)
+        for (size_t i = 0; i < in.key_presses.size(); ++i) {
+            if (in.key_presses[i] != GLFW_KEY_E) continue;
+            const double step = (in.key_mods[i] & GLFW_MOD_SHIFT) ? -kExposureKeyStep : kExposureKeyStep;
+            const double ev = std::clamp(model.settings().tone.exposure + step, -kMaxExposureStops, kMaxExposureStops);
+            model.seal_undo_step();
+            if (ctx.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.tone.exposure = ev; }, "exposure"))
+                ctx.messages.show_status("exposure " + format_ev(ev) + " EV (E / Shift+E; Ctrl+Z undoes)");
+        }
     if (pressed(GLFW_KEY_F)) ui.pick_focus = !ui.pick_focus;
     if (pressed(GLFW_KEY_G)) ui.nav.fly = !ui.nav.fly;
     // B: the next left drag draws the render region; Shift+B: the whole image again.
@@ -545,14 +584,16 @@ void handle_keys(PanelContext& ctx, InputState& in, WindowRequests& requests) {
         in.key_orbit.reset();
         return;
     }
-    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D/Q/E pan.
+    // Held keys move the camera at rates per second: arrows orbit, W/S dolly, A/D and Page Up/Down pan.
     // A chord's key stays no camera key until it is released (Ctrl let go before the S).
     auto held = [&](int key) { return int(ImGui::IsKeyDown(key) && !in.held_in_chord(key)); };
     KeyMotion keys;
     keys.orbit_x = held(GLFW_KEY_RIGHT) - held(GLFW_KEY_LEFT);
     keys.orbit_y = held(GLFW_KEY_DOWN) - held(GLFW_KEY_UP);
     keys.pan_x = held(GLFW_KEY_A) - held(GLFW_KEY_D);
-    keys.pan_y = held(GLFW_KEY_E) - held(GLFW_KEY_Q);
+    // Q / E fly down / up in fly mode; out of it, E is the exposure key and Page Up / Page
+    // Down pan up / down.
+    keys.pan_y = ui.nav.fly ? held(GLFW_KEY_E) - held(GLFW_KEY_Q) : held(GLFW_KEY_PAGE_UP) - held(GLFW_KEY_PAGE_DOWN);
     keys.dolly = held(GLFW_KEY_S) - held(GLFW_KEY_W);
     if (keys.any()) {
         // The time since the previous frame with keys held; a first frame moves one 60 Hz step.

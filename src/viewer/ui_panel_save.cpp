@@ -6,6 +6,7 @@
 #include <imgui_stdlib.h>
 
 #include "viewer/save_dialog.h"
+#include "viewer/ui_file_dialog.h"
 #include "viewer/ui_panels.h"
 
 namespace kr::viewer {
@@ -25,10 +26,17 @@ void panel_save(PanelContext& ctx) {
         if (ImGui::Button((std::string("Save ") + format.name).c_str()))
             request_save(ctx, format.format, image_save_path(format.format, paths.image));
     }
+    // Any folder and name (the file chooser, else the built-in browser); its extension picks the format.
+    if (ImGui::Button("Save image as...")) {
+        ctx.ui.files.browser_name = format_info(image_save_kind(paths.image).format).extension;
+        open_file_dialog(ctx, FilePurpose::save_image);
+    }
     ImGui::EndDisabled();
     ImGui::InputText("scene", &paths.scene);
     // Save As: the file becomes the scene's (watched, in the title, saved); a copy leaves it.
     if (ImGui::Button("Save scene as")) request_save(ctx, SaveKind::scene, paths.scene);
+    ImGui::SameLine();
+    if (ImGui::Button("Save as... (Ctrl+Shift+S)")) open_file_dialog(ctx, FilePurpose::save_scene);
     ImGui::SameLine();
     if (ImGui::Button("Save a copy")) request_save(ctx, SaveKind::scene_copy, paths.scene);
     if (ImGui::Button("Save (Ctrl+S)")) save_scene_in_place(ctx);
@@ -49,6 +57,7 @@ void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
         if (kind.what == SaveKind::scene) {
             watch.watch(path);
             ctx.ui.save.read_only = false;
+            note_recent_file(ctx, FilePurpose::open_scene, path);
         }
     } catch (const std::exception& e) {
         ctx.messages.show_error(std::string("save failed: ") + e.what());
@@ -96,6 +105,12 @@ void overwrite_popup(PanelContext& ctx, bool cancel, bool confirm) {
         if (ImGui::Button("Save") || entered || confirm) {
             ImGui::CloseCurrentPopup();
             request_save(ctx, SaveKind::scene, ctx.ui.save.paths.scene);
+        }
+        ImGui::SameLine();
+        // Another folder: the file dialog, starting at the name given here.
+        if (ImGui::Button("Browse...")) {
+            ImGui::CloseCurrentPopup();
+            open_file_dialog(ctx, FilePurpose::save_scene);
         }
         ImGui::SameLine();
         if (ImGui::Button("Cancel") || cancel) {

@@ -10,6 +10,7 @@
 
 #include "core/data_dir.h"
 #include "scene/scene_list.h"
+#include "viewer/ui_file_dialog.h"
 #include "viewer/ui_panels.h"
 
 namespace kr::viewer {
@@ -22,6 +23,14 @@ void panel_scene(PanelContext& ctx) {
     ViewerModel& model = ctx.model;
     const fs::path current = files.watch.file();
     ImGui::TextWrapped("%s", current.string().c_str());
+    // Any folder's scene (the platform's file chooser, else the built-in browser), the
+    // recent ones, and image B from a file; dropping a file on the window does the same.
+    if (ImGui::Button("Open... (Ctrl+O)")) open_file_dialog(ctx, FilePurpose::open_scene);
+    ImGui::SameLine();
+    if (ImGui::Button("Image B...")) open_file_dialog(ctx, FilePurpose::open_image);
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("an image file as image B, the reference the compare views use");
+    recent_files_combo(ctx, FilePurpose::open_scene, "recent scenes");
+    recent_files_combo(ctx, FilePurpose::open_image, "recent images B");
     if (files.folders.empty()) {
         // The scene's own folder, then the bundled scenes' (default_scenes) and the examples'
         // (example_scenes); a file listed from two shows once.
@@ -36,7 +45,7 @@ void panel_scene(PanelContext& ctx) {
     }
     // Every choice at once (as tall as the window allows), under a line per folder; a bundled
     // folder says that its scenes open as they ship and Save asks where.
-    if (ImGui::BeginCombo("open", current.filename().string().c_str(), ImGuiComboFlags_HeightLargest)) {
+    if (ImGui::BeginCombo("nearby", current.filename().string().c_str(), ImGuiComboFlags_HeightLargest)) {
         const std::optional<DataDir> data = data_dir();
         fs::path folder;
         for (size_t i = 0; i < files.choices.size(); ++i) {
@@ -71,6 +80,18 @@ void panel_scene(PanelContext& ctx) {
     ImGui::SameLine();
     if (ImGui::Button("Reset view")) model.reset_view();
     ImGui::TextDisabled("the file is watched: saving it in an editor reloads it");
+    // The UI's size: times the monitor's content scale; kept with the recent files.
+    // It applies when the slider is let go: the panel does not change size under the pointer.
+    static std::optional<float> dragged;
+    float scale = dragged.value_or(float(ctx.ui.files.ui_scale));
+    if (ImGui::SliderFloat("UI scale", &scale, float(ViewerSettingsFile::kMinUiScale),
+                           float(ViewerSettingsFile::kMaxUiScale), "%.2f"))
+        dragged = scale;
+    if (ImGui::IsItemDeactivated() && dragged) {
+        set_ui_scale(ctx, *dragged);
+        dragged.reset();
+    }
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("Ctrl+= / Ctrl+- / Ctrl+0; times the monitor's scale");
     // The loader's warnings under one line that is always there, folded: an edit that adds
     // or clears one moves no control under the pointer.
     const std::vector<std::string>& warnings = model.warnings();

@@ -40,6 +40,11 @@ constexpr const char* kViewOnlyOptions = R"(  --unlimited           keep refinin
   --error METRIC        the error view's per-pixel error: absolute or relative
   --zoom Z              show the image at Z screen pixels per pixel (up to 16) about its centre
   --probe X,Y           lock the pixel inspector on image pixel (X, Y)
+  --ui-scale S          the panels' and text's size, 0.5 to 3, times the monitor's content
+                        scale (default: the UI scale set in the window, kept with the recent
+                        files in $XDG_CONFIG_HOME/keithray/viewer.json, else 1)
+  --drop FILE           as if FILE were dropped on the window (repeatable): a scene (.json)
+                        opens, an image becomes image B; anything else is an error
   -h, --help            this text
 Edits made at the start, as the mouse makes them (pixels within the image):
   --aperture A          make the camera a thin lens of aperture radius A
@@ -118,6 +123,8 @@ ViewOptions parse_view_options(int argc, char** argv) {
         else if (arg == "--measure-latency") o.measure_latency = int(parse_integer(arg, value(), 1, 10000));
         else if (arg == "--measure-idle") o.measure_idle = parse_number(arg, value(), 0.1, 3600);
         else if (arg == "--status-file") o.status_file = value();
+        else if (arg == "--ui-scale") o.ui_scale = parse_number(arg, value(), 0.5, 3);
+        else if (arg == "--drop") o.drop.emplace_back(value());
         else if (arg == "--reference") o.reference = value();
         else if (arg == "--view") o.compare.mode = parse_name(arg, value(), view_mode_names);
         else if (arg == "--split") o.compare.split = parse_number(arg, value(), 0, 1);

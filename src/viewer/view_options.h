@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "render/options.h"
 #include "viewer/compare_view.h"
@@ -38,6 +39,8 @@ struct ViewOptions {
     double zoom = 0;                                  // 0: fit; else about the image's centre
     std::optional<std::pair<int, int>> probe;         // a locked probe at image pixel (x, y)
     std::optional<std::filesystem::path> stats_json;  // figures written when a scripted run ends
+    std::optional<double> ui_scale;  // --ui-scale: the UI's size (times the monitor's scale)
+    std::vector<std::filesystem::path> drop;  // --drop: files handled as dropped on the window
     double timeout = 600;     // seconds: a scripted run that gets stuck fails
     bool help = false;        // -h, --help
     // Something a scripted run writes once the render has its passes (or --frames alone).
