@@ -3,7 +3,6 @@
 // (per frame), medians of 15 at the scene's resolution; then the render thread from an edit to
 // its finished 8 spp, with the feature layers off (the default) and on, interleaved, medians
 // of 5 each. Usage: keithray_bench_features [SCENE.json] (default res/scenes/assignment_03.json).
-#include <string_view>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -11,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "bench_main.h"
 #include "render/outputs.h"
 #include "scene/load.h"
 #include "viewer/inspect.h"
@@ -92,17 +92,6 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-// A bad argument or scene file is one line on stderr and exit status 1, not an abort.
 int main(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i)
-        if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
-            std::printf("usage: keithray_bench_features [SCENE.json]\n");
-            return 0;
-        }
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "keithray_bench_features: %s\n", e.what());
-        return 1;
-    }
+    return kr::bench::bench_main(argc, argv, "keithray_bench_features", "[SCENE.json]", run);
 }

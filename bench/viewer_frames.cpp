@@ -8,7 +8,6 @@
 // before it. Then the render thread's passes per second against ProgressiveDriver's alone.
 // Usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N]
 //                              [--size WxH] [--raw] [--dump DIR] [--no-region] [--before S]
-#include <string_view>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -19,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_main.h"
 #include "core/image_io.h"
 #include "render/progressive.h"
 #include "scene/load.h"
@@ -176,17 +176,6 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
-// A bad argument or scene file is one line on stderr and exit status 1, not an abort.
 int main(int argc, char** argv) {
-    for (int i = 1; i < argc; ++i)
-        if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
-            std::printf("usage: keithray_bench_frames [SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N] [--size WxH] [--raw] [--dump DIR] [--no-region] [--before S]\n");
-            return 0;
-        }
-    try {
-        return run(argc, argv);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "keithray_bench_frames: %s\n", e.what());
-        return 1;
-    }
+    return kr::bench::bench_main(argc, argv, "keithray_bench_frames", "[SCENE.json] [--orbit DX] [--seconds S] [--settle-spp N] [--size WxH] [--raw] [--dump DIR] [--no-region] [--before S]", run);
 }

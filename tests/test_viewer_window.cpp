@@ -1157,22 +1157,35 @@ TEST_F(ViewerWindow, OpenAndSaveAsBrowseFoldersAndKeepRecentFiles) {
     keep_shot(dir, "browser.ppm");
 }
 
+// What the drop tests drop, in dir: their own scene (mine/a.json, started with), an image
+// (mine/ref.ppm), a text file (mine/notes.txt) and a link to a bundled example (example.json).
+::testing::AssertionResult drop_files(const fs::path& dir) {
+    own_scene(dir, "mine/a.json");
+    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
+    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
+    const auto examples = kr::example_scenes();
+    if (examples.empty()) return ::testing::AssertionFailure() << "no example scene";
+    fs::create_symlink(examples.front(), dir / "example.json");
+    return ::testing::AssertionSuccess();
+}
+
+// The drop's outcome: the image became image B, the text file was refused with an error, the
+// example opened.
+void expect_dropped(std::map<std::string, std::string>& r) {
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["b"], "reference");
+    EXPECT_EQ(r["error_shown"], "1");
+    EXPECT_EQ(r["opened"], "example.json");
+}
+
 // A drop by --drop (the drop callback's path; FilesDroppedThroughXdnd... drops for real):
 // the image became image B, the text file was refused with an error, the bundled
 // example (a link to it) opened read-only: Ctrl+S asks where.
 TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
-    const fs::path scene = own_scene(dir, "mine/a.json");
-    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
-    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
-    const auto examples = kr::example_scenes();
-    ASSERT_FALSE(examples.empty());
-    fs::create_symlink(examples.front(), dir / "example.json");
-    auto r = drive(dir, "drop", 3, scene);
-    ASSERT_EQ(r.count("error"), 0u) << r["error"];
-    EXPECT_EQ(r["b"], "reference");
-    EXPECT_EQ(r["error_shown"], "1");
-    EXPECT_EQ(r["opened"], "example.json");
+    ASSERT_TRUE(drop_files(dir));
+    auto r = drive(dir, "drop", 3, dir / "mine" / "a.json");
+    expect_dropped(r);
     EXPECT_EQ(r["asked"], "save-where");
     keep_shot(dir, "drop.ppm");
 }
@@ -1183,17 +1196,9 @@ TEST_F(ViewerWindow, DroppedImageIsImageBDroppedSceneOpensOtherFilesAreRefused) 
 // stays); with unsaved edits a dropped scene asks first.
 TEST_F(ViewerWindow, FilesDroppedThroughXdndOpenAsTheyWouldFromOpen) {
     if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
-    const fs::path scene = own_scene(dir, "mine/a.json");
-    fs::copy_file(kr::test::brief_reference_file(3), dir / "mine" / "ref.ppm");
-    std::ofstream(dir / "mine" / "notes.txt") << "not an image";
-    const auto examples = kr::example_scenes();
-    ASSERT_FALSE(examples.empty());
-    fs::create_symlink(examples.front(), dir / "example.json");
-    auto r = drive(dir, "xdnd_drop", 3, scene);
-    ASSERT_EQ(r.count("error"), 0u) << r["error"];
-    EXPECT_EQ(r["b"], "reference");
-    EXPECT_EQ(r["error_shown"], "1");
-    EXPECT_EQ(r["opened"], "example.json");
+    ASSERT_TRUE(drop_files(dir));
+    auto r = drive(dir, "xdnd_drop", 3, dir / "mine" / "a.json");
+    expect_dropped(r);
     EXPECT_EQ(r["b_after"], "reference");
     // With unsaved edits, a dropped scene asks first; Esc keeps the scene and the edits.
     EXPECT_EQ(r["asked"], "discard");
