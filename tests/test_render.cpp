@@ -139,12 +139,12 @@ TEST(MaterialLobes, SmoothLobeIsWhatSamplingDraws) {
             const Vec3 n = sample_uniform_sphere(rng.next(), rng.next());
             const Vec3 wi = sample_uniform_sphere(rng.next(), rng.next());
             if (std::abs(dot(wi, n)) < 1e-3) continue;
-            const SurfacePoint sp{n, dot(wi, n) < 0, wi};
+            const SurfacePoint sp{n, dot(wi, n) < 0};
             ScatterSample s;
             if (!sample_material(m, sp, wi, rng.next(), {rng.next(), rng.next()}, s)) continue;
             const Color f_cos = eval_smooth(m, sp, s.direction);
             const vertex::LobeValue<vertex::OnePath> lobe =
-                vertex::eval_smooth_lobe<vertex::OnePath>(vertex::OneMaterial{m}, wi, sp.ns(), s.direction);
+                vertex::eval_smooth_lobe<vertex::OnePath>(vertex::OneMaterial{m}, sp.ns(), s.direction);
             if (!has_smooth_lobe(m)) {
                 EXPECT_TRUE(is_black(f_cos));
                 EXPECT_FALSE(s.smooth);

@@ -18,7 +18,7 @@ FirstSurface first_surface(const RenderScene& scene, Ray ray, int max_chain) {
         Hit hit;
         if (!scene.intersects(ray, hit)) break;
         const Material& m = scene.materials[size_t(scene.sphere_material[size_t(hit.sphere)])];
-        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0, ray.d};
+        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
         // unless it totally reflects (by the material's lobes, vertex.inc).
         const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);

@@ -61,7 +61,7 @@ struct Tracer {
         if (light_index >= 0) L += medium.seen(scene.area_lights[light_index].radiance);
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
-        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0, ray.d};
+        const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         // By the material's lobes (vertex.inc's material_lobes), not its type.
         const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
         if (lobes.smooth) {
@@ -120,7 +120,7 @@ struct Tracer {
             if (bounce >= settings.max_depth) break;
 
             const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
-            const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0, ray.d};
+            const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
 
             // Every vertex draws the same dimensions whatever its material, so each dimension
             // of a low-discrepancy sampler keeps one meaning across the pixel's samples; only

@@ -13,7 +13,6 @@ namespace kr {
 struct SurfacePoint {
     Vec3 n;      // outward geometric normal of the sphere
     bool front;  // the incoming ray arrived from outside the sphere
-    Vec3 wi;     // the incoming ray's direction (unit, pointing at the surface)
     Vec3 ns() const { return front ? n : -n; }  // normal on the incident side
 };
 
@@ -57,8 +56,8 @@ inline bool uses_direction_sample(const Material& m) {
     return lobes.smooth || (lobes.rough && m.roughness > 0);
 }
 
-// f(wi, wo) * |cos(wo)| of the smooth lobe (vertex.inc's smooth_lobe; 0 for a material without
-// one), for sp.wi the incoming ray and wo a unit direction away from the surface.
+// f * |cos(wo)| of the smooth lobe (vertex.inc's smooth_lobe; 0 for a material without one),
+// for wo a unit direction away from the surface.
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
 
 // Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface),

@@ -41,8 +41,8 @@ bool area_light_direct(const RenderScene& scene, LightSampling sampling, const A
     const SphereGeom& geom = scene.spheres[light.sphere];
     if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
     const vertex::DirectLight<OnePath> d = vertex::direct_light<OnePath>(
-        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, vertex::OneMaterial{m}, sp.wi, sp.ns(), light.radiance,
-        select_prob, mis);
+        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, vertex::OneMaterial{m}, sp.ns(), light.radiance, select_prob,
+        mis);
     if (!d.lit) return false;
     respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
     direct = d.light;

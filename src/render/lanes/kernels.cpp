@@ -456,7 +456,7 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
                 if (use[k] & Sampler::use_light_pick) lane_u.light_pick = u.light_pick[k];
                 if (use[k] & Sampler::use_light) lane_u.light = {u.light_x[k], u.light_y[k]};
                 const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
-                const SurfacePoint sp{hit.n, front[k] != 0, lane(paths.d, k)};
+                const SurfacePoint sp{hit.n, front[k] != 0};
                 Ray shadow;
                 Color light;
                 LaneVertex& v = vertex[k];
@@ -488,8 +488,8 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
             const vertex::LightSample<Lanes> ls = vertex::sample_sphere_light<Lanes>(
                 settings.light_sampling, light_centre, light_radius, p, u.light_x, u.light_y, light_lane);
             const vertex::DirectLight<Lanes> light =
-                vertex::direct_light<Lanes>(ls, LaneMaterial<SphereTable<kWide>>{table, hit_id, type, rho}, paths.d,
-                                            ns, light_radiance, light_select, true);
+                vertex::direct_light<Lanes>(ls, LaneMaterial<SphereTable<kWide>>{table, hit_id, type, rho}, ns,
+                                            light_radiance, light_select, true);
             const vm lit = light.lit;
             shadow_cast |= lit;
             shadow_d = select(lit, ls.wi, shadow_d);

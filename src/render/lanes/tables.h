@@ -188,11 +188,16 @@ struct SphereTable {
         for (auto& c : number) store.bind(c);
         store.bind(type), store.bind(use);
     }
-    // Sphere s's material: its type and parameters.
+    // Sphere s's material: its type and parameters (each column's member a constant, so each
+    // is one store, as a batch fills the table).
     void set_material(size_t s, const Material& material) {
-        for (size_t i = 0; i < kMaterialColours.count; ++i) colour[i].set(s, material.*kMaterialColours.members[i]);
-        for (size_t i = 0; i < kMaterialNumbers.count; ++i)
-            number[i].data()[s] = real(material.*kMaterialNumbers.members[i]);
+        set_material(s, material, std::make_index_sequence<kMaterialColours.count>{},
+                     std::make_index_sequence<kMaterialNumbers.count>{});
+    }
+    template <size_t... C, size_t... N>
+    void set_material(size_t s, const Material& material, std::index_sequence<C...>, std::index_sequence<N...>) {
+        (colour[C].set(s, material.*kMaterialColours.members[C]), ...);
+        ((number[N].data()[s] = real(material.*kMaterialNumbers.members[N])), ...);
         type.data()[s] = lane_int(material.type);
     }
 };
