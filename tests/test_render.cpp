@@ -4,6 +4,7 @@
 #include <cmath>
 #include <omp.h>
 
+#include "render/material.h"
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "test_util.h"
@@ -121,6 +122,47 @@ TEST(Furnace, ZeroRoughnessEqualsDeltaMaterials) {
 // Direct light from a sphere light of radiance Le and radius r at distance d from a diffuse
 // point whose normal makes angle theta with the light: L = rho Le (r/d)^2 cos(theta),
 // the irradiance pi Le sin^2(theta_max) cos(theta) times rho/pi.
+// Each material type's smooth lobe, as next-event estimation evaluates it (eval_smooth and
+// vertex.inc's smooth_lobe), is the lobe sample_material draws: at a drawn direction its
+// density is the sample's and f cos / pdf its weight. A type without a smooth lobe evaluates
+// to black and its samples carry no density. Over every type, so a new one is checked too.
+TEST(MaterialLobes, SmoothLobeIsWhatSamplingDraws) {
+    Rng rng(7, 0);
+    for (size_t t = 0; t < material_type_names.names.size(); ++t) {
+        Material m;
+        m.type = MaterialType(t);
+        m.rho = {0.2, 0.5, 0.9};
+        m.roughness = 0.3;
+        SCOPED_TRACE(std::string(material_type_names.names[t]));
+        int smooth_samples = 0;
+        for (int i = 0; i < 2000; ++i) {
+            const Vec3 n = sample_uniform_sphere(rng.next(), rng.next());
+            const Vec3 wi = sample_uniform_sphere(rng.next(), rng.next());
+            if (std::abs(dot(wi, n)) < 1e-3) continue;
+            const SurfacePoint sp{n, dot(wi, n) < 0};
+            ScatterSample s;
+            if (!sample_material(m, sp, wi, rng.next(), {rng.next(), rng.next()}, s)) continue;
+            const Color f_cos = eval_smooth(m, sp, s.direction);
+            const vertex::LobeValue<vertex::OnePath> lobe =
+                vertex::eval_smooth_lobe<vertex::OnePath>(vertex::OneMaterial{m}, sp.ns(), s.direction);
+            if (!has_smooth_lobe(m)) {
+                EXPECT_TRUE(is_black(f_cos));
+                EXPECT_FALSE(s.smooth);
+                continue;
+            }
+            ASSERT_TRUE(s.smooth);
+            ASSERT_GT(s.pdf, 0);
+            ++smooth_samples;
+            EXPECT_NEAR(lobe.pdf, s.pdf, 1e-12 * s.pdf);
+            for (int c = 0; c < 3; ++c) {
+                EXPECT_NEAR(f_cos[c], lobe.f_cos[c], 1e-15);
+                EXPECT_NEAR(f_cos[c] / s.pdf, s.weight[c], 1e-12);
+            }
+        }
+        if (has_smooth_lobe(m)) EXPECT_GT(smooth_samples, 1000);
+    }
+}
+
 TEST(DirectLighting, SphereLightOnDiffuseFloor) {
     test::SceneBuilder b;
     const double rho = 0.5, le = 4.0, r = 0.5;

@@ -9,7 +9,7 @@ using vertex::OnePath;
 
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo) {
     if (!has_smooth_lobe(m)) return {};
-    return m.rho * vertex::lambert<OnePath>(dot(sp.ns(), wo));
+    return vertex::eval_smooth_lobe<OnePath>(OneMaterial{m}, sp.ns(), wo).f_cos;
 }
 
 DielectricSplit split_dielectric(const Material& m, const SurfacePoint& sp, const Vec3& wi) {

@@ -56,7 +56,8 @@ inline bool uses_direction_sample(const Material& m) {
     return lobes.smooth || (lobes.rough && m.roughness > 0);
 }
 
-// f(wi, wo) * |cos(wo)| of the smooth lobe, for wo a unit direction away from the surface.
+// f * |cos(wo)| of the smooth lobe (vertex.inc's smooth_lobe; 0 for a material without one),
+// for wo a unit direction away from the surface.
 Color eval_smooth(const Material& m, const SurfacePoint& sp, const Vec3& wo);
 
 // Samples an outgoing direction for a ray arriving along `wi` (unit, pointing at the surface),

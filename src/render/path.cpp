@@ -36,12 +36,13 @@ bool area_light_direct(const RenderScene& scene, LightSampling sampling, const A
                        const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
                        Color& direct) {
     if (light.sphere == hit.sphere) return false;  // a convex emitter cannot light itself
-    if (!has_smooth_lobe(m)) return false;          // eval_smooth is 0
+    if (!has_smooth_lobe(m)) return false;          // nothing for a light sample to evaluate
     LightSample ls;
     const SphereGeom& geom = scene.spheres[light.sphere];
     if (!sample_sphere_light(geom, hit.p, sampling, u.x, u.y, ls)) return false;
     const vertex::DirectLight<OnePath> d = vertex::direct_light<OnePath>(
-        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, m.rho, sp.ns(), light.radiance, select_prob, mis);
+        {ls.wi, ls.distance, ls.pdf, ls.mis_pdf, true}, vertex::OneMaterial{m}, sp.ns(), light.radiance, select_prob,
+        mis);
     if (!d.lit) return false;
     respawn(shadow, hit, ls.wi, ls.distance, light.sphere);
     direct = d.light;

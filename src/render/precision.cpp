@@ -7,6 +7,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "render/lanes/vertex.h"
+
 namespace kr {
 
 namespace {
@@ -219,9 +221,9 @@ bool float_reach_fits(const RenderScene& scene) {
     for (size_t s = 0; s < n; ++s) {
         box[s] = ReachBox::around(spheres[s].centre, spheres[s].radius);
         const int m = s < scene.sphere_material.size() ? scene.sphere_material[s] : -1;
+        // Rays enter a material that transmits (a Fresnel split, vertex.inc's material_lobes).
         const bool enters = m < 0 || size_t(m) >= scene.materials.size() ||
-                            scene.materials[size_t(m)].type == MaterialType::dielectric ||
-                            scene.materials[size_t(m)].type == MaterialType::translucent;
+                            vertex::material_lobes(scene.materials[size_t(m)].type).fresnel_split;
         const bool emitter = s < scene.sphere_light.size() && scene.sphere_light[s] >= 0;
         // The lens within (or touching) the ball: rays start inside it.
         const bool lens_inside = !(lens.nearest(spheres[s].centre) > spheres[s].radius);

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -79,8 +80,79 @@ struct MaterialParam {
     bool in_range(double x) const { return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi); }
 };
 
+namespace material_param_rows {
+
+constexpr MaterialParam colour_param(std::string_view name, Color Material::*member) {
+    MaterialParam p;
+    p.name = name;
+    p.colour = member;
+    return p;
+}
+constexpr MaterialParam number_param(std::string_view name, double Material::*member, std::string_view expected,
+                                     double lo, double hi, bool lo_open, bool hi_open, double edit_lo,
+                                     double edit_hi, float edit_speed) {
+    MaterialParam p;
+    p.name = name;
+    p.number = member;
+    p.expected = expected;
+    p.lo = lo, p.hi = hi, p.lo_open = lo_open, p.hi_open = hi_open;
+    p.edit_lo = edit_lo, p.edit_hi = edit_hi, p.edit_speed = edit_speed;
+    return p;
+}
+
+inline constexpr MaterialParam kRho = colour_param("rho", &Material::rho);
+inline constexpr MaterialParam kRhoR = colour_param("rhoR", &Material::rho_r);
+inline constexpr MaterialParam kRhoT = colour_param("rhoT", &Material::rho_t);
+inline constexpr MaterialParam kRoughness = number_param("roughness", &Material::roughness, "a roughness in [0, 1)",
+                                                         0, 1, false, true, 0, 0.999, 0.002f);
+inline constexpr MaterialParam kEta =
+    number_param("eta", &Material::eta, "a refractive index eta > 0", 0, std::numeric_limits<double>::infinity(),
+                 true, false, 1.0 / 4, 4, 0.002f);
+
+inline constexpr MaterialParam kRhoOnly[] = {kRho};
+inline constexpr MaterialParam kGlossy[] = {kRho, kRoughness};
+inline constexpr MaterialParam kDielectric[] = {kRhoR, kRhoT, kEta};
+inline constexpr MaterialParam kTranslucent[] = {kRhoR, kRhoT, kEta, kRoughness};
+
+}  // namespace material_param_rows
+
 // The parameters of a material type, in the file's order.
-std::span<const MaterialParam> material_params(MaterialType type);
+constexpr std::span<const MaterialParam> material_params(MaterialType type) {
+    using namespace material_param_rows;
+    switch (type) {
+    case MaterialType::diffuse:
+    case MaterialType::specular: return kRhoOnly;
+    case MaterialType::glossy: return kGlossy;
+    case MaterialType::dielectric: return kDielectric;
+    case MaterialType::translucent: return kTranslucent;
+    }
+    return {};
+}
+
+// The colour or number members (T: Color or double) that any type's parameters name, each
+// once, in the order of the types and their parameters: the SIMD lanes keep a per-sphere
+// column of each (render/lanes/tables.h), so a new parameter needs no reader of its own.
+template <class T>
+struct MaterialMembers {
+    std::array<T Material::*, 8> members{};
+    size_t count = 0;
+    // The member's place in `members` (count where it is not there).
+    constexpr size_t index(T Material::*member) const {
+        for (size_t i = 0; i < count; ++i)
+            if (members[i] == member) return i;
+        return count;
+    }
+};
+template <class T>
+constexpr MaterialMembers<T> material_members(T Material::*MaterialParam::*field) {
+    MaterialMembers<T> out;
+    for (size_t t = 0; t < material_type_names.names.size(); ++t)
+        for (const MaterialParam& param : material_params(MaterialType(t)))
+            if (param.*field && out.index(param.*field) == out.count) out.members[out.count++] = param.*field;
+    return out;
+}
+inline constexpr MaterialMembers<Color> kMaterialColours = material_members<Color>(&MaterialParam::colour);
+inline constexpr MaterialMembers<double> kMaterialNumbers = material_members<double>(&MaterialParam::number);
 
 struct Shape {
     std::string id;

@@ -282,12 +282,7 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
         const Material& material = scene.materials[material_index];
         table.centre.set(s, geom.centre);
         table.radius.data()[s] = real(geom.radius);
-        table.rho.set(s, material.rho);
-        table.rho_r.set(s, material.rho_r);
-        table.rho_t.set(s, material.rho_t);
-        table.eta.data()[s] = real(material.eta);
-        table.roughness.data()[s] = real(material.roughness);
-        table.type.data()[s] = lane_int(material.type);
+        table.set_material(s, material);
         table.use.data()[s] = lane_int(numbers_used[material_index]);
     }
     for (size_t i = 0; i < scene.area_lights.size(); ++i) {
@@ -482,7 +477,7 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
             shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
             direct = gather(vertex, &LaneVertex::direct);
         }
-        const V3 rho = look_up(table.rho, hit_id);
+        const V3 rho = look_up_rho(table, hit_id);
         const V3 shadow_o = p;
         const vm shadow_from = id;
 
@@ -493,7 +488,8 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
             const vertex::LightSample<Lanes> ls = vertex::sample_sphere_light<Lanes>(
                 settings.light_sampling, light_centre, light_radius, p, u.light_x, u.light_y, light_lane);
             const vertex::DirectLight<Lanes> light =
-                vertex::direct_light<Lanes>(ls, rho, ns, light_radiance, light_select, true);
+                vertex::direct_light<Lanes>(ls, LaneMaterial<SphereTable<kWide>>{table, hit_id, type, rho}, ns,
+                                            light_radiance, light_select, true);
             const vm lit = light.lit;
             shadow_cast |= lit;
             shadow_d = select(lit, ls.wi, shadow_d);

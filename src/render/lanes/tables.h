@@ -172,16 +172,33 @@ struct WideStore {
 
 // What a vertex on each sphere reads: its geometry and its material's values, and (use) the
 // numbers it draws (vertex_numbers_used, less Russian roulette, which goes by depth alone).
+// The material's parameters are a column each, in the order of scene.h's kMaterialColours and
+// kMaterialNumbers (every member material_params names), filled by `set_material`.
 template <bool kWide>
 struct SphereTable {
-    Column3Of<kWide> centre, rho, rho_r, rho_t;
-    ColumnOf<kWide> radius, eta, roughness;
+    Column3Of<kWide> centre;
+    ColumnOf<kWide> radius;
+    Column3Of<kWide> colour[kMaterialColours.count];
+    ColumnOf<kWide> number[kMaterialNumbers.count];
     IndexColumnOf<kWide> type, use;
-    static constexpr size_t kReals = 15, kInts = 2;
+    static constexpr size_t kReals = 4 + 3 * kMaterialColours.count + kMaterialNumbers.count, kInts = 2;
     void bind(WideStore& store) {
-        store.bind(centre), store.bind(rho), store.bind(rho_r), store.bind(rho_t);
-        store.bind(radius), store.bind(eta), store.bind(roughness);
+        store.bind(centre), store.bind(radius);
+        for (auto& c : colour) store.bind(c);
+        for (auto& c : number) store.bind(c);
         store.bind(type), store.bind(use);
+    }
+    // Sphere s's material: its type and parameters (each column's member a constant, so each
+    // is one store, as a batch fills the table).
+    void set_material(size_t s, const Material& material) {
+        set_material(s, material, std::make_index_sequence<kMaterialColours.count>{},
+                     std::make_index_sequence<kMaterialNumbers.count>{});
+    }
+    template <size_t... C, size_t... N>
+    void set_material(size_t s, const Material& material, std::index_sequence<C...>, std::index_sequence<N...>) {
+        (colour[C].set(s, material.*kMaterialColours.members[C]), ...);
+        ((number[N].data()[s] = real(material.*kMaterialNumbers.members[N])), ...);
+        type.data()[s] = lane_int(material.type);
     }
 };
 // The area lights' values, by light.
@@ -197,16 +214,31 @@ struct LightTable {
 };
 KR_LANES vm of_type(vm type, MaterialType wanted) { return type == lane_int(wanted); }
 
-// A vertex's material as vertex.h reads it: the lanes' spheres' columns.
+// A vertex's material as vertex.h reads it: the lanes' spheres' columns, a parameter by its
+// member (rho gathered once per vertex by the path loop, which reads it for light samples too).
 template <class Table>
 struct LaneMaterial {
     const Table& table;
     vm sphere, type;
     V3 rho_;
     KR_LANES vm is(MaterialType wanted) const { return of_type(type, wanted); }
-    KR_LANES V3 rho() const { return rho_; }
-    KR_LANES V3 rho_r() const { return look_up(table.rho_r, sphere); }
-    KR_LANES V3 rho_t() const { return look_up(table.rho_t, sphere); }
-    KR_LANES vf eta() const { return look_up(table.eta, sphere); }
-    KR_LANES vf roughness() const { return look_up(table.roughness, sphere); }
+    template <auto member>
+    KR_LANES auto get() const {
+        if constexpr (std::is_same_v<decltype(member), Color Material::*>) {
+            constexpr size_t column = kMaterialColours.index(member);
+            static_assert(column < kMaterialColours.count, "not a parameter of material_params");
+            if constexpr (member == &Material::rho) return rho_;
+            else return look_up(table.colour[column], sphere);
+        } else {
+            constexpr size_t column = kMaterialNumbers.index(member);
+            static_assert(column < kMaterialNumbers.count, "not a parameter of material_params");
+            return look_up(table.number[column], sphere);
+        }
+    }
 };
+// The gather of rho that LaneMaterial's rho_ takes.
+template <class Table>
+KR_LANES V3 look_up_rho(const Table& table, vm sphere) {
+    constexpr size_t column = kMaterialColours.index(&Material::rho);
+    return look_up(table.colour[column], sphere);
+}

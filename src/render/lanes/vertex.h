@@ -72,15 +72,15 @@ struct OnePath {
     static KR_LANES double expm1(double x, bool) { return std::expm1(x); }
 };
 
-// One path's material, as the vertex code reads a material (the lanes read columns by sphere).
+// One path's material, as the vertex code reads a material (the lanes read columns by sphere):
+// its type, and any parameter by its member (`param<&Material::eta>(m)`, vertex.inc).
 struct OneMaterial {
     const Material& m;
     KR_LANES bool is(MaterialType type) const { return m.type == type; }
-    KR_LANES const Vec3& rho() const { return m.rho; }
-    KR_LANES const Vec3& rho_r() const { return m.rho_r; }
-    KR_LANES const Vec3& rho_t() const { return m.rho_t; }
-    KR_LANES double eta() const { return m.eta; }
-    KR_LANES double roughness() const { return m.roughness; }
+    template <auto member>
+    KR_LANES const auto& get() const {
+        return m.*member;
+    }
 };
 
 #include "render/lanes/vertex.inc"
