@@ -402,21 +402,22 @@ void RenderWorker::run() {
     int history_spp = 0;
     std::optional<Reprojection> prior;
     bool prior_made = false;
-    // Whether the history can stand for `job`'s view: the same world, radiance estimated alike.
-    auto history_fits = [&] {
-        const RenderSettings &a = job.settings, &b = history_settings;
-        return history && history_scene && job.scene && reprojectable(*job.scene) && same_world(*history_scene, *job.scene) &&
-               a.integrator == b.integrator && a.max_depth == b.max_depth && a.rr_depth == b.rr_depth &&
-               a.light_sampling == b.light_sampling;
+    // Whether a frame of `scene` made with `settings` can stand for `job`'s view: the same
+    // world, radiance estimated alike, a pinhole.
+    auto fits_job = [&](const RenderScene& scene, const RenderSettings& settings) {
+        const RenderSettings& a = job.settings;
+        return reprojectable(scene) && reprojectable(*job.scene) && same_world(scene, *job.scene) &&
+               a.integrator == settings.integrator && a.max_depth == settings.max_depth &&
+               a.rr_depth == settings.rr_depth && a.light_sampling == settings.light_sampling;
     };
-    // The newest full frame becomes the history when it has more samples than the history,
-    // or the history is of another world.
+    auto history_fits = [&] { return history && history_scene && fits_job(*history_scene, history_settings); };
+    // The newest full frame (an earlier job's) becomes the history when it could stand for
+    // `job`'s view and has more samples than the history, or the history could not.
     auto keep_history = [&] {
         if (!last_full || !last_full_scene || last_full->denoised.pixels.empty() || last_full->spp < 2 ||
-            !reprojectable(*last_full_scene) || (history && history->generation == last_full->generation))
+            (history && history->generation == last_full->generation) || !fits_job(*last_full_scene, last_full_settings))
             return;
-        const bool other_world = !history_scene || !same_world(*history_scene, *last_full_scene);
-        if (!other_world && last_full->spp <= history_spp) return;
+        if (history_fits() && last_full->spp <= history_spp) return;
         ViewHistory h;
         h.generation = last_full->generation;
         h.hits = view_hits(*last_full_scene, last_full->radiance.width, last_full->radiance.height);
@@ -602,7 +603,7 @@ void RenderWorker::run() {
                 // be the best picture of the world yet, and this view takes what it can of it.
                 prior_made = true;
                 try {
-                    keep_history();
+                    if (!region.region) keep_history();
                     if (!region.region && history_fits() && history->generation != job.generation)
                         prior = reproject(*job.scene, view_hits(*job.scene, w, h), *history);
                 } catch (const std::bad_alloc&) {
