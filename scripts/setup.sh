@@ -17,7 +17,9 @@ packages=(cmake g++ make pkg-config nlohmann-json3-dev libgtest-dev
           # the X server its window tests run under, with xdotool for real input events
           libglfw3-dev libgl-dev libosmesa6-dev libimgui-dev xvfb xdotool xauth
           # python3 reads a window back from the X server for the window tests (tests/x_window_shot.py)
-          python3
+          # and drops files on it (tests/x_drop.py); xprop sets the test X server's Xft.dpi
+          # (the UI-scale window test)
+          python3 x11-utils
           # the install tests (tests/install_check.sh): the Debian package's dependencies
           # (dpkg-shlibdeps, which CPack runs), the man page shown with man -l, the desktop
           # entry checked by desktop-file-validate
