@@ -236,6 +236,23 @@ TEST(KeyQueue, QuickCtrlAIsSeenAndTextAfterItWaits) {
     EXPECT_EQ(n, 7u);
 }
 
+// Ctrl+A as xdotool sends it (Ctrl goes up before A) between two frames: a frame starts with
+// Ctrl and A down, Ctrl's release waits for the next one (with it in the same frame, ImGui saw
+// an A without Ctrl: the outliner's filter lost its select-all after the viewer had idled).
+// Likewise a modifier pressed after a key waits: the key is not taken as a chord.
+TEST(KeyQueue, AModifierChangeAfterAKeysPressWaitsForTheNextFrame) {
+    KeyEventQueue q;
+    for (const KeyEvent& e : {key(kCtrl, 1), key(kA, 1, 2), key(kCtrl, 0, 2), key(kA, 0)}) q.push(e);
+    Frames f(q);
+    EXPECT_EQ(f.down(kA, true).size(), 1u);
+    EXPECT_EQ(f.down(kA).size(), 1u);
+    KeyEventQueue r;
+    for (const KeyEvent& e : {key(kD, 1), key(kCtrl, 1), key(kD, 0, 2), key(kCtrl, 0, 2)}) r.push(e);
+    Frames g(r);
+    EXPECT_EQ(g.down(kD, true).size(), 0u);  // D was pressed alone
+    EXPECT_EQ(g.down(kD).size(), 1u);
+}
+
 // B3: "2.8" and Enter, all between two frames: Enter is down at the start of one frame, by
 // which all the text has reached the field (it applies "2.8"); its release in a later one.
 TEST(KeyQueue, QuickEnterAfterTypingIsSeenWithTheText) {

@@ -1043,6 +1043,7 @@ TEST_F(ViewerWindow, OutlinerSelectsFramesAndRecolours) {
     EXPECT_EQ(r["selected_by_row"], "0");
     EXPECT_EQ(r["selected_by_row_again"], r["selected_on_image"]);
     EXPECT_EQ(r["filtered"], "2");  // "SPHERE 0": sphere 01 and sphere 02
+    EXPECT_EQ(r["filtered_more"], "1");  // "SPHERE 02"
     EXPECT_EQ(r["unfiltered"], "1");
     auto vec = [](const std::string& text) {
         kr::Vec3 v;

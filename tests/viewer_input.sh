@@ -627,11 +627,16 @@ outliner)
     click_at "row:o$sel" || exit 1
     wait_for "selected=$sel .*tab=object" || exit 1
     echo "selected_by_row_again=$(field selected)"
-    # The filter (case-insensitive): "SPHERE 0" lists sphere 01 and 02 only; cleared, all again.
+    # The filter (case-insensitive): "SPHERE 0" lists sphere 01 and 02 only, "SPHERE 02" only
+    # sphere 02 (so every typed key has been handled: "SPH" already lists the two); cleared,
+    # all again.
     click_at "outliner:filter" || exit 1
     xdotool type "SPHERE 0"
     wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o6:[0-9-]+,[0-9-]+;row:o7:[0-9-]+,[0-9-]+;tab:scene" || exit 1
     echo "filtered=$(field at | tr ';' '\n' | grep -c '^row:')"
+    xdotool type "2"
+    wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o7:[0-9-]+,[0-9-]+;tab:scene" || exit 1
+    echo "filtered_more=$(field at | tr ';' '\n' | grep -c '^row:')"
     xdotool key ctrl+a BackSpace Return
     wait_for "at=outliner:filter:[0-9-]+,[0-9-]+;row:o0:" || exit 1
     echo "unfiltered=1"

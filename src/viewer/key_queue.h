@@ -27,9 +27,11 @@ public:
 
     void push(const KeyEvent& e);
     // The events for the next frame, oldest first, up to the first that would hide one of
-    // them from the frame: a second change of a key already pressed or released in it, or
-    // text after a key that edits text (Enter, Backspace, arrows, a Ctrl chord) pressed in it
-    // (ImGui applies a frame's text before its keys). At least one event when any is queued.
+    // them from the frame: a second change of a key already pressed or released in it, a
+    // modifier that changes after a key's press in it (the key would be seen with the
+    // modifiers as they are at the frame's start), or text after a key that edits text
+    // (Enter, Backspace, arrows, a Ctrl chord) pressed in it (ImGui applies a frame's text
+    // before its keys). At least one event when any is queued.
     std::vector<KeyEvent> take_frame();
     bool empty() const { return pending_.empty(); }
 
