@@ -402,6 +402,10 @@ void RenderWorker::run() {
     int history_spp = 0;
     std::optional<Reprojection> prior;
     bool prior_made = false;
+    // The first surfaces of a view a prior was made for (`hits_generation`'s job): its frame,
+    // kept as the history later, takes them instead of tracing them again.
+    std::optional<ViewHits> view_hits_made;
+    uint64_t hits_generation = 0;
     // Whether a frame of `scene` made with `settings` can stand for `job`'s view: the same
     // world, radiance estimated alike, a pinhole.
     auto fits_job = [&](const RenderScene& scene, const RenderSettings& settings) {
@@ -420,7 +424,9 @@ void RenderWorker::run() {
         if (history_fits() && last_full->spp <= history_spp) return;
         ViewHistory h;
         h.generation = last_full->generation;
-        h.hits = view_hits(*last_full_scene, last_full->radiance.width, last_full->radiance.height);
+        if (view_hits_made && hits_generation == last_full->generation) h.hits = std::move(*view_hits_made);
+        else h.hits = view_hits(*last_full_scene, last_full->radiance.width, last_full->radiance.height);
+        view_hits_made.reset();
         h.picture = last_full->denoised;
         h.samples = last_full->sample_count;
         history = std::move(h);
@@ -604,13 +610,17 @@ void RenderWorker::run() {
                 prior_made = true;
                 try {
                     if (!region.region) keep_history();
-                    if (!region.region && history_fits() && history->generation != job.generation)
-                        prior = reproject(*job.scene, view_hits(*job.scene, w, h), *history);
+                    if (!region.region && history_fits() && history->generation != job.generation) {
+                        view_hits_made = view_hits(*job.scene, w, h);
+                        hits_generation = job.generation;
+                        prior = reproject(*job.scene, *view_hits_made, *history);
+                    }
                 } catch (const std::bad_alloc&) {
                     history.reset();  // only the carried picture is lost, not the job
                     history_scene.reset();
                     history_spp = 0;
                     prior.reset();
+                    view_hits_made.reset();
                 }
             }
             const auto start = Clock::now();
