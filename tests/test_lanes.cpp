@@ -280,9 +280,9 @@ TEST_P(Lanes, PointLightsEveryMaterialAndPartialPackets) {
     b.emitter({2, 5, 5}, 0.5, Color(0), grey);
     const RenderScene scene = b.build();
     ASSERT_TRUE(scene.bvh.lanes_cast());
-    ASSERT_EQ(scene.point_lights.size(), 2u);
-    ASSERT_EQ(scene.area_lights.size(), 4u);
-    ASSERT_EQ(scene.area_lights.back().select_prob, 0.0);
+    ASSERT_EQ(test::lights_of(scene, LightType::point).size(), 2u);
+    ASSERT_EQ(test::lights_of(scene, LightType::area).size(), 4u);
+    ASSERT_EQ(scene.lights.back().select_prob, 0.0);
     for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area}) {
         RenderSettings settings = settings_of(scene);
         settings.light_sampling = light;

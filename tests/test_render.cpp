@@ -163,6 +163,100 @@ TEST(MaterialLobes, SmoothLobeIsWhatSamplingDraws) {
     }
 }
 
+// Every light type's sample (vertex.inc's light_direct, as next-event estimation takes it)
+// against the analytic irradiance on a white-ish diffuse point facing the light, and what
+// light_kind says of the type against its prepared form: a light on a sphere carries that
+// sphere and its shadow rays end on it; a light at a point has its shadow rays end there.
+// Over every type, so a new one is checked too (its case below: a scene and its answer).
+TEST(Lights, EveryTypesSampleGivesItsIrradiance) {
+    const Color rho(0.5);
+    const double d = 4, radius = 1, power = 2;
+    for (size_t t = 0; t < light_type_names.names.size(); ++t) {
+        const LightType type = LightType(t);
+        SCOPED_TRACE(std::string(light_type_names.name(type)));
+        test::SceneBuilder b;
+        double irradiance = 0;  // at the origin, normal +y
+        switch (type) {
+        case LightType::point:  // I / d^2
+            b.point_light({0, d, 0}, Color(power));
+            irradiance = power / (d * d);
+            break;
+        case LightType::area:  // a sphere of radiance L wholly above the horizon: pi L (r / d)^2
+            b.emitter({0, d, 0}, radius, Color(power), b.material(MaterialType::diffuse, Color(0)));
+            irradiance = kPi * power * (radius / d) * (radius / d);
+            break;
+        }
+        const RenderScene scene = b.build();
+        ASSERT_EQ(scene.lights.size(), 1u);
+        const RenderLight& light = scene.lights[0];
+        const vertex::LightKind kind = vertex::light_kind(type);
+        EXPECT_EQ(kind.on_sphere, light.sphere >= 0);
+        EXPECT_EQ(scene.lights_off_spheres, kind.on_sphere ? 0u : 1u);
+        Material m;
+        m.type = MaterialType::diffuse;
+        m.rho = rho;
+        const Vec3 p{0, 0, 0}, ns{0, 1, 0};
+        // Stratified light numbers; the light sample alone (no MIS), selection divided out.
+        const int n = 64;
+        double sum = 0, sum2 = 0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                vertex::OneLightSample s;
+                const Vec2 u{(i + 0.5) / n, (j + 0.5) / n};
+                ASSERT_TRUE(vertex::light_direct<true>(scene, LightSampling::cone, light, m, p, ns, -1, false, u, s));
+                const Vec3 end = p + s.wi * s.distance;
+                if (kind.at_point) EXPECT_NEAR(length(end - light.position), 0, 1e-12);
+                if (kind.on_sphere) {
+                    EXPECT_EQ(s.to_sphere, light.sphere);
+                    EXPECT_NEAR(length(end - scene.spheres[size_t(light.sphere)].centre), radius, 1e-9);
+                } else {
+                    EXPECT_EQ(s.to_sphere, -1);
+                }
+                sum += s.light.x;
+                sum2 += s.light.x * s.light.x;
+            }
+        const double count = double(n) * n, mean = sum / count;
+        const double sigma = std::sqrt(std::max(0.0, sum2 / count - mean * mean) / count);
+        const double expected = rho.x / kPi * irradiance;
+        EXPECT_NEAR(mean, expected, 5 * sigma + 1e-12 * expected) << "expected " << expected;
+    }
+}
+
+// choose_light takes each light in proportion to its selection probability (a grid of u gives
+// the shares to within one step); naive path tracing takes only the lights off the spheres,
+// which come first; sphere_light names each light's sphere.
+TEST(Lights, ChoiceFollowsPowerAndNaiveTakesTheLightsOffTheSpheres) {
+    test::SceneBuilder b;
+    const int black = b.material(MaterialType::diffuse, Color(0));
+    b.emitter({0, 5, 0}, 1, Color(3), black);
+    b.point_light({2, 3, 0}, Color(1));
+    b.emitter({0, -5, 0}, 0.5, Color(8), black);
+    b.point_light({-2, 3, 0}, Color(5, 4, 3));
+    const RenderScene scene = b.build();
+    ASSERT_EQ(scene.lights.size(), 4u);
+    ASSERT_EQ(scene.lights_off_spheres, 2u);
+    for (size_t i = 0; i < scene.lights.size(); ++i)
+        EXPECT_EQ(vertex::light_kind(scene.lights[i].type).on_sphere, i >= scene.lights_off_spheres);
+    EXPECT_EQ(scene.lights[0].position, Vec3(2, 3, 0));  // the file's order within each group
+    for (size_t s = 0; s < scene.spheres.size(); ++s)
+        if (scene.sphere_light[s] >= 0) EXPECT_EQ(scene.lights[size_t(scene.sphere_light[s])].sphere, int(s));
+    const int n = 100000;
+    for (bool naive : {false, true}) {
+        std::vector<int> count(scene.lights.size() + 1, 0);  // the last: none
+        for (int i = 0; i < n; ++i) {
+            const int chosen = vertex::choose_light<vertex::OnePath>(scene, naive, (i + 0.5) / n);
+            count[chosen < 0 ? scene.lights.size() : size_t(chosen)]++;
+        }
+        double off_share = 0;
+        for (size_t i = 0; i < scene.lights.size(); ++i) {
+            const bool taken = !naive || i < scene.lights_off_spheres;
+            EXPECT_NEAR(count[i] / double(n), taken ? scene.lights[i].select_prob : 0.0, 2.0 / n) << naive << " " << i;
+            if (i < scene.lights_off_spheres) off_share += scene.lights[i].select_prob;
+        }
+        EXPECT_NEAR(count.back() / double(n), naive ? 1 - off_share : 0.0, 2.0 / n);
+    }
+}
+
 TEST(DirectLighting, SphereLightOnDiffuseFloor) {
     test::SceneBuilder b;
     const double rho = 0.5, le = 4.0, r = 0.5;

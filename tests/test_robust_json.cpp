@@ -168,7 +168,7 @@ TEST(RobustJson, HundredThousandPrimitives) {
     auto sec = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
     EXPECT_EQ(loaded.scene.primitives.size(), size_t(kCount));
     EXPECT_EQ(scene.spheres.size(), size_t(kCount));
-    EXPECT_EQ(scene.area_lights.size(), size_t(kCount / 2));
+    EXPECT_EQ(test::lights_of(scene, LightType::area).size(), size_t(kCount / 2));
     ASSERT_TRUE(all_finite(state));
     EXPECT_EQ(state.nonfinite_samples, 0u);
     double lit = 0;

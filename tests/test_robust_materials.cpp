@@ -207,8 +207,8 @@ TEST(RobustLights, ZeroAndHugePower) {
                 b.point_light({0, 3, -2}, Color(power));
             b.scene.cameras[0].fov = 5;  // the ball fills the image
             const RenderScene scene = b.build();
-            for (const PointLight& l : scene.point_lights) EXPECT_NEAR(l.select_prob, 1.0, 1e-15);
-            for (const AreaLight& l : scene.area_lights) EXPECT_NEAR(l.select_prob, 1.0, 1e-15);
+            ASSERT_EQ(scene.lights.size(), 1u);
+            EXPECT_NEAR(scene.lights[0].select_prob, 1.0, 1e-15);
             for (Integrator integrator : {Integrator::wrt, Integrator::pt}) {
                 const RenderState state = render(scene, settings_for(integrator, 4, 2), 6, 6, 2);
                 const Rgb8Image img = tonemap(state.radiance(), ToneMap::sigmoid);
@@ -235,17 +235,13 @@ TEST(RobustLights, ZeroAndHugePower) {
     b.emitter({0, 5, 0}, 1e150, Color(1e300), b.material(MaterialType::diffuse, Color(0)));
     const RenderScene scene = b.build();
     double total = 0;
-    for (const PointLight& l : scene.point_lights) {
-        EXPECT_TRUE(std::isfinite(l.select_prob));
-        total += l.select_prob;
-    }
-    for (const AreaLight& l : scene.area_lights) {
+    for (const RenderLight& l : scene.lights) {
         EXPECT_TRUE(std::isfinite(l.select_prob));
         total += l.select_prob;
     }
     EXPECT_NEAR(total, 1.0, 1e-12);
-    EXPECT_EQ(scene.point_lights[0].select_prob, 0.0);
-    EXPECT_GT(scene.area_lights[0].select_prob, 0.99);
+    EXPECT_EQ(test::lights_of(scene, LightType::point)[0].select_prob, 0.0);
+    EXPECT_GT(test::lights_of(scene, LightType::area)[0].select_prob, 0.99);
     // The tone maps on infinite and NaN radiance: white and black.
     Image img(3, 1);
     img.pixels = {Color(kInfinity), Color(std::nan("")), Color(1)};

@@ -230,4 +230,12 @@ inline SceneBuilder furnace(MaterialType type, Color rho, double le) {
     return b;
 }
 
+// The prepared scene's lights of one type, in their order in scene.lights.
+inline std::vector<RenderLight> lights_of(const RenderScene& scene, LightType type) {
+    std::vector<RenderLight> out;
+    for (const RenderLight& light : scene.lights)
+        if (light.type == type) out.push_back(light);
+    return out;
+}
+
 }  // namespace kr::test

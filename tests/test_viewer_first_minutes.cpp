@@ -599,16 +599,16 @@ TEST(SceneEdit, LightsOnAndOff) {
     ViewerModel m = test::brief_model(3);
     const Scene& s = m.scene();
     ASSERT_GT(s.lights.size(), s.active_lights.size());
-    const size_t point_lights = m.prepared()->point_lights.size();
+    const size_t point_lights = test::lights_of(*m.prepared(), LightType::point).size();
     int off = -1;
     for (int i = 0; i < int(s.lights.size()); ++i)
         if (std::find(s.active_lights.begin(), s.active_lights.end(), i) == s.active_lights.end()) off = i;
     ASSERT_GE(off, 0);
     ASSERT_EQ(s.lights[size_t(off)].type, LightType::point);
     ASSERT_TRUE(m.edit(Edit::light, [&](Scene& sc, ViewerSettings&) { set_light_on(sc, off, true); }));
-    EXPECT_EQ(m.prepared()->point_lights.size(), point_lights + 1);
+    EXPECT_EQ(test::lights_of(*m.prepared(), LightType::point).size(), point_lights + 1);
     ASSERT_TRUE(m.edit(Edit::light, [&](Scene& sc, ViewerSettings&) { set_light_on(sc, off, false); }));
-    EXPECT_EQ(m.prepared()->point_lights.size(), point_lights);
+    EXPECT_EQ(test::lights_of(*m.prepared(), LightType::point).size(), point_lights);
     // Every light off, one at a time: the scene still prepares.
     for (int i = 0; i < int(s.lights.size()); ++i) {
         ViewerModel each = test::brief_model(3);
@@ -714,7 +714,7 @@ TEST(SceneEdit, DuplicateDeleteAddMaterialEmissiveUndoAndSave) {
     EXPECT_EQ(moved.centre, before.shapes[size_t(before.primitives[size_t(ball)].shape)].centre + Vec3(0, 0, 2));
     ASSERT_TRUE(m.edit(Edit::object, [&](Scene& s, ViewerSettings&) { new_material_for(s, copy); }));
     ASSERT_TRUE(m.edit(Edit::object, [&](Scene& s, ViewerSettings&) { set_emissive(s, copy, true, Color(3)); }));
-    EXPECT_EQ(m.prepared()->area_lights.size(), 2u);
+    EXPECT_EQ(test::lights_of(*m.prepared(), LightType::area).size(), 2u);
     int added = -1;
     ASSERT_TRUE(m.edit(Edit::object, [&](Scene& s, ViewerSettings&) { added = add_sphere(s, Vec3(0, -4, 3), 0.7); }));
     ASSERT_TRUE(m.edit(Edit::object, [&](Scene& s, ViewerSettings&) { own_shape(s, added).radius = 0.9; }));

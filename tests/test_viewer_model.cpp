@@ -71,7 +71,7 @@ TEST(ResetRule, GenerationAdvancesOnlyOnImageEdits) {
     });
     EXPECT_EQ(m.prepared()->camera.lens_radius, 0.5);
     expect_reset(Edit::light, [](Scene& s, ViewerSettings&) { s.lights[size_t(s.active_lights[0])].power = Color(3); });
-    EXPECT_EQ(m.prepared()->area_lights[0].radiance, Color(3));
+    EXPECT_EQ(test::lights_of(*m.prepared(), LightType::area)[0].power, Color(3));
     expect_reset(Edit::material, [](Scene& s, ViewerSettings&) { s.materials[0].rho = Color(0.1); });
     expect_reset(Edit::renderer, [](Scene&, ViewerSettings& s) { s.render.max_depth = 2; });
     EXPECT_EQ(m.settings().render.max_depth, 2);
@@ -128,7 +128,7 @@ TEST(ResetRule, EditsThatMoveNoSphereKeepTheBvh) {
     up.d = {0, 1, 0};
     Hit hit;
     ASSERT_TRUE(model.prepared()->intersects(up, hit));
-    EXPECT_EQ(hit.sphere, model.prepared()->area_lights[0].sphere);
+    EXPECT_EQ(hit.sphere, test::lights_of(*model.prepared(), LightType::area)[0].sphere);
     EXPECT_NEAR(hit.t, 1.0, 1e-12);  // radius 3, not 2
     // A reload of the same file keeps it too.
     EXPECT_TRUE(kept(Edit::scene, [](Scene&, ViewerSettings&) {}));

@@ -79,11 +79,10 @@ TEST(LightsPanel, AnAreaLightSwitchedOffEmitsNothingInTheRenderTheFileAndTheCli)
     m.set_scene(small);
     const int area = light_named(m.scene(), "area light");
     ASSERT_GE(area, 0);
-    ASSERT_EQ(m.prepared()->area_lights.size(), 1u);
+    ASSERT_EQ(test::lights_of(*m.prepared(), LightType::area).size(), 1u);
     EXPECT_GT(brightest(*m.prepared(), 2), 0.1);
     ASSERT_TRUE(m.edit(Edit::light, [&](Scene& s, ViewerSettings&) { viewer::set_light_on(s, area, false); }));
-    EXPECT_TRUE(m.prepared()->area_lights.empty());
-    EXPECT_TRUE(m.prepared()->point_lights.empty());
+    EXPECT_TRUE(m.prepared()->lights.empty());
     for (int l : m.prepared()->sphere_light) EXPECT_EQ(l, -1);
     EXPECT_EQ(brightest(*m.prepared(), 2), 0.0);
     for (const std::string& w : m.warnings()) EXPECT_EQ(w.find("emits anyway"), std::string::npos) << w;
@@ -97,7 +96,7 @@ TEST(LightsPanel, AnAreaLightSwitchedOffEmitsNothingInTheRenderTheFileAndTheCli)
     const int carrier = primitive_named(loaded.scene, "area light");
     ASSERT_GE(carrier, 0);
     EXPECT_EQ(loaded.scene.primitives[size_t(carrier)].type, PrimitiveType::emissive);
-    EXPECT_TRUE(prepare_scene(loaded.scene).area_lights.empty());
+    EXPECT_TRUE(prepare_scene(loaded.scene).lights.empty());
     const test::CommandResult r = test::run_command(
         std::string("'") + KEITHRAY_EXE + "' render '" + file.string() + "' --spp 2 -q -o '" + image.string() + "'",
         fs::temp_directory_path());
@@ -110,7 +109,7 @@ TEST(LightsPanel, AnAreaLightSwitchedOffEmitsNothingInTheRenderTheFileAndTheCli)
     fs::remove(fs::path(image).replace_filename(image.stem().string() + "-depth.pfm"));
     // On again: it lights the room as before.
     ASSERT_TRUE(m.edit(Edit::light, [&](Scene& s, ViewerSettings&) { viewer::set_light_on(s, area, true); }));
-    EXPECT_EQ(m.prepared()->area_lights.size(), 1u);
+    EXPECT_EQ(test::lights_of(*m.prepared(), LightType::area).size(), 1u);
 }
 
 // B1: a light that cannot be seen says why: scene 3's point light sits inside the area

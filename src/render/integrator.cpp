@@ -36,17 +36,14 @@ struct Tracer {
         return r;
     }
 
-    // point_light_direct and area_light_direct with their shadow ray cast at once.
-    Color point_light_now(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp) {
-        Ray shadow;
-        Color direct;
-        return point_light_direct(light, m, hit, sp, shadow, direct) && visible(shadow) ? direct : Color();
-    }
-    Color area_light_now(const AreaLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp, Vec2 u) {
-        Ray shadow;
-        Color direct;
-        const bool lit = area_light_direct(scene, settings.light_sampling, light, m, hit, sp, false, 1.0, u, shadow, direct);
-        return lit && visible(shadow) ? direct : Color();
+    // A light's sample (vertex::light_direct, every light taken: no selection, no MIS) with its
+    // shadow ray cast at once. u: the vertex's light numbers, for a light on a sphere.
+    Color light_now(const RenderLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp, Vec2 u) {
+        vertex::OneLightSample sample;
+        if (!vertex::light_direct<false>(scene, settings.light_sampling, light, m, hit.p, sp.ns(), hit.sphere, false, u,
+                                         sample))
+            return {};
+        return visible(spawn(hit, sample.wi, sample.distance, sample.to_sphere)) ? sample.light : Color();
     }
 
     // ---- Whitted-style ray tracing: L D S* E, recursive. ----
@@ -58,17 +55,18 @@ struct Tracer {
         if (primary_distance) *primary_distance = hit.t;
         Color L;
         const int light_index = scene.sphere_light[hit.sphere];
-        if (light_index >= 0) L += medium.seen(scene.area_lights[light_index].radiance);
+        if (light_index >= 0) L += medium.seen(scene.lights[light_index].power);
         if (event > settings.max_depth) return L;
         const Material& m = scene.materials[scene.sphere_material[hit.sphere]];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         // By the material's lobes (vertex.inc's material_lobes), not its type.
         const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
         if (lobes.smooth) {
-            // Every point light exactly; every area light with one sample (distributed RT).
-            for (const PointLight& light : scene.point_lights) L += medium.seen(point_light_now(light, m, hit, sp));
-            for (const AreaLight& light : scene.area_lights)
-                L += medium.seen(area_light_now(light, m, hit, sp, sampler.next_2d()));
+            // Every light off the spheres exactly; every light on a sphere with one sample
+            // (distributed RT), which draws the vertex's next two numbers.
+            for (const RenderLight& light : scene.lights)
+                L += medium.seen(light_now(light, m, hit, sp,
+                                           vertex::light_kind(light.type).on_sphere ? sampler.next_2d() : Vec2{}));
         } else if (lobes.fresnel_split) {
             // Both branches, weighted by Fresnel: F rhoR L_r + (1 - F) rhoT L_t.
             const DielectricSplit split = split_dielectric(m, sp, ray.d);
@@ -113,8 +111,8 @@ struct Tracer {
             // Emission seen along the path, MIS-weighted where a light sample could have found it.
             const int light_index = scene.sphere_light[hit.sphere];
             if (light_index >= 0) {
-                const AreaLight& light = scene.area_lights[light_index];
-                L += medium.seen(throughput) * light.radiance *
+                const RenderLight& light = scene.lights[light_index];
+                L += medium.seen(throughput) * light.power *
                      emission_weight(scene, settings.light_sampling, light, hit, ray.d, history);
             }
             if (bounce >= settings.max_depth) break;

@@ -34,19 +34,8 @@ struct PathHistory {
 // The weight of emission seen along a path at `hit` (arriving along `incoming`): 1 where no
 // light sample could have found it, 0 where the last vertex's light sample counted all of it
 // (the brief's own strategy), else the power heuristic against that light sample.
-double emission_weight(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Hit& hit,
+double emission_weight(const RenderScene& scene, LightSampling sampling, const RenderLight& light, const Hit& hit,
                        const Vec3& incoming, const PathHistory& history);
-
-// Direct light from one point light at a surface with a smooth lobe (no selection pdf):
-// the shadow ray to cast and what it brings if nothing blocks it. False: nothing to bring.
-bool point_light_direct(const PointLight& light, const Material& m, const Hit& hit, const SurfacePoint& sp,
-                        Ray& shadow, Color& direct);
-
-// Light sample towards one area light; `mis` weights it against BSDF sampling. The shadow
-// ray to cast and what it brings if nothing blocks it; false: nothing to bring.
-bool area_light_direct(const RenderScene& scene, LightSampling sampling, const AreaLight& light, const Material& m,
-                       const Hit& hit, const SurfacePoint& sp, bool mis, double select_prob, Vec2 u, Ray& shadow,
-                       Color& direct);
 
 // Next-event estimation: one light, chosen in proportion to its power (point lights cannot be
 // hit by chance, so even naive mode samples them). The chosen light's shadow ray, and the

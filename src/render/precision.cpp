@@ -82,7 +82,8 @@ bool float_resolves_gaps(const RenderScene& scene) {
     // The largest 1-norm of a point rays start from or aim at: on a sphere, or a point light.
     double extent = 0;
     for (const SphereGeom& s : spheres) extent = std::max(extent, norm_l1(s.centre) + std::sqrt(3.0) * s.radius);
-    for (const PointLight& light : scene.point_lights) extent = std::max(extent, norm_l1(light.position));
+    for (const RenderLight& light : scene.lights)
+        if (vertex::light_kind(light.type).at_point) extent = std::max(extent, norm_l1(light.position));
     // A shadow segment towards a light is cut short by 64 epsilons of tmax + |o|_1 + |c|_1
     // (blocker B's centre), tmax + |o|_1 at most 3 extents; kFloatShadowEndUlps adds the
     // crossing's own rounding. Double precision's cut, the same in its epsilon, is "on the
@@ -95,8 +96,8 @@ bool float_resolves_gaps(const RenderScene& scene) {
     };
 
     // A point light within the float lanes' cut of a surface, but off it as double sees it.
-    for (const PointLight& light : scene.point_lights) {
-        if (!emits(light.intensity)) continue;
+    for (const RenderLight& light : scene.lights) {
+        if (!vertex::light_kind(light.type).at_point || !emits(light.power)) continue;
         for (const SphereGeom& s : spheres) {
             const double gap = std::abs(length(light.position - s.centre) - s.radius);
             if (gap > end_tolerance(s, kDoubleEpsilon) && gap < end_tolerance(s, kFloatEpsilon)) return false;
@@ -110,7 +111,7 @@ bool float_resolves_gaps(const RenderScene& scene) {
         margin = std::max({margin, end_tolerance(s, kFloatEpsilon), 2 * hit_tolerance(s, s)});
     const auto emitting = [&](size_t s) {
         const int light = scene.sphere_light.empty() ? -1 : scene.sphere_light[s];
-        return light >= 0 && emits(scene.area_lights[size_t(light)].radiance);
+        return light >= 0 && emits(scene.lights[size_t(light)].power);
     };
     // Whether the pair's near zones stay small: each sphere's within the hit tolerance of the
     // other, and a light's within the end tolerance of any other surface.
@@ -213,7 +214,8 @@ bool float_reach_fits(const RenderScene& scene) {
     const ReachBox lens = ReachBox::around(camera.position, std::max(camera.lens_radius, 0.0));
     // Where rays start or end outside the spheres: the lens and the point lights.
     ReachBox fixed_points = lens;
-    for (const PointLight& light : scene.point_lights) fixed_points.add(ReachBox::around(light.position, 0));
+    for (const RenderLight& light : scene.lights)
+        if (vertex::light_kind(light.type).at_point) fixed_points.add(ReachBox::around(light.position, 0));
     if (fixed_points.empty()) return false;  // a NaN position
     // Per sphere: its box, whether it counts whole, and the part rays reach so far.
     std::vector<ReachBox> box(n), reach(n);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/text.h"
+#include "render/lanes/vertex.h"
 #include "scene/load.h"
 
 namespace kr {
@@ -99,19 +100,30 @@ bool RenderScene::is_occluded_linear(const Ray& ray) const {
 namespace {
 
 // Whether two render scenes' lights are where the gap check (precision.h) looks: the same
-// point lights (position, whether they emit) and area lights (sphere, whether they emit).
+// lights at the same places (position, sphere), each emitting or not as before.
 bool same_light_geometry(const RenderScene& a, const RenderScene& b) {
     const auto emits = [](const Color& c) { return c != Color(); };
-    if (a.point_lights.size() != b.point_lights.size() || a.area_lights.size() != b.area_lights.size()) return false;
-    for (size_t i = 0; i < a.point_lights.size(); ++i)
-        if (a.point_lights[i].position != b.point_lights[i].position ||
-            emits(a.point_lights[i].intensity) != emits(b.point_lights[i].intensity))
+    if (a.lights.size() != b.lights.size()) return false;
+    for (size_t i = 0; i < a.lights.size(); ++i) {
+        const RenderLight &x = a.lights[i], &y = b.lights[i];
+        if (x.type != y.type || x.position != y.position || x.sphere != y.sphere || emits(x.power) != emits(y.power))
             return false;
-    for (size_t i = 0; i < a.area_lights.size(); ++i)
-        if (a.area_lights[i].sphere != b.area_lights[i].sphere ||
-            emits(a.area_lights[i].radiance) != emits(b.area_lights[i].radiance))
-            return false;
+    }
     return a.sphere_light == b.sphere_light;
+}
+
+// The natural log of a light's emitted power's luminance (lights are chosen in proportion to
+// it): 4 pi I for a point light, pi A Le for a sphere emitting from its outside. As a
+// logarithm: a file may hold an intensity of 1e308 or a radius of 1e200, whose power
+// overflows a double (and inf / inf would make every share NaN).
+double log_light_power(const RenderScene& rs, const RenderLight& light) {
+    const double scale = max_component(light.power);  // luminance(power / scale) is in (0.07, 1]
+    const double log_luminance = scale > 0 ? std::log(scale) + std::log(luminance(light.power / scale)) : -kInfinity;
+    switch (light.type) {
+    case LightType::point: return std::log(4.0 * kPi) + log_luminance;
+    case LightType::area: return std::log(4.0 * kPi * kPi) + 2.0 * std::log(rs.spheres[light.sphere].radius) + log_luminance;
+    }
+    return -kInfinity;
 }
 
 }  // namespace
@@ -126,14 +138,12 @@ bool same_world(const RenderScene& a, const RenderScene& b) {
     for (size_t i = 0; i < a.sphere_material.size(); ++i)
         if (!same_material(a.materials[size_t(a.sphere_material[i])], b.materials[size_t(b.sphere_material[i])]))
             return false;
-    if (a.point_lights.size() != b.point_lights.size() || a.area_lights.size() != b.area_lights.size()) return false;
-    for (size_t i = 0; i < a.point_lights.size(); ++i)
-        if (!(a.point_lights[i].position == b.point_lights[i].position) ||
-            !(a.point_lights[i].intensity == b.point_lights[i].intensity))
+    if (a.lights.size() != b.lights.size()) return false;
+    for (size_t i = 0; i < a.lights.size(); ++i) {
+        const RenderLight &x = a.lights[i], &y = b.lights[i];
+        if (x.type != y.type || !(x.position == y.position) || x.sphere != y.sphere || !(x.power == y.power))
             return false;
-    for (size_t i = 0; i < a.area_lights.size(); ++i)
-        if (a.area_lights[i].sphere != b.area_lights[i].sphere || !(a.area_lights[i].radiance == b.area_lights[i].radiance))
-            return false;
+    }
     const RendererSettings &ra = a.renderer, &rb = b.renderer;
     return ra.type == rb.type && ra.width == rb.width && ra.height == rb.height && ra.depth == rb.depth;
 }
@@ -176,6 +186,7 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
     };
 
     std::vector<bool> active(scene.lights.size(), false);
+    std::vector<RenderLight> on_spheres;  // the lights the primitives carry, by sphere
     for (int l : scene.active_lights) active[size_t(l)] = true;
 
     // One sphere per distinct shape: a repeated primitive would only hit itself again. The
@@ -225,8 +236,8 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         // sphere stays, with its material, and emits nothing (the viewer's light checkbox).
         if (prim.type == PrimitiveType::emissive && active[size_t(prim.light)]) {
             const Light& light = scene.lights[prim.light];
-            light_index = static_cast<int>(rs.area_lights.size());
-            rs.area_lights.push_back({static_cast<int>(rs.spheres.size()) - 1, light.power, 0});
+            light_index = static_cast<int>(on_spheres.size());
+            on_spheres.push_back({light.type, light.power, {}, static_cast<int>(rs.spheres.size()) - 1, 0});
             if (light.shape != prim.shape)
                 warn(path + "/shape", "differs from the shape of light " + quote_user_text(light.id) +
                                           "; the primitive's shape emits");
@@ -241,45 +252,33 @@ RenderScene prepare_scene(const Scene& scene, std::vector<std::string>* warnings
         if (prim.type == PrimitiveType::emissive && prim.light >= 0) carried[size_t(prim.light)] = true;
     for (size_t k = 0; k < scene.active_lights.size(); ++k) {
         const Light& light = scene.lights[scene.active_lights[k]];
-        if (light.type == LightType::point) {
-            rs.point_lights.push_back({light.position, light.power, 0});
+        if (!vertex::light_kind(light.type).on_sphere) {
+            rs.lights.push_back({light.type, light.power, light.position, -1, 0});
             continue;
         }
         if (!carried[size_t(scene.active_lights[k])])
             throw SceneError(file, "/scene/lights/" + std::to_string(k),
-                             "area light " + quote_user_text(light.id) +
+                             std::string(light_type_names.name(light.type)) + " light " + quote_user_text(light.id) +
                                  " is not carried by any emissive primitive; add one with \"light\": " +
                                  quote_user_text(light.id));
     }
+    // The lights on the spheres after those off them; sphere_light indexes the whole array.
+    rs.lights_off_spheres = rs.lights.size();
+    rs.lights.insert(rs.lights.end(), on_spheres.begin(), on_spheres.end());
+    for (int& light : rs.sphere_light)
+        if (light >= 0) light += int(rs.lights_off_spheres);
 
-    // Light selection probabilities proportional to emitted power (luminance):
-    // 4 pi I for a point light, pi A Le for a sphere emitting from its outside. Powers are
-    // compared as logarithms: a file may hold an intensity of 1e308 or a radius of 1e200,
-    // whose power overflows a double (and inf / inf would make every share NaN).
-    auto log_luminance = [](const Color& c) {
-        const double scale = max_component(c);  // luminance(c / scale) is in (0.07, 1]
-        return scale > 0 ? std::log(scale) + std::log(luminance(c / scale)) : -kInfinity;
-    };
+    // Light selection probabilities proportional to emitted power (luminance).
     std::vector<double> log_power;
-    for (const PointLight& l : rs.point_lights) log_power.push_back(std::log(4.0 * kPi) + log_luminance(l.intensity));
-    for (const AreaLight& l : rs.area_lights) {
-        const double r = rs.spheres[l.sphere].radius;
-        log_power.push_back(std::log(4.0 * kPi * kPi) + 2.0 * std::log(r) + log_luminance(l.radiance));
-    }
+    for (const RenderLight& light : rs.lights) log_power.push_back(log_light_power(rs, light));
     const size_t n = log_power.size();
     double log_max = -kInfinity, total = 0;
     for (double p : log_power) log_max = std::max(log_max, p);
     std::vector<double> power(n, 0.0);  // relative to the brightest light
     if (log_max > -kInfinity)
         for (size_t i = 0; i < n; ++i) total += power[i] = std::exp(log_power[i] - log_max);
-    for (size_t i = 0; i < n; ++i) {
-        // Equal shares when every light is black (keeps pdfs defined).
-        const double prob = total > 0 ? power[i] / total : 1.0 / double(n);
-        if (i < rs.point_lights.size())
-            rs.point_lights[i].select_prob = prob;
-        else
-            rs.area_lights[i - rs.point_lights.size()].select_prob = prob;
-    }
+    for (size_t i = 0; i < n; ++i)  // equal shares when every light is black (keeps pdfs defined)
+        rs.lights[i].select_prob = total > 0 ? power[i] / total : 1.0 / double(n);
     // The BVH depends on the spheres alone, and at many spheres its build is most of the
     // viewer's latency after a camera edit; the gap check depends on the spheres and the
     // lights (docs/performance.md, "Design choices and their figures").

@@ -43,26 +43,27 @@ struct SphereGeom {
     bool operator==(const SphereGeom&) const = default;
 };
 
-struct PointLight {
-    Vec3 position;
-    Color intensity;  // radiant intensity (W/sr per channel)
-    double select_prob = 0;
-};
-
-// A spherical emitter: an emissive primitive. Emits `radiance` from both sides of its surface.
-struct AreaLight {
-    int sphere = -1;
-    Color radiance;
-    double select_prob = 0;
+// A light of the scene block as the integrators read it. Each type's physics is in
+// lanes/vertex.inc, section "Lights" (light_kind says what the type is; light_direct samples it).
+struct RenderLight {
+    LightType type = LightType::point;
+    Color power;     // point: radiant intensity (W/sr per channel); area: emitted radiance
+    Vec3 position;   // point: where it is
+    int sphere = -1; // area: the sphere that emits, from both sides of its surface
+    double select_prob = 0;  // the chance next-event estimation takes it (by power)
+    bool operator==(const RenderLight&) const = default;
 };
 
 struct RenderScene {
     std::vector<SphereGeom> spheres;
     std::vector<int> sphere_material;  // per sphere: index into materials
-    std::vector<int> sphere_light;     // per sphere: index into area_lights, or -1
+    std::vector<int> sphere_light;     // per sphere: index into lights of the light it carries, or -1
     std::vector<Material> materials;   // only those the primitives use
-    std::vector<PointLight> point_lights;
-    std::vector<AreaLight> area_lights;
+    // The active lights: first those off the spheres (no ray finds them by chance, so naive
+    // path tracing samples only these) in the order /scene/lights lists them, then those on
+    // the spheres (light_kind's on_sphere) in the spheres' order.
+    std::vector<RenderLight> lights;
+    size_t lights_off_spheres = 0;  // how many lights come first, off the spheres
     CameraModel camera;
     RendererSettings renderer;  // the file's renderer block
 
@@ -84,7 +85,7 @@ struct RenderScene {
     // Builds the BVH over `spheres` (after edits to them or to the lights) and checks the gaps
     // between them again.
     void build_accel();
-    size_t light_count() const { return point_lights.size() + area_lights.size(); }
+    size_t light_count() const { return lights.size(); }
 };
 
 // Whether `a` and `b` render the same image (the same samples): their spheres, each sphere's

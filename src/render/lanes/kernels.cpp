@@ -164,6 +164,11 @@ struct CameraColumns {
 };
 #endif
 
+// Sphere s's light's row in the lanes' light table (which holds the lights on spheres), or -1.
+int light_row(const RenderScene& scene, size_t s) {
+    return scene.sphere_light[s] >= 0 ? scene.sphere_light[s] - int(scene.lights_off_spheres) : -1;
+}
+
 // The per-sphere and per-light tables of a batch and where its rays are cast: fixed columns
 // and the one leaf's spheres in turn for scenes of up to 16 spheres, columns in a buffer
 // (WideStore) and the lane tree for larger ones.
@@ -175,9 +180,9 @@ struct LaneScene<false> {
     LightTable<false> lights{};
     TestSphere test_spheres[kMaxLeafSpheres];
     size_t count;
-    lane_int emitters = 0;  // a bit per sphere: whether it is an area light's
-    IndexColumnOf<false> light{};  // per sphere, its area light's index, or -1
-    // The lanes whose hit sphere is an area light's.
+    lane_int emitters = 0;  // a bit per sphere: whether it carries a light
+    IndexColumnOf<false> light{};  // per sphere, its light's row in `lights`, or -1
+    // The lanes whose hit sphere carries a light.
     KR_LANES vm emits(vm hit_id) const { return (((vm{} + emitters) >> hit_id) & 1) != 0; }
     KR_LANES void closest(const V3& o, const V3& d, vm from, vm into, vm alive, vf& best, vm& best_id) const {
         closest_lanes(test_spheres, count, o, d, from, into, alive, best, best_id);
@@ -193,7 +198,7 @@ struct LaneScene<false> {
                                real(std::abs(geom.centre.x) + std::abs(geom.centre.y) + std::abs(geom.centre.z)),
                                int32_t(s)};
             if (scene.sphere_light[s] >= 0) emitters |= lane_int(1) << s;
-            light.v[s] = lane_int(scene.sphere_light[s]);
+            light.v[s] = lane_int(light_row(scene, s));
         }
     }
 };
@@ -202,7 +207,7 @@ struct LaneScene<true> {
     WideStore store;
     SphereTable<true> table;
     LightTable<true> lights;
-    IndexColumnOf<true> light;  // per sphere, its area light's index, or -1
+    IndexColumnOf<true> light;  // per sphere, its light's row in `lights`, or -1
     const LaneNode* nodes;
     const TestSphere* spheres;
     // Up to kLaneScanMaxSpheres the float lanes test every sphere, a cluster at a time
@@ -225,7 +230,7 @@ struct LaneScene<true> {
         table.bind(store);
         lights.bind(store);
         store.bind(light);
-        for (size_t s = 0; s < scene.spheres.size(); ++s) light.data()[s] = lane_int(scene.sphere_light[s]);
+        for (size_t s = 0; s < scene.spheres.size(); ++s) light.data()[s] = lane_int(light_row(scene, s));
         const LaneTree& tree = scene.bvh.lane_tree();
         nodes = tree.nodes.data();
 #ifdef KR_LANES_FLOAT
@@ -261,8 +266,8 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
     if constexpr (!Source::kSobolOnly)
         for (int k = 0; k < count; ++k) sobol_lanes &= samplers[k]->sobol();
 
-    // Per sphere: its material and what a vertex on it reads, and its light. Per area light:
-    // what its samples read. Where the rays are cast: the spheres or the tree.
+    // Per sphere: its material and what a vertex on it reads, and its light. Per light on a
+    // sphere: what its samples read. Where the rays are cast: the spheres or the tree.
     LaneScene<kWide> lane_scene(scene);
     auto& table = lane_scene.table;
     auto& lights = lane_scene.lights;
@@ -285,14 +290,15 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
         table.set_material(s, material);
         table.use.data()[s] = lane_int(numbers_used[material_index]);
     }
-    for (size_t i = 0; i < scene.area_lights.size(); ++i) {
-        const AreaLight& light = scene.area_lights[i];
+    for (size_t i = scene.lights_off_spheres; i < scene.lights.size(); ++i) {
+        const RenderLight& light = scene.lights[i];
         const SphereGeom& geom = scene.spheres[size_t(light.sphere)];
-        lights.centre.set(i, geom.centre);
-        lights.radius.data()[i] = real(geom.radius);
-        lights.radiance.set(i, light.radiance);
-        lights.select_prob.data()[i] = real(light.select_prob);
-        lights.sphere.data()[i] = lane_int(light.sphere);
+        const size_t row = i - scene.lights_off_spheres;
+        lights.centre.set(row, geom.centre);
+        lights.radius.data()[row] = real(geom.radius);
+        lights.radiance.set(row, light.power);
+        lights.select_prob.data()[row] = real(light.select_prob);
+        lights.sphere.data()[row] = lane_int(light.sphere);
     }
     for (;;) {
         // Lanes whose path has ended hand in its result and start the next sample's. The new
@@ -421,15 +427,17 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
                  gather(numbers, &Numbers::roulette)};
         }
 
-        // Diffuse vertices whose chosen light is an area light seen from outside (not the hit
+        // Diffuse vertices whose chosen light is on a sphere seen from outside (not the hit
         // sphere, the point outside it) sample it lane-wise, below.
         vm light_lane{}, light_to{};
         vm light_index{};  // the light a lane samples (light_lane), else 0
         vf light_select{}, light_radius{};
         V3 light_centre{};
-        if (lane_lights && !scene.area_lights.empty() && any_lane(smooth)) {
-            const vm area_index =
-                smooth ? vertex::choose_light<Lanes>(scene, false, u.light_pick).area : vm{} - 1;
+        if (lane_lights && scene.lights_off_spheres < scene.lights.size() && any_lane(smooth)) {
+            // The chosen light's row in `lights` (negative: none, or a light off the spheres).
+            const vm area_index = smooth ? vertex::choose_light<Lanes>(scene, false, u.light_pick) -
+                                               lane_int(scene.lights_off_spheres)
+                                         : vm{} - 1;
             light_index = (area_index >= 0) & area_index;
             light_select = look_up(lights.select_prob, light_index);
             light_to = look_up(lights.sphere, light_index);
@@ -481,7 +489,7 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
         const V3 shadow_o = p;
         const vm shadow_from = id;
 
-        // area_light_direct (integrator.cpp) for those lanes: the light sample, and what it
+        // light_direct (vertex.inc) for those lanes: the sphere light's sample, and what it
         // brings (vertex.h).
         if (any_lane(light_lane)) {
             const V3 light_radiance = look_up(lights.radiance, light_index);

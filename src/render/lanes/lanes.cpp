@@ -140,10 +140,8 @@ bool float_lanes_fit(const RenderScene& scene) {
             if (c[k] != 0 && !(std::abs(c[k]) >= 0x1.0p-60 && std::abs(c[k]) <= 0x1.0p60)) return false;
         return true;
     };
-    for (const AreaLight& light : scene.area_lights)
-        if (!in_range(light.radiance)) return false;
-    for (const PointLight& light : scene.point_lights)
-        if (!in_range(light.intensity)) return false;
+    for (const RenderLight& light : scene.lights)
+        if (!in_range(light.power)) return false;
     // Gaps: surfaces and lights no nearer each other than the lanes' rounding resolves.
     // Sizes (last, the dearest): each sphere's tests round to well under its radius
     // (float_sizes_fit, precision.h), once per pass.
