@@ -192,35 +192,19 @@ struct LightParam {
 namespace light_param_rows {
 
 constexpr LightParam vector_param(std::string_view name, Vec3 Light::*member, bool anchor, float edit_speed) {
-    LightParam p;
-    p.name = name;
-    p.kind = LightFieldKind::vector;
-    p.value = member;
-    p.expected = "an array of 3 finite numbers";
-    p.anchor = anchor;
-    p.edit_speed = edit_speed;
-    return p;
+    return {.name = name, .kind = LightFieldKind::vector, .value = member, .expected = "an array of 3 finite numbers",
+            .anchor = anchor, .edit_speed = edit_speed};
 }
 constexpr LightParam colour_param(std::string_view name, Color Light::*member, float edit_speed) {
-    LightParam p;
-    p.name = name;
-    p.kind = LightFieldKind::colour;
-    p.value = member;
-    p.expected = "an array of 3 numbers >= 0";
-    p.edit_speed = edit_speed;
-    return p;
+    return {.name = name, .kind = LightFieldKind::colour, .value = member, .expected = "an array of 3 numbers >= 0",
+            .edit_speed = edit_speed};
 }
+// A shape reference is where its light is.
 constexpr LightParam shape_param(std::string_view name, int Light::*member) {
-    LightParam p;
-    p.name = name;
-    p.kind = LightFieldKind::shape;
-    p.shape = member;
-    p.expected = "a shape id";
-    p.anchor = true;
-    return p;
+    return {.name = name, .kind = LightFieldKind::shape, .shape = member, .expected = "a shape id", .anchor = true};
 }
 
-// A point light: where it is and its radiant intensity (W/sr per channel).
+// A point light: where it is and its radiant intensity.
 inline constexpr LightParam kPoint[] = {vector_param("position", &Light::position, true, 0.02f),
                                         colour_param("power", &Light::power, 0.5f)};
 // An area light: the sphere that emits (carried by an emissive primitive over the same
