@@ -62,6 +62,11 @@ void expect_equal_scenes(const Scene& a, const Scene& b, bool compare_output = t
         EXPECT_EQ(x.position, y.position);
         EXPECT_EQ(x.power, y.power);
         EXPECT_EQ(x.shape, y.shape);
+        // And every field its type's row names (scene.h's light_params), a new type's too.
+        for (const LightParam& param : light_params(x.type)) {
+            if (param.kind == LightFieldKind::shape) EXPECT_EQ(x.*param.shape, y.*param.shape) << param.name;
+            else EXPECT_EQ(x.*param.value, y.*param.value) << param.name;
+        }
     }
     EXPECT_EQ(a.camera, b.camera);
     EXPECT_EQ(a.active_lights, b.active_lights);
