@@ -528,6 +528,109 @@ TEST_F(LoadErrors, MaterialParametersFollowTheTable) {
     }
 }
 
+// A light field's value in the file, by its kind (kBaseScene's shapes: "ball", "lamp").
+std::string light_field_text(const LightParam& param) {
+    switch (param.kind) {
+    case LightFieldKind::vector: return "[0, 4, 0]";
+    case LightFieldKind::colour: return "[100, 100, 100]";
+    case LightFieldKind::shape: return "\"lamp\"";
+    }
+    return "null";
+}
+
+// Light 1 of kBaseScene ("bulb", on in the scene block) as a light of `type` with its fields
+// but `missing`, and `bad` (a key's value text) in place of one field's value.
+std::string scene_with_light(LightType type, std::string_view missing = {}, std::string_view bad_key = {},
+                             std::string_view bad = {}) {
+    std::string l = R"({"id": "bulb", "type": ")" + std::string(light_type_names.name(type)) + "\"";
+    for (const LightParam& param : light_params(type))
+        if (param.name != missing)
+            l += ", \"" + std::string(param.name) + "\": " + (param.name == bad_key ? std::string(bad) : light_field_text(param));
+    l += "}";
+    const std::string s = test::edit_once(kBaseScene, R"({"id": "bulb", "type": "point", "position": [0, 4, 0], "power": [100, 100, 100]})", l);
+    return test::edit_once(s, R"("lights": ["lamp"],)", R"("lights": ["lamp", "bulb"],)");
+}
+
+TEST_F(LoadErrors, LightFieldsFollowTheTable) {
+    for (size_t t = 0; t < light_type_names.names.size(); ++t) {
+        const LightType type = LightType(t);
+        SCOPED_TRACE(std::string(light_type_names.name(type)));
+        const auto params = light_params(type);
+        ASSERT_FALSE(params.empty());
+        // Every field there: it loads, each value where its row puts it.
+        const LoadedScene loaded = load_ok(scene_with_light(type));
+        const Light& light = loaded.scene.lights[1];
+        EXPECT_EQ(light.type, type);
+        for (const LightParam& param : params) {
+            if (param.kind == LightFieldKind::shape) EXPECT_EQ(light.*param.shape, 1);
+            else EXPECT_EQ(light.*param.value, param.kind == LightFieldKind::vector ? Vec3(0, 4, 0) : Color(100));
+        }
+        for (const LightParam& param : params) {
+            const std::string name(param.name);
+            expect_error(scene_with_light(type, name), "/lights/1",
+                         "missing key \"" + name + "\"; expected " + std::string(param.expected));
+            // A value of the wrong kind, then (numbers) one out of range.
+            switch (param.kind) {
+            case LightFieldKind::vector:
+            case LightFieldKind::colour:
+                expect_error(scene_with_light(type, {}, name, "[1, 2]"), "/lights/1/" + name,
+                             "expected an array of 3 finite numbers, got");
+                break;
+            case LightFieldKind::shape:
+                expect_error(scene_with_light(type, {}, name, "\"moon\""), "/lights/1/" + name, "no shape with id \"moon\"");
+                break;
+            }
+            if (param.kind == LightFieldKind::colour)
+                expect_error(scene_with_light(type, {}, name, "[1, -1, 1]"), "/lights/1/" + name + "/1",
+                             "expected a value >= 0, got -1");
+        }
+        // An emissive primitive carries a light on a shape, and no other.
+        const std::string carried = test::edit_once(scene_with_light(type), R"("light": "lamp")", R"("light": "bulb")");
+        if (light_has_shape(type))
+            EXPECT_EQ(load_ok(carried).scene.primitives[3].light, 1);
+        else
+            expect_error(carried, "/scene/primitives/3/light",
+                         "light \"bulb\" is a \"" + std::string(light_type_names.name(type)) +
+                             "\" light; an emissive primitive expects an \"area\" light");
+    }
+    expect_error(test::edit_once(kBaseScene, R"(, "light": "lamp")", ""), "/scene/primitives/3",
+                 "missing key \"light\"; expected an area light id");
+}
+
+// Where each light type is (scene.h's light_anchor), which the viewer's outliner, gizmo and
+// placement ask: its anchor field's value, or a shape's index.
+TEST(LightAnchor, IsTheRowsAnchorField) {
+    for (size_t t = 0; t < light_type_names.names.size(); ++t) {
+        Light light;
+        light.type = LightType(t);
+        light.position = {1, 2, 3};
+        light.shape = 4;
+        const LightAnchor anchor = light_anchor(light);
+        const LightParam* field = nullptr;
+        for (const LightParam& param : light_params(light.type))
+            if (param.anchor && !field) field = &param;
+        if (!field) {
+            EXPECT_EQ(anchor.kind, LightAnchor::Kind::none);
+        } else if (field->kind == LightFieldKind::shape) {
+            EXPECT_EQ(anchor.kind, LightAnchor::Kind::shape);
+            EXPECT_EQ(anchor.shape, 4);
+        } else {
+            EXPECT_EQ(anchor.kind, LightAnchor::Kind::point);
+            EXPECT_EQ(anchor.point, light.*field->value);
+        }
+    }
+    Light point;
+    point.position = {1, 2, 3};
+    EXPECT_EQ(light_anchor(point).kind, LightAnchor::Kind::point);
+    EXPECT_EQ(light_anchor(point).point, Vec3(1, 2, 3));
+    Light area;
+    area.type = LightType::area;
+    area.shape = 2;
+    EXPECT_EQ(light_anchor(area).kind, LightAnchor::Kind::shape);
+    EXPECT_EQ(light_anchor(area).shape, 2);
+    EXPECT_TRUE(light_has_shape(kShapeLightType));
+}
+
 TEST_F(LoadErrors, LensCameraNeedsFocalDistanceAndAlpha) {
     expect_error(test::edit_once(kBaseScene, R"("type": "pinhole")", R"("type": "lens-based")"), "/cameras/0",
                  "missing key \"focal distance\"");

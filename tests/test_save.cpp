@@ -7,6 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "render/progressive.h"
 #include "scene/load.h"
@@ -59,6 +62,11 @@ void expect_equal_scenes(const Scene& a, const Scene& b, bool compare_output = t
         EXPECT_EQ(x.position, y.position);
         EXPECT_EQ(x.power, y.power);
         EXPECT_EQ(x.shape, y.shape);
+        // And every field its type's row names (scene.h's light_params), a new type's too.
+        for (const LightParam& param : light_params(x.type)) {
+            if (param.kind == LightFieldKind::shape) EXPECT_EQ(x.*param.shape, y.*param.shape) << param.name;
+            else EXPECT_EQ(x.*param.value, y.*param.value) << param.name;
+        }
     }
     EXPECT_EQ(a.camera, b.camera);
     EXPECT_EQ(a.active_lights, b.active_lights);
@@ -134,6 +142,52 @@ TEST_P(SaveScene, SavedSceneRendersTheSameImage) {
 }
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SaveScene, testing::Range(1, 9));
+
+// Every light type's fields (scene.h's light_params) are written in its row's order, after
+// its id and type, and load back equal.
+TEST(SaveSceneVariants, EveryLightTypeRoundTrips) {
+    Scene s;
+    Camera cam;
+    cam.id = "cam";
+    s.cameras = {cam};
+    s.camera = 0;
+    Material grey;
+    grey.id = "grey";
+    s.materials = {grey};
+    Shape ball;
+    ball.id = "ball";
+    Shape lamp = ball;
+    lamp.id = "lamp";
+    lamp.centre = {0, 3, 0};
+    s.shapes = {ball, lamp};
+    s.primitives = {{"ball", PrimitiveType::geometric, 0, 0, -1}};
+    s.renderer.output = "out.ppm";
+    for (size_t t = 0; t < light_type_names.names.size(); ++t) {
+        Light light;
+        light.type = LightType(t);
+        light.id = std::string(light_type_names.name(light.type));
+        // Values unlike the defaults, so a field not written or not read shows.
+        for (const LightParam& param : light_params(light.type)) {
+            if (param.kind == LightFieldKind::shape) light.*param.shape = 1;
+            else light.*param.value = param.kind == LightFieldKind::vector ? Vec3(1e-7, 2e5, -3) : Color(30, 20, 10.5);
+        }
+        s.lights.push_back(light);
+        s.active_lights.push_back(int(t));
+        if (light_has_shape(light.type)) s.primitives.push_back({light.id, PrimitiveType::emissive, 1, 0, int(t)});
+    }
+    const std::string text = scene_to_json(s);
+    const LoadedScene back = parse_scene(text, "");
+    EXPECT_TRUE(back.warnings.empty());
+    expect_equal_scenes(s, back.scene);
+    const nlohmann::ordered_json file = nlohmann::ordered_json::parse(text);
+    ASSERT_EQ(file["lights"].size(), s.lights.size());
+    for (size_t t = 0; t < s.lights.size(); ++t) {
+        std::vector<std::string> keys, expected = {"id", "type"};
+        for (const auto& [key, value] : file["lights"][t].items()) keys.push_back(key);
+        for (const LightParam& param : light_params(s.lights[t].type)) expected.emplace_back(param.name);
+        EXPECT_EQ(keys, expected);
+    }
+}
 
 // Every camera, material and light variant the format has, used or not, survives.
 TEST(SaveSceneVariants, EveryTypeRoundTrips) {

@@ -393,18 +393,40 @@ void Loader::read_light(const Json& j, const std::string& pointer, size_t index)
     const Owner owner{Category::lights, index};
     std::tie(light.id, light.type) = header(j, pointer, &lights_, light_type_names, "light");
     std::vector<Field> fields = {id_field(), type_field()};
-    if (light.type == LightType::point)
-        fields.push_back({"position", "an array of 3 finite numbers",
-                          [&](const Json& v, const std::string& p) { light.position = vec3(v, p); }});
-    else
-        fields.push_back({"shape", "a shape id", [&](const Json& v, const std::string& p) {
-                              light.shape = static_cast<int>(resolve(shapes_, v, p));
-                          }});
-    fields.push_back({"power", "an array of 3 numbers >= 0", [&](const Json& v, const std::string& p) {
-                          light.power = color(v, p, owner, false);
-                      }});
+    for (const LightParam& param : light_params(light.type)) {
+        std::function<void(const Json&, const std::string&)> read;
+        switch (param.kind) {
+        case LightFieldKind::vector:
+            read = [&, t = &(light.*param.value)](const Json& v, const std::string& p) { *t = vec3(v, p); };
+            break;
+        case LightFieldKind::colour:
+            read = [&, t = &(light.*param.value)](const Json& v, const std::string& p) {
+                *t = color(v, p, owner, false);
+            };
+            break;
+        case LightFieldKind::shape:
+            read = [&, t = &(light.*param.shape)](const Json& v, const std::string& p) {
+                *t = static_cast<int>(resolve(shapes_, v, p));
+            };
+            break;
+        }
+        fields.push_back({std::string(param.name), std::string(param.expected), std::move(read)});
+    }
     read_fields(j, pointer, fields);
     out_.scene.lights.push_back(std::move(light));
+}
+
+// The lights an emissive primitive may carry, those whose row names a shape, in words:
+// "an area light", or quoted as type names, "an \"area\" light".
+std::string shape_light_words(bool quoted) {
+    std::string names;
+    for (size_t t = 0; t < light_type_names.names.size(); ++t) {
+        if (!light_has_shape(LightType(t))) continue;
+        const std::string name(light_type_names.names[t]);
+        names += (names.empty() ? "" : " or ") + (quoted ? in_quotes(name) : name);
+    }
+    const bool vowel = names.find_first_of("aeiou") == (quoted ? 1 : 0);
+    return (vowel ? "an " : "a ") + names + " light";
 }
 
 void Loader::read_primitive(const Json& j, const std::string& pointer) {
@@ -422,13 +444,13 @@ void Loader::read_primitive(const Json& j, const std::string& pointer) {
          }},
     };
     if (prim.type == PrimitiveType::emissive)
-        fields.push_back({"light", "an area light id", [&](const Json& v, const std::string& p) {
+        fields.push_back({"light", shape_light_words(false) + " id", [&](const Json& v, const std::string& p) {
                               const size_t l = resolve(lights_, v, p);
                               const Light& light = out_.scene.lights[l];
-                              if (light.type != LightType::area)
+                              if (!light_has_shape(light.type))
                                   fail(p, "light " + in_quotes(light.id) + " is a " +
                                               in_quotes(light_type_names.name(light.type)) +
-                                              " light; an emissive primitive expects an \"area\" light");
+                                              " light; an emissive primitive expects " + shape_light_words(true));
                               prim.light = static_cast<int>(l);
                           }});
     read_fields(j, pointer, fields);
@@ -536,7 +558,7 @@ void Loader::read_display(const Json& j, const std::string& pointer) {
 }
 
 // Which objects the scene block uses: the active camera, the active lights, the
-// primitives' shapes, materials and lights, and the shapes of the area lights used.
+// primitives' shapes, materials and lights, and the shapes the lights used name.
 Loader::Usage Loader::usage() const {
     const Scene& s = out_.scene;
     Usage used;
@@ -551,8 +573,12 @@ Loader::Usage Loader::usage() const {
         used.materials[size_t(p.material)] = true;
         if (p.light >= 0) used.lights[size_t(p.light)] = true;
     }
-    for (size_t l = 0; l < s.lights.size(); ++l)
-        if (used.lights[l] && s.lights[l].shape >= 0) used.shapes[size_t(s.lights[l].shape)] = true;
+    for (size_t l = 0; l < s.lights.size(); ++l) {
+        if (!used.lights[l]) continue;
+        for (const LightParam& param : light_params(s.lights[l].type))
+            if (param.kind == LightFieldKind::shape && s.lights[l].*param.shape >= 0)
+                used.shapes[size_t(s.lights[l].*param.shape)] = true;
+    }
     return used;
 }
 

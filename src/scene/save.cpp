@@ -80,9 +80,11 @@ std::string scene_to_json(const Scene& scene) {
         const ReleasedOnExit<Json> freed{j};
         j["id"] = l.id;
         j["type"] = light_type_names.name(l.type);
-        if (l.type == LightType::point) j["position"] = vec3(l.position);
-        else j["shape"] = id_of(scene.shapes, l.shape, "light shape");
-        j["power"] = vec3(l.power);
+        for (const LightParam& param : light_params(l.type)) {
+            const std::string key(param.name);
+            if (param.kind == LightFieldKind::shape) j[key] = id_of(scene.shapes, l.*param.shape, ("light " + key).c_str());
+            else j[key] = vec3(l.*param.value);
+        }
         root["lights"].push_back(std::move(j));
     }
     Json block = Json::object();

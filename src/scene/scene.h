@@ -169,6 +169,92 @@ struct Light {
     int shape = -1;   // area only: index into Scene::shapes
 };
 
+// One field of a light type as the file names it, read by the loader, written by the saver
+// and shown by the viewer's Lights and Selection panels: what kind of value it holds, the
+// member it sets, the words a missing key's message says, and the panel's step.
+enum class LightFieldKind {
+    vector,  // three finite numbers (a position, a direction)
+    colour,  // three numbers >= 0 (a power)
+    shape,   // a shape's id in the file, an index into Scene::shapes here
+};
+struct LightParam {
+    std::string_view name;            // "position", "shape", "power"
+    LightFieldKind kind = LightFieldKind::vector;
+    Vec3 Light::*value = nullptr;     // a vector's or a colour's member (Color is Vec3)
+    int Light::*shape = nullptr;      // a shape reference's member
+    std::string_view expected;        // a missing key's words: "an array of 3 finite numbers"
+    // Where the light is: its point (a vector) or its sphere (a shape reference); a light
+    // with no such field (one at infinity) is nowhere in the scene (light_anchor).
+    bool anchor = false;
+    float edit_speed = 0.1f;          // the panel's step per pixel dragged
+};
+
+namespace light_param_rows {
+
+constexpr LightParam vector_param(std::string_view name, Vec3 Light::*member, bool anchor, float edit_speed) {
+    return {.name = name, .kind = LightFieldKind::vector, .value = member, .expected = "an array of 3 finite numbers",
+            .anchor = anchor, .edit_speed = edit_speed};
+}
+constexpr LightParam colour_param(std::string_view name, Color Light::*member, float edit_speed) {
+    return {.name = name, .kind = LightFieldKind::colour, .value = member, .expected = "an array of 3 numbers >= 0",
+            .edit_speed = edit_speed};
+}
+// A shape reference is where its light is.
+constexpr LightParam shape_param(std::string_view name, int Light::*member) {
+    return {.name = name, .kind = LightFieldKind::shape, .shape = member, .expected = "a shape id", .anchor = true};
+}
+
+// A point light: where it is and its radiant intensity.
+inline constexpr LightParam kPoint[] = {vector_param("position", &Light::position, true, 0.02f),
+                                        colour_param("power", &Light::power, 0.5f)};
+// An area light: the sphere that emits (carried by an emissive primitive over the same
+// shape) and its emitted radiance.
+inline constexpr LightParam kArea[] = {shape_param("shape", &Light::shape), colour_param("power", &Light::power, 0.1f)};
+
+}  // namespace light_param_rows
+
+// The fields of a light type, in the file's order.
+constexpr std::span<const LightParam> light_params(LightType type) {
+    using namespace light_param_rows;
+    switch (type) {
+    case LightType::point: return kPoint;
+    case LightType::area: return kArea;
+    }
+    return {};
+}
+
+// Whether a light of this type is a shape's surface, which an emissive primitive carries
+// (its row names a shape).
+constexpr bool light_has_shape(LightType type) {
+    for (const LightParam& param : light_params(type))
+        if (param.kind == LightFieldKind::shape) return true;
+    return false;
+}
+
+// The type of the light the viewer gives a primitive made emissive: the first with a shape.
+inline constexpr LightType kShapeLightType = [] {
+    for (size_t t = 0; t < light_type_names.names.size(); ++t)
+        if (light_has_shape(LightType(t))) return LightType(t);
+    return LightType::area;
+}();
+
+// Where a light is, from its row's anchor field: a point, a shape (an index into
+// Scene::shapes, possibly -1 in a scene built in code), or nowhere (no anchor field).
+struct LightAnchor {
+    enum class Kind { none, point, shape };
+    Kind kind = Kind::none;
+    Vec3 point{};
+    int shape = -1;
+};
+constexpr LightAnchor light_anchor(const Light& light) {
+    for (const LightParam& param : light_params(light.type)) {
+        if (!param.anchor) continue;
+        if (param.kind == LightFieldKind::shape) return {LightAnchor::Kind::shape, Vec3{}, light.*param.shape};
+        return {LightAnchor::Kind::point, light.*param.value, -1};
+    }
+    return {};
+}
+
 struct Primitive {
     std::string id;
     PrimitiveType type = PrimitiveType::geometric;

@@ -79,10 +79,10 @@ std::optional<Ball> selection_ball(const Scene& scene, const Selection& selectio
     if (selection.light) {
         const int l = *selection.light;
         if (l < 0 || size_t(l) >= scene.lights.size()) return std::nullopt;
-        const Light& light = scene.lights[size_t(l)];
-        if (light.type == LightType::point) return Ball{light.position, 0};
-        if (light.shape >= 0 && size_t(light.shape) < scene.shapes.size())
-            return Ball{scene.shapes[size_t(light.shape)].centre, scene.shapes[size_t(light.shape)].radius};
+        const LightAnchor anchor = light_anchor(scene.lights[size_t(l)]);
+        if (anchor.kind == LightAnchor::Kind::point) return Ball{anchor.point, 0};
+        if (anchor.kind == LightAnchor::Kind::shape && anchor.shape >= 0 && size_t(anchor.shape) < scene.shapes.size())
+            return Ball{scene.shapes[size_t(anchor.shape)].centre, scene.shapes[size_t(anchor.shape)].radius};
     }
     return std::nullopt;
 }

@@ -21,11 +21,14 @@ void set_light_on(Scene& scene, int index, bool on) {
 std::string light_unseen_reason(const Scene& scene, int index) {
     const Light& light = scene.lights[size_t(index)];
     if (!(max_component(light.power) > 0)) return "its power is 0: it emits nothing";
-    // The point (or sphere) that emits, and the primitive that carries an area light.
-    Vec3 at = light.position;
+    // The point (or sphere) that emits, and the primitive that carries a light on a shape;
+    // a light with no place in the scene (scene.h's light_anchor) is inside no sphere.
+    const LightAnchor anchor = light_anchor(light);
+    if (anchor.kind == LightAnchor::Kind::none) return {};
+    Vec3 at = anchor.point;
     double radius = 0;
     int carrier = -1;
-    if (light.type == LightType::area) {
+    if (anchor.kind == LightAnchor::Kind::shape) {
         for (size_t i = 0; i < scene.primitives.size() && carrier < 0; ++i)
             if (scene.primitives[i].type == PrimitiveType::emissive && scene.primitives[i].light == index)
                 carrier = int(i);
@@ -262,8 +265,9 @@ SpherePlace free_sphere_place(const Scene& scene, const Vec3& eye, const Vec3& t
             else return 0.0;
         }
         for (int l : scene.active_lights) {
-            const Light& light = scene.lights[size_t(l)];
-            if (light.type == LightType::point) free = std::min(free, length(c - light.position));
+            // A light on a shape is a primitive's sphere, counted above.
+            const LightAnchor anchor = light_anchor(scene.lights[size_t(l)]);
+            if (anchor.kind == LightAnchor::Kind::point) free = std::min(free, length(c - anchor.point));
         }
         return free;
     };
@@ -301,7 +305,7 @@ void set_emissive(Scene& scene, int p, bool emissive, const Color& power) {
     own_shape(scene, p);
     Light light;
     light.id = unused_id(scene.lights, prim.id + " light");
-    light.type = LightType::area;
+    light.type = kShapeLightType;
     light.power = power;
     light.shape = prim.shape;
     scene.lights.push_back(light);

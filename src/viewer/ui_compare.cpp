@@ -270,13 +270,18 @@ void draw_inspector(PanelContext& ctx, const PixelRect& rect) {
         draw->PopClipRect();
     }
     // A light selected as itself in the outliner (a point light): a marker where it is, as
-    // a light gizmo (drawn over whatever hides it), or its name where it is off the image.
+    // a light gizmo (drawn over whatever hides it), or its name where it is off the image
+    // (or nowhere: a light with no place in the scene, scene.h's light_anchor).
     if (const auto l = ctx.ui.selected_light;
         l && !ctx.selection() && model.prepared() && size_t(*l) < model.scene().lights.size()) {
         const Light& light = model.scene().lights[size_t(*l)];
-        const Vec3 at = light.type == LightType::point || light.shape < 0 ? light.position
-                                                                          : model.scene().shapes[size_t(light.shape)].centre;
-        const auto p = project_sphere(model.prepared()->camera, at, 0);
+        const LightAnchor anchor = light_anchor(light);
+        const auto& shapes = model.scene().shapes;
+        const bool on_shape = anchor.kind == LightAnchor::Kind::shape && anchor.shape >= 0 && size_t(anchor.shape) < shapes.size();
+        const std::optional<ImageCircle> p =
+            on_shape ? project_sphere(model.prepared()->camera, shapes[size_t(anchor.shape)].centre, 0)
+            : anchor.kind == LightAnchor::Kind::point ? project_sphere(model.prepared()->camera, anchor.point, 0)
+                                                      : std::nullopt;
         const PixelRect view = ctx.view_area();
         const ImU32 orange = IM_COL32(255, 160, 0, 255);
         if (p && p->fx >= 0 && p->fx <= 1 && p->fy >= 0 && p->fy <= 1) {

@@ -1,4 +1,6 @@
-// The Lights panel: each active light's position and power; an area light's sphere.
+// The Lights panel: every light of the file with its fields as the file has them (scene.h's
+// light_params through light_fields): a point light's position and power; an area light's
+// sphere and power.
 #include <string>
 
 #include <imgui.h>
@@ -30,23 +32,16 @@ void panel_lights(PanelContext& ctx) {
         ImGui::BeginDisabled(!on);
         Light edited = light;
         const std::string name = "light " + light.id;
-        if (light.type == LightType::point) {
-            bool changed = field(ctx, "position", &edited.position.x, 3, 0.02f, -kHuge, kHuge);
-            // "power" as the file says it: a point light's intensity, an area light's radiance.
-            changed |= power_fields(ctx, edited.power, 0.5f);
-            if (changed && on)
-                ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = edited; }, name, name);
-        } else {
-            Shape shape = scene.shapes[size_t(light.shape)];
-            bool changed = field(ctx, "position", &shape.centre.x, 3, 0.02f, -kHuge, kHuge);
-            changed |= field(ctx, "radius", &shape.radius, 1, 0.005f, 1e-4, kHuge);
-            changed |= power_fields(ctx, edited.power);
-            if (changed && on)
-                ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) {
-                    s.lights[size_t(index)] = edited;
-                    s.shapes[size_t(light.shape)] = shape;
-                }, name, name);
-        }
+        // Its fields as the file has them; a light on a shape edits that sphere here too.
+        const LightAnchor anchor = light_anchor(light);
+        const int on_shape = anchor.kind == LightAnchor::Kind::shape && anchor.shape >= 0 &&
+                                     size_t(anchor.shape) < scene.shapes.size() ? anchor.shape : -1;
+        Shape shape = on_shape >= 0 ? scene.shapes[size_t(on_shape)] : Shape{};
+        if (light_fields(ctx, edited, on_shape >= 0 ? &shape : nullptr) && on)
+            ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) {
+                s.lights[size_t(index)] = edited;
+                if (on_shape >= 0) s.shapes[size_t(on_shape)] = shape;
+            }, name, name);
         ImGui::EndDisabled();
         ImGui::PopID();
     }

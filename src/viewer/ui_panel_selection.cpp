@@ -33,12 +33,8 @@ void light_section(PanelContext& ctx, int index) {
     const std::string name = "light " + light.id;
     bool changed = false;
     ImGui::BeginDisabled(!on);
-    if (light.type == LightType::point) {
-        changed |= field(ctx, "position", &light.position.x, 3, 0.02f, -kHuge, kHuge);
-        changed |= power_fields(ctx, light.power, 0.5f);
-    } else {
-        changed |= power_fields(ctx, light.power);
-    }
+    // Its fields as the file has them; a light on a shape shows its sphere in the Lights panel.
+    changed |= light_fields(ctx, light, nullptr);
     ImGui::EndDisabled();
     if (changed && on) ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(index)] = light; }, name, name);
 }
@@ -153,12 +149,15 @@ void panel_selection(PanelContext& ctx) {
     // Its light's power, greyed while it has none: checking "emissive" moves no control.
     const Primitive& after = ctx.model.scene().primitives[size_t(p)];
     const bool has_light = after.type == PrimitiveType::emissive && after.light >= 0;
-    Light light = has_light ? ctx.model.scene().lights[size_t(after.light)] : Light{};
+    // Without one, the fields of the light an emissive primitive gets (greyed).
+    Light light;
+    light.type = kShapeLightType;
+    if (has_light) light = ctx.model.scene().lights[size_t(after.light)];
     ImGui::SameLine();
     ImGui::TextDisabled("%s", has_light ? ("light " + light.id).c_str() : "no light");
     ImGui::BeginDisabled(!has_light);
     const int light_index = after.light;
-    if (power_fields(ctx, light.power) && has_light)
+    if (light_fields(ctx, light, nullptr) && has_light)
         ctx.edit(Edit::light, [&](Scene& s, ViewerSettings&) { s.lights[size_t(light_index)] = light; }, name, name);
     ImGui::EndDisabled();
 }

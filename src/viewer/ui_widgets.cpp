@@ -76,8 +76,8 @@ bool colour_picker(const char* label, Color& c) {
     return true;
 }
 
-bool power_fields(PanelContext& ctx, Color& power, float speed) {
-    bool changed = field(ctx, "power", &power.x, 3, speed, 0.0, kHuge);
+bool power_fields(PanelContext& ctx, const char* label, Color& power, float speed) {
+    bool changed = field(ctx, label, &power.x, 3, speed, 0.0, kHuge);
     // power = colour x strength: the colour's largest component is 1.
     ColourStrength cs = split_power(power);
     bool split = colour_picker("light colour", cs.colour);
@@ -99,6 +99,25 @@ bool material_fields(PanelContext& ctx, Material& m) {
             changed |= field(ctx, label.c_str(), &(m.*param.colour).x, 3, 0.005f, 0.0, 1.0);
         } else
             changed |= field(ctx, label.c_str(), &(m.*param.number), 1, param.edit_speed, param.edit_lo, param.edit_hi);
+    }
+    return changed;
+}
+
+bool light_fields(PanelContext& ctx, Light& light, Shape* shape) {
+    bool changed = false;
+    for (const LightParam& param : light_params(light.type)) {
+        const std::string label(param.name);
+        switch (param.kind) {
+        case LightFieldKind::vector:
+            changed |= field(ctx, label.c_str(), &(light.*param.value).x, 3, param.edit_speed, -kHuge, kHuge);
+            break;
+        case LightFieldKind::colour: changed |= power_fields(ctx, label.c_str(), light.*param.value, param.edit_speed); break;
+        case LightFieldKind::shape:
+            if (!shape) break;
+            changed |= field(ctx, "position", &shape->centre.x, 3, 0.02f, -kHuge, kHuge);
+            changed |= field(ctx, "radius", &shape->radius, 1, 0.005f, 1e-4, kHuge);
+            break;
+        }
     }
     return changed;
 }

@@ -24,9 +24,17 @@ bool field_int(PanelContext& ctx, const char* label, int& v, int lo, int hi);
 
 // A colour swatch on the line before, opening ImGui's picker (ColorEdit3, values in [0, 1]).
 bool colour_picker(const char* label, Color& c);
-// A light's power as the file has it ("power"), and the same split as a colour (a picker,
-// its largest component 1) times a "strength" (split_power): editing either sets the power.
-bool power_fields(PanelContext& ctx, Color& power, float speed = 0.1f);
+// A light's power as the file has it (`label`, "power"), and the same split as a colour (a
+// picker, its largest component 1) times a "strength" (split_power): editing either sets it.
+bool power_fields(PanelContext& ctx, const char* label, Color& power, float speed);
+
+// A light's fields as the file has them (scene.h's light_params), each at its row's step: a
+// vector as three numbers, a colour as power_fields, a shape reference as its sphere's
+// "position" (centre) and "radius" where `shape` is given (the shape it names, edited in
+// place: the Lights panel), else nothing (the Selection panel shows an object's sphere under
+// Shape). True when `light` or `*shape` was changed. The Lights panel and the Selection
+// panel both edit lights through it.
+bool light_fields(PanelContext& ctx, Light& light, Shape* shape);
 
 // A material's type and its parameters as the file has them (scene.h's material_params):
 // colour parameters as a picker and three numbers. True when `m` was changed. The Materials
