@@ -148,8 +148,7 @@ Options parse_options(int argc, char** argv) {
 // thread, whose team is then never started: its passes cost a few milliseconds, less than
 // another thread costs to start and to wait in (libgomp's idle threads spin about 20 ms of
 // CPU after each parallel region unless OMP_WAIT_POLICY=passive, which only the environment
-// sets). The image is the same on any number of threads (docs/performance.md, "Our tree, the
-// lanes' limits and small renders").
+// sets). The image is the same on any number of threads (docs/performance.md, "Start-up").
 constexpr uint64_t kOneThreadMaxSamples = 64 * 64 * 4;
 
 // Writes the checkpoint of `state` (gathered at rank 0 first). Returns false after printing
