@@ -18,19 +18,19 @@ namespace {
 constexpr int kBins = 16;
 // Sets of up to this many spheres (four blocks) are leaves, larger ones always split. Testing
 // the blocks of a small set is cheaper than the box tests that would cull some of them: walls
-// are spheres with huge boxes that every ray enters (docs/performance.md: scene 6, of ten
-// spheres, as a tree of 7 nodes took 40% more instructions than as one leaf).
+// are spheres with huge boxes that every ray enters (docs/performance.md, "Ray casting: one
+// leaf, blocks of four, culls": scene 6 as a tree against one leaf).
 constexpr int kMaxLeafSpheres = 16;
 // The lanes' tree (LaneTree) ends in leaves of up to this many spheres: the lanes test a
 // node's box for all their rays at once, which costs about what one sphere does.
 constexpr int kLaneLeafSpheres = 4;
 // The float lanes' scan of up to kLaneScanMaxSpheres (LaneTree::clusters) tests a box before
-// clusters of up to this many spheres (46 spheres, callgrind of the eight lanes: clusters of
-// 4 cost 4 % more instructions than of 8, of 2 or 3 up to 20 % more).
+// clusters of up to this many spheres (docs/performance.md, "Sixteen single-precision lanes",
+// "More than 16 spheres": the cluster sizes measured on 46 spheres).
 constexpr int kLaneClusterSpheres = 8;
-// From this many spheres, AccelBackend::automatic takes Embree where the build has it. Whole
-// renders of the stress scenes (`bench --stress`, both interleaved): our tree 8 % faster at
-// 20 spheres, Embree 5 to 8 % faster at 30 to 100 and 13 to 23 % from 1,000 to 100,000.
+// From this many spheres, AccelBackend::automatic takes Embree where the build has it
+// (docs/performance.md, "Design choices and their figures": whole renders of the stress
+// scenes, ours against Embree's).
 constexpr size_t kEmbreeFromSpheres = 33;
 constexpr int kMaxTreeDepth = 60;    // traversal stack size; deeper sets become leaves
 constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -24,8 +24,8 @@ struct WideBvh;        // accel.cpp: our tree as it is walked, four children a n
 // own:       our BVH. One leaf, without any box test, for up to 16 spheres: the faster one
 //            for small scenes (the brief's have 5 to 10 spheres).
 // embree:    Embree's BVH over user geometry whose intersection callbacks are our double-
-//            precision sphere tests: the faster one for large scenes (ray casting alone 1.4x
-//            at 1,000 to 100,000 spheres, whole renders 1.13x to 1.23x; docs/performance.md).
+//            precision sphere tests: the faster one for large scenes (docs/performance.md,
+//            "Scaling").
 // automatic: embree for more than 32 spheres where the build has Embree and the spheres fit
 //            its single precision (embree_fits), else own.
 enum class AccelBackend { automatic, own, embree };
@@ -72,8 +72,8 @@ struct LaneSphere {
     int32_t id;      // the sphere's index in the scene
 };
 // Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
-// walk the lane tree (docs/performance.md, "Switch points": the scan is the cheaper up to
-// about 2,500 spheres with sixteen lanes and about 1,500 with eight). It covers every lane
+// walk the lane tree (docs/performance.md, "Switch points": where the scan is the cheaper,
+// measured per lane count). It covers every lane
 // tree built for the float lanes under `--kernels best` (kLaneOwnMaxSpheres): their tree walk
 // runs only with kernels named for measuring, and the double lanes always walk it.
 inline constexpr size_t kLaneScanMaxSpheres = 2048;

@@ -304,8 +304,8 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
         // Lanes whose path has ended hand in its result and start the next sample's. The new
         // paths' state is blended in lane-wise: stores into single lanes would stall the
         // vectors' next loads.
-        // (A loop over the ended lanes' bits: testing the alive mask lane by lane took 7 % of
-        // the paths' time on 46 spheres.)
+        // (A loop over the ended lanes' bits: testing the alive mask lane by lane is dearer,
+        // docs/performance.md, "Design choices and their figures".)
         vm start{};
         int start_sample[kLanes] = {};
         const int first_started = next_sample;
