@@ -754,7 +754,21 @@ void RenderWorker::run() {
             last_full_scene = job.scene;
             last_full_settings = job.settings;
         }
+        const bool full_frame = frame->scale == 1;
         publish(std::move(frame));
+        // The view's first surfaces, which the next camera move's prior needs for this view's
+        // picture (keep_history): traced once a job, once its first full frame is on screen and
+        // while no edit waits, so that the move's own first frame does not trace them too (a
+        // scalar trace of every pixel's centre: at 1920x1080 about as long as a pass).
+        if (full_frame && denoise_.load() && !region.region && !stop_.load() && reprojectable(*job.scene) &&
+            !(view_hits_made && hits_generation == job.generation)) {
+            try {
+                view_hits_made = view_hits(*job.scene, w, h);
+                hits_generation = job.generation;
+            } catch (const std::bad_alloc&) {
+                view_hits_made.reset();  // the next move traces them itself
+            }
+        }
     }
 }
 
