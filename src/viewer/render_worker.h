@@ -203,14 +203,16 @@ bool guides_full_frame(const DisplayFeatures& preview, int width, int height);
 // The display's feature buffers for the job's next full frame, as the render thread makes them:
 // the first full frame of an edit, without a region, takes those of the job's last preview
 // (`preview`, null where it had none) where guides_full_frame (their camera samples are paid
-// for already: at 1920x1080 one sample a pixel costs about a pass); every other frame refines
-// them by a sample (next_display_feature_samples), within the region where there is one.
+// for already: at 1920x1080 one sample a pixel costs about a pass), and the next frame traces
+// both of its own samples (kDisplayFeatureSamples); otherwise each frame refines them by a
+// sample (next_display_feature_samples), within the region where there is one. So every frame
+// after an edit's first has kDisplayFeatureSamples, however many frames came before it.
 void display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
                                 const std::optional<PixelBox>& region);
 // The camera samples a pixel of the display's feature buffers at the next frame: the first full
-// frame of an edit traces one (or takes its preview's: display_features_for_frame), the next one
-// more (a sample costs about as much as a pass; kFeatureSamples, which Save and the feature
-// views use, would hold up the first frames).
+// frame of an edit traces one (or takes its preview's, and the next frame traces both:
+// display_features_for_frame), the next one more (at 1920x1080 a sample costs about as much as
+// a pass; kFeatureSamples, which Save and the feature views use, would hold up the first frames).
 inline constexpr int kDisplayFeatureSamples = 2;
 int next_display_feature_samples(const DisplayFeatures& features);
 // A preview's feature buffers: its image is coarse anyway.
@@ -220,13 +222,8 @@ inline constexpr int kPreviewFeatureSamples = 2;
 // a preview of `job` at 1/scale resolution (one pass of its own), with the display's denoised
 // radiance and the feature layers where asked (the display's feature buffers, of the
 // preview's resolution, moved to `kept` where given: display_features_for_frame takes them);
-// with a render `region`, only the preview pixels over it (preview_box) are sampled, their
-// features made and denoised (the others black, as in the region's full frames);
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
-                        Snapshot& frame, DisplayFeatures* kept = nullptr,
-                        const std::optional<PixelBox>& region = std::nullopt);
-// The pixels of a 1/scale preview of a width x height image that cover some of `region`.
-std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int width, int height, int scale);
+                        Snapshot& frame, DisplayFeatures* kept = nullptr);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
 // `features` (null: not denoised) and the pixel statistics. With a render `region`, only the
 // region's pixels are denoised where denoised_box says so, over the job's `previous` full
