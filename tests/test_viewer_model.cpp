@@ -654,6 +654,46 @@ TEST(RenderThread, DisplayFeaturesRefineARegionFirstAndEndAsSavesOwn) {
     EXPECT_EQ(features.normal, normal);
 }
 
+// A render region's previews sample only the preview pixels over it (the others stay black,
+// as in its full frames), and their features and denoised picture are those pixels' alone.
+TEST(RenderThread, ARegionsPreviewsSampleOnlyItsPixels) {
+    EXPECT_EQ(preview_box(std::nullopt, 40, 30, 2), std::nullopt);
+    EXPECT_EQ(preview_box(PixelBox{5, 4, 17, 20}, 40, 30, 2), (PixelBox{2, 2, 9, 10}));
+    EXPECT_EQ(preview_box(PixelBox{5, 4, 17, 20}, 40, 30, 4), (PixelBox{1, 1, 5, 6}));  // of 10 x 8 pixels
+    EXPECT_EQ(preview_box(PixelBox{-3, -3, 99, 99}, 40, 30, 8), (PixelBox{0, 0, 5, 4}));
+    const auto scene = small_scene(8, 40, 30);
+    const RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    const RenderJob job{1, scene, settings, StopRule{4}};
+    const PixelBox region{5, 4, 17, 20};
+    for (const int scale : {4, 2}) {
+        SCOPED_TRACE(scale);
+        DenoiseWorkspace workspace;
+        Snapshot boxed, whole;
+        DisplayFeatures kept;
+        make_preview_frame(job, scale, true, false, workspace, boxed, &kept, region);
+        make_preview_frame(job, scale, true, false, workspace, whole);
+        EXPECT_EQ(kept.width, 0);  // a region's preview guides no full frame
+        const PixelBox box = *preview_box(region, 40, 30, scale);
+        const int pw = boxed.radiance.width;
+        size_t lit = 0;
+        for (int y = 0; y < boxed.radiance.height; ++y)
+            for (int x = 0; x < pw; ++x) {
+                const size_t i = size_t(y) * size_t(pw) + size_t(x);
+                const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+                const Color c = boxed.radiance.pixels[i];
+                if (!in) {
+                    ASSERT_EQ(c, Color()) << x << "," << y;
+                    ASSERT_EQ(boxed.denoised.pixels[i], Color()) << x << "," << y;
+                    continue;
+                }
+                // The region's samples are the whole preview's (the same samplers).
+                ASSERT_EQ(std::memcmp(&c, &whole.radiance.pixels[i], sizeof(Color)), 0) << x << "," << y;
+                lit += boxed.denoised.pixels[i][0] > 0;
+            }
+        EXPECT_GT(lit, size_t((box.x1 - box.x0) * (box.y1 - box.y0) / 2));
+    }
+}
+
 // The first full frame of an edit takes its 1/2 preview's feature buffers (each pixel the
 // preview pixel it lies in, nothing traced), the next one traces every pixel's two camera
 // samples over them; a coarser preview, a region or no preview: the first frame traces its own.

@@ -351,17 +351,43 @@ int next_display_feature_samples(const DisplayFeatures& features) {
     return std::min(kDisplayFeatureSamples, features.samples + 1);
 }
 
+std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int width, int height, int scale) {
+    if (!region) return std::nullopt;
+    const int pw = scaled(width, scale), ph = scaled(height, scale);
+    // The preview pixels that cover some of the region's: preview pixel i spans the image's
+    // pixels [i * width / pw, (i + 1) * width / pw).
+    const auto first = [&](int v, int size, int psize) { return int(int64_t(std::clamp(v, 0, size)) * psize / size); };
+    const auto end = [&](int v, int size, int psize) {
+        return int((int64_t(std::clamp(v, 0, size)) * psize + size - 1) / size);
+    };
+    return PixelBox{first(region->x0, width, pw), first(region->y0, height, ph), end(region->x1, width, pw),
+                    end(region->y1, height, ph)};
+}
+
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
-                        Snapshot& frame, DisplayFeatures* kept) {
+                        Snapshot& frame, DisplayFeatures* kept, const std::optional<PixelBox>& region) {
     const int w = job.scene->renderer.width, h = job.scene->renderer.height;
     RenderState preview(scaled(w, scale), scaled(h, scale));
+    // A render region's preview samples only the pixels over it, as its full passes do
+    // (RegionHooks): the rows outside it skipped whole, the other pixels of its rows by the
+    // plan's mask; they stay black, as they stay in its full frames.
+    const std::optional<PixelBox> box = preview_box(region, w, h, scale);
+    if (box) {
+        preview.active_rows.assign(size_t(preview.height), 0);
+        preview.plan.active.assign(size_t(preview.width) * size_t(preview.height), 0);
+        for (int y = box->y0; y < box->y1; ++y) {
+            preview.active_rows[size_t(y)] = 1;
+            std::fill_n(preview.plan.active.begin() + long(size_t(y) * size_t(preview.width) + size_t(box->x0)),
+                        box->x1 - box->x0, uint8_t(1));
+        }
+    }
     kr::render_pass(*job.scene, job.settings, preview);
     frame.scale = scale;
     frame.radiance = preview.radiance();
     DisplayFeatures preview_features;
     if (denoise || features) {
         preview_features.reset(preview.width, preview.height);
-        preview_features.refine_to(job, kPreviewFeatureSamples);
+        preview_features.refine_to(job, kPreviewFeatureSamples, box);
     }
     if (denoise) {
         DevelopOptions reads;
@@ -369,7 +395,12 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
         reads.interactive = true;
         reads.sampling = job.settings;
         RenderEstimates estimates = render_estimates(preview, develop_reads(reads) | kLayerRadiance);
-        frame.denoised = denoised_radiance(job, estimates, preview_features, workspace);
+        // The box alone unless it is empty or most of the preview (denoised_box's rule).
+        const bool boxed = box && box->x0 < box->x1 && box->y0 < box->y1 &&
+                           2 * double(box->x1 - box->x0) * (box->y1 - box->y0) <= double(preview.width) * preview.height;
+        frame.denoised = boxed
+                             ? denoised_radiance_in(job, estimates, preview_features, *box, estimates.radiance, workspace)
+                             : denoised_radiance(job, estimates, preview_features, workspace);
     }
     if (features) {
         auto f = std::make_shared<FeatureBuffers>();
@@ -380,7 +411,8 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
         frame.features = std::move(f);
         frame.hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
     }
-    if (kept) *kept = std::move(preview_features);
+    // A region's preview has features over the region only: none to guide a full frame.
+    if (kept) *kept = box ? DisplayFeatures{} : std::move(preview_features);
 }
 
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
@@ -569,7 +601,13 @@ void RenderWorker::run() {
                 driver.emplace(*job.scene, job.settings, state, rule_, hooks);
                 job_unsent = ranks_ != nullptr;  // sent outside the lock: the ranks may be busy
                 job_rays = job_nonfinite = 0;
-                previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
+                // A render region's previews sample its pixels only: planned by its size.
+                int pw = w, ph = h;
+                if (region_) {
+                    pw = std::max(1, std::clamp(region_->x1, 0, w) - std::clamp(region_->x0, 0, w));
+                    ph = std::max(1, std::clamp(region_->y1, 0, h) - std::clamp(region_->y0, 0, h));
+                }
+                previews = preview_scales(pw, ph, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
             }
             skip_previews = paused_;
@@ -605,7 +643,8 @@ void RenderWorker::run() {
             ++next_preview;
             // Not stopped by an edit: a preview is short by design (preview_scales), and during a
             // drag, edits coming faster than previews would otherwise leave the window none.
-            make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame, &preview_features);
+            make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame, &preview_features,
+                               region.region);
         } else {
             next_preview = previews.size();  // paused: straight to the full frame
             const auto start = Clock::now();
@@ -625,7 +664,13 @@ void RenderWorker::run() {
             else if (!driver->pass(rule, &stop_)) continue;
             // Only full passes: tiny previews are dominated by per-pass overheads.
             const double pass_seconds = seconds_since(start);
-            seconds_per_pixel = pass_seconds / (double(w) * h);
+            // Per pixel the pass sampled: a render region's only (previews of the whole
+            // image are planned from it after the region is cleared).
+            double pass_pixels = double(w) * h;
+            if (region.region)
+                pass_pixels = std::max(1.0, double(std::clamp(region.region->x1, 0, w) - std::clamp(region.region->x0, 0, w)) *
+                                                double(std::clamp(region.region->y1, 0, h) - std::clamp(region.region->y0, 0, h)));
+            seconds_per_pixel = pass_seconds / pass_pixels;
             unpublished = true;
             // The frame schedule: is this pass's image worth making and drawing now?
             bool due = false;

@@ -222,8 +222,13 @@ inline constexpr int kPreviewFeatureSamples = 2;
 // a preview of `job` at 1/scale resolution (one pass of its own), with the display's denoised
 // radiance and the feature layers where asked (the display's feature buffers, of the
 // preview's resolution, moved to `kept` where given: display_features_for_frame takes them);
+// with a render `region`, only the preview pixels over it (preview_box) are sampled, their
+// features made and denoised (the others black, as in the region's full frames);
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
-                        Snapshot& frame, DisplayFeatures* kept = nullptr);
+                        Snapshot& frame, DisplayFeatures* kept = nullptr,
+                        const std::optional<PixelBox>& region = std::nullopt);
+// The pixels of a 1/scale preview of a width x height image that cover some of `region`.
+std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int width, int height, int scale);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
 // `features` (null: not denoised) and the pixel statistics. With a render `region`, only the
 // region's pixels are denoised where denoised_box says so, over the job's `previous` full
