@@ -1,7 +1,8 @@
 // The viewer's first frames after an edit never get worse (model level, no window): the
 // frames the render thread can publish, in their order (the previews from 1/16 to 1/2, then
 // the full-resolution frames at 1, 2, ... spp), each taken as the window shows it with the
-// default denoised display (viewer/status.h displayed_picture: a preview upscaled smoothly),
+// default denoised display (viewer/status.h displayed_picture: a preview upscaled smoothly; the
+// first full frame guided by the 1/2 preview's feature buffers, as display_features_for_frame does),
 // compared with the settled image of the scene (a raw render of many samples at another seed).
 // The render thread publishes some of these frames, by its schedule; any of them in order
 // keeps the order. Every scene of res/scenes and res/scenes/examples, at a small size.
@@ -62,9 +63,10 @@ TEST(FirstFrames, NeverWorseAfterAnEditOnEveryBundledScene) {
 
         std::vector<std::pair<std::string, double>> frames;
         DenoiseWorkspace workspace;
+        DisplayFeatures preview_features;  // the last preview's, which the first full frame takes
         for (const int scale : {8, 4, 2}) {
             Snapshot frame;
-            make_preview_frame(job, scale, true, false, workspace, frame);
+            make_preview_frame(job, scale, true, false, workspace, frame, &preview_features);
             frames.push_back({"1/" + std::to_string(scale) + " preview",
                               psnr(displayed_picture(frame, DenoiseView::on, w, h, scene.display), reference)});
         }
@@ -77,7 +79,7 @@ TEST(FirstFrames, NeverWorseAfterAnEditOnEveryBundledScene) {
         for (int spp = 1; spp <= kFullFrames; ++spp) {
             driver.pass(rule);
             if (!frame_spp(spp, first_frame_spp(*job.scene))) continue;
-            features.refine_to(job, next_display_feature_samples(features));
+            display_features_for_frame(features, job, &preview_features, std::nullopt);
             Snapshot frame;
             make_full_frame(job, state, &features, workspace, frame);
             frames.push_back({std::to_string(spp) + " spp",

@@ -654,6 +654,109 @@ TEST(RenderThread, DisplayFeaturesRefineARegionFirstAndEndAsSavesOwn) {
     EXPECT_EQ(features.normal, normal);
 }
 
+// A render region's previews sample only the preview pixels over it (the others stay black,
+// as in its full frames), and their features and denoised picture are those pixels' alone.
+TEST(RenderThread, ARegionsPreviewsSampleOnlyItsPixels) {
+    EXPECT_EQ(preview_box(std::nullopt, 40, 30, 2), std::nullopt);
+    EXPECT_EQ(preview_box(PixelBox{5, 4, 17, 20}, 40, 30, 2), (PixelBox{2, 2, 9, 10}));
+    EXPECT_EQ(preview_box(PixelBox{5, 4, 17, 20}, 40, 30, 4), (PixelBox{1, 1, 5, 6}));  // of 10 x 8 pixels
+    EXPECT_EQ(preview_box(PixelBox{-3, -3, 99, 99}, 40, 30, 8), (PixelBox{0, 0, 5, 4}));
+    const auto scene = small_scene(8, 40, 30);
+    const RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    const RenderJob job{1, scene, settings, StopRule{4}};
+    const PixelBox region{5, 4, 17, 20};
+    for (const int scale : {4, 2}) {
+        SCOPED_TRACE(scale);
+        DenoiseWorkspace workspace;
+        Snapshot boxed, whole;
+        DisplayFeatures kept;
+        make_preview_frame(job, scale, true, false, workspace, boxed, &kept, region);
+        make_preview_frame(job, scale, true, false, workspace, whole);
+        EXPECT_EQ(kept.width, 0);  // a region's preview guides no full frame
+        const PixelBox box = *preview_box(region, 40, 30, scale);
+        const int pw = boxed.radiance.width;
+        size_t lit = 0;
+        for (int y = 0; y < boxed.radiance.height; ++y)
+            for (int x = 0; x < pw; ++x) {
+                const size_t i = size_t(y) * size_t(pw) + size_t(x);
+                const bool in = x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1;
+                const Color c = boxed.radiance.pixels[i];
+                if (!in) {
+                    ASSERT_EQ(c, Color()) << x << "," << y;
+                    ASSERT_EQ(boxed.denoised.pixels[i], Color()) << x << "," << y;
+                    continue;
+                }
+                // The region's samples are the whole preview's (the same samplers).
+                ASSERT_EQ(std::memcmp(&c, &whole.radiance.pixels[i], sizeof(Color)), 0) << x << "," << y;
+                lit += boxed.denoised.pixels[i][0] > 0;
+            }
+        EXPECT_GT(lit, size_t((box.x1 - box.x0) * (box.y1 - box.y0) / 2));
+    }
+}
+
+// The first full frame of an edit takes its 1/2 preview's feature buffers (each pixel the
+// preview pixel it lies in, nothing traced), the next one traces every pixel's two camera
+// samples over them; a coarser preview, a region or no preview: the first frame traces its own.
+TEST(RenderThread, TheFirstFullFrameTakesItsPreviewsFeatures) {
+    for (const auto& [w, h] : {std::pair{30, 24}, std::pair{31, 23}}) {
+        SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+        const auto scene = small_scene(8, w, h);
+        RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+        const RenderJob job{1, scene, settings, StopRule{4}};
+        DenoiseWorkspace workspace;
+        Snapshot frame;
+        DisplayFeatures preview;
+        make_preview_frame(job, 2, true, false, workspace, frame, &preview);
+        ASSERT_EQ(preview.width, (w + 1) / 2);
+        ASSERT_EQ(preview.height, (h + 1) / 2);
+        ASSERT_EQ(preview.albedo.size(), 3 * size_t(preview.width) * size_t(preview.height));
+        ASSERT_TRUE(guides_full_frame(preview, w, h));
+        DisplayFeatures features;
+        features.reset(w, h);
+        display_features_for_frame(features, job, &preview, std::nullopt);
+        EXPECT_EQ(features.samples, 0);
+        EXPECT_TRUE(features.counts.empty());  // nothing traced
+        size_t lit = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                // Pixel x's centre lies in preview pixel x / 2 (the preview spans the same film).
+                const int px = int((2 * x + 1) * preview.width / (2 * w)), py = int((2 * y + 1) * preview.height / (2 * h));
+                const size_t i = 3 * (size_t(y) * size_t(w) + size_t(x)), j = 3 * (size_t(py) * size_t(preview.width) + size_t(px));
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_EQ(features.albedo[i + size_t(k)], preview.albedo[j + size_t(k)]) << x << "," << y;
+                    ASSERT_EQ(features.normal[i + size_t(k)], preview.normal[j + size_t(k)]) << x << "," << y;
+                }
+                lit += features.albedo[i] > 0;
+            }
+        EXPECT_GT(lit, size_t(w * h / 4));  // the scene's spheres are there
+        // The next frame: every pixel's own two camera samples at once (as a frame after a
+        // traced first one has them), as refine_to(2) alone gives them.
+        display_features_for_frame(features, job, &preview, std::nullopt);
+        DisplayFeatures both;
+        both.reset(w, h);
+        both.refine_to(job, kDisplayFeatureSamples);
+        EXPECT_EQ(features.samples, kDisplayFeatureSamples);
+        EXPECT_EQ(features.albedo, both.albedo);
+        EXPECT_EQ(features.normal, both.normal);
+        DisplayFeatures traced;
+        traced.reset(w, h);
+        traced.refine_to(job, 1);
+        // A 1/4 preview guides no full frame; nor does a preview under a region.
+        DisplayFeatures coarse;
+        make_preview_frame(job, 4, true, false, workspace, frame, &coarse);
+        EXPECT_FALSE(guides_full_frame(coarse, w, h));
+        DisplayFeatures first;
+        first.reset(w, h);
+        display_features_for_frame(first, job, &coarse, std::nullopt);
+        EXPECT_EQ(first.albedo, traced.albedo);
+        DisplayFeatures boxed;
+        boxed.reset(w, h);
+        display_features_for_frame(boxed, job, &preview, PixelBox{2, 2, 10, 10});
+        EXPECT_EQ(boxed.samples, 1);
+        EXPECT_EQ(boxed.counts[size_t(3 * w + 3)], 1);
+    }
+}
+
 // The frame schedule: the first frame, then intervals of half the image's age (at least a
 // display refresh, at most a second), never shorter than the frames' cost over their share.
 TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {

@@ -307,21 +307,87 @@ void DisplayFeatures::refine_to(const RenderJob& job, int total, const std::opti
     if (!box) whole = total;
 }
 
+void DisplayFeatures::take_preview(const DisplayFeatures& preview) {
+    const int pw = preview.width, ph = preview.height;
+    albedo.resize(3 * size_t(width) * size_t(height));
+    normal.resize(albedo.size());
+    // Pixel x's centre, (x + 1/2) / width of the film, lies in the preview's pixel
+    // floor((x + 1/2) * pw / width): both images span the same film.
+    std::vector<int> column(size_t(std::max(0, width)));
+    for (int x = 0; x < width; ++x) column[size_t(x)] = std::min(pw - 1, int((2 * int64_t(x) + 1) * pw / (2 * int64_t(width))));
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < height; ++y) {
+        const int py = std::min(ph - 1, int((2 * int64_t(y) + 1) * ph / (2 * int64_t(height))));
+        for (int x = 0; x < width; ++x) {
+            const size_t to = 3 * (size_t(y) * size_t(width) + size_t(x));
+            const size_t from = 3 * (size_t(py) * size_t(pw) + size_t(column[size_t(x)]));
+            std::copy_n(preview.albedo.begin() + long(from), 3, albedo.begin() + long(to));
+            std::copy_n(preview.normal.begin() + long(from), 3, normal.begin() + long(to));
+        }
+    }
+}
+
+bool guides_full_frame(const DisplayFeatures& preview, int width, int height) {
+    return preview.width > 0 && preview.height > 0 && 2 * preview.width >= width && 2 * preview.height >= height &&
+           preview.albedo.size() == 3 * size_t(preview.width) * size_t(preview.height) &&
+           preview.normal.size() == preview.albedo.size();
+}
+
+void display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
+                                const std::optional<PixelBox>& region) {
+    if (!region && features.samples == 0 && features.albedo.empty() && preview &&
+        guides_full_frame(*preview, features.width, features.height)) {
+        features.take_preview(*preview);
+        return;
+    }
+    // After a frame guided by the preview's buffers, both samples at once: every frame after
+    // the first then has the same buffers however many frames the schedule made before it
+    // (the image a scripted run or Save takes does not depend on the machine's speed).
+    const bool took_preview = features.samples == 0 && !features.albedo.empty();
+    features.refine_to(job, took_preview ? kDisplayFeatureSamples : next_display_feature_samples(features), region);
+}
+
 int next_display_feature_samples(const DisplayFeatures& features) {
     return std::min(kDisplayFeatureSamples, features.samples + 1);
 }
 
+std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int width, int height, int scale) {
+    if (!region) return std::nullopt;
+    const int pw = scaled(width, scale), ph = scaled(height, scale);
+    // The preview pixels that cover some of the region's: preview pixel i spans the image's
+    // pixels [i * width / pw, (i + 1) * width / pw).
+    const auto first = [&](int v, int size, int psize) { return int(int64_t(std::clamp(v, 0, size)) * psize / size); };
+    const auto end = [&](int v, int size, int psize) {
+        return int((int64_t(std::clamp(v, 0, size)) * psize + size - 1) / size);
+    };
+    return PixelBox{first(region->x0, width, pw), first(region->y0, height, ph), end(region->x1, width, pw),
+                    end(region->y1, height, ph)};
+}
+
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
-                        Snapshot& frame) {
+                        Snapshot& frame, DisplayFeatures* kept, const std::optional<PixelBox>& region) {
     const int w = job.scene->renderer.width, h = job.scene->renderer.height;
     RenderState preview(scaled(w, scale), scaled(h, scale));
+    // A render region's preview samples only the pixels over it, as its full passes do
+    // (RegionHooks): the rows outside it skipped whole, the other pixels of its rows by the
+    // plan's mask; they stay black, as they stay in its full frames.
+    const std::optional<PixelBox> box = preview_box(region, w, h, scale);
+    if (box) {
+        preview.active_rows.assign(size_t(preview.height), 0);
+        preview.plan.active.assign(size_t(preview.width) * size_t(preview.height), 0);
+        for (int y = box->y0; y < box->y1; ++y) {
+            preview.active_rows[size_t(y)] = 1;
+            std::fill_n(preview.plan.active.begin() + long(size_t(y) * size_t(preview.width) + size_t(box->x0)),
+                        box->x1 - box->x0, uint8_t(1));
+        }
+    }
     kr::render_pass(*job.scene, job.settings, preview);
     frame.scale = scale;
     frame.radiance = preview.radiance();
     DisplayFeatures preview_features;
     if (denoise || features) {
         preview_features.reset(preview.width, preview.height);
-        preview_features.refine_to(job, kPreviewFeatureSamples);
+        preview_features.refine_to(job, kPreviewFeatureSamples, box);
     }
     if (denoise) {
         DevelopOptions reads;
@@ -329,17 +395,24 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
         reads.interactive = true;
         reads.sampling = job.settings;
         RenderEstimates estimates = render_estimates(preview, develop_reads(reads) | kLayerRadiance);
-        frame.denoised = denoised_radiance(job, estimates, preview_features, workspace);
+        // The box alone unless it is empty or most of the preview (denoised_box's rule).
+        const bool boxed = box && box->x0 < box->x1 && box->y0 < box->y1 &&
+                           2 * double(box->x1 - box->x0) * (box->y1 - box->y0) <= double(preview.width) * preview.height;
+        frame.denoised = boxed
+                             ? denoised_radiance_in(job, estimates, preview_features, *box, estimates.radiance, workspace)
+                             : denoised_radiance(job, estimates, preview_features, workspace);
     }
     if (features) {
         auto f = std::make_shared<FeatureBuffers>();
         f->width = preview.width;
         f->height = preview.height;
-        f->albedo = std::move(preview_features.albedo);
-        f->normal = std::move(preview_features.normal);
+        f->albedo = kept ? preview_features.albedo : std::move(preview_features.albedo);
+        f->normal = kept ? preview_features.normal : std::move(preview_features.normal);
         frame.features = std::move(f);
         frame.hit_depth = hit_depths(preview.mean_depth(), preview.sample_count());
     }
+    // A region's preview has features over the region only: none to guide a full frame.
+    if (kept) *kept = box ? DisplayFeatures{} : std::move(preview_features);
 }
 
 void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
@@ -388,6 +461,7 @@ void RenderWorker::run() {
     size_t next_preview = 0;
     double seconds_per_pixel = 0;  // measured cost, carried across edits
     DisplayFeatures display_features;  // of `job` at full resolution, for the display's filter
+    DisplayFeatures preview_features;  // of `job`'s last preview (display_features_for_frame)
     std::shared_ptr<const FeatureBuffers> features;  // the feature views' (complete), made once
     DenoiseWorkspace denoise_planes;    // kept between frames
     std::shared_ptr<const Snapshot> last_full;  // the newest full frame made (a region's frames build on it)
@@ -520,13 +594,20 @@ void RenderWorker::run() {
                     continue;
                 }
                 display_features.reset(w, h);
+                preview_features.reset(0, 0);
                 features.reset();
                 unpublished = false;
                 full_frame_made = false;
                 driver.emplace(*job.scene, job.settings, state, rule_, hooks);
                 job_unsent = ranks_ != nullptr;  // sent outside the lock: the ranks may be busy
                 job_rays = job_nonfinite = 0;
-                previews = preview_scales(w, h, seconds_per_pixel, kPreviewBudget);
+                // A render region's previews sample its pixels only: planned by its size.
+                int pw = w, ph = h;
+                if (region_) {
+                    pw = std::max(1, std::clamp(region_->x1, 0, w) - std::clamp(region_->x0, 0, w));
+                    ph = std::max(1, std::clamp(region_->y1, 0, h) - std::clamp(region_->y0, 0, h));
+                }
+                previews = preview_scales(pw, ph, seconds_per_pixel, kPreviewBudget);
                 next_preview = 0;
             }
             skip_previews = paused_;
@@ -562,7 +643,8 @@ void RenderWorker::run() {
             ++next_preview;
             // Not stopped by an edit: a preview is short by design (preview_scales), and during a
             // drag, edits coming faster than previews would otherwise leave the window none.
-            make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame);
+            make_preview_frame(job, scale, denoise_.load(), features_.load(), denoise_planes, *frame, &preview_features,
+                               region.region);
         } else {
             next_preview = previews.size();  // paused: straight to the full frame
             const auto start = Clock::now();
@@ -582,7 +664,13 @@ void RenderWorker::run() {
             else if (!driver->pass(rule, &stop_)) continue;
             // Only full passes: tiny previews are dominated by per-pass overheads.
             const double pass_seconds = seconds_since(start);
-            seconds_per_pixel = pass_seconds / (double(w) * h);
+            // Per pixel the pass sampled: a render region's only (previews of the whole
+            // image are planned from it after the region is cleared).
+            double pass_pixels = double(w) * h;
+            if (region.region)
+                pass_pixels = std::max(1.0, double(std::clamp(region.region->x1, 0, w) - std::clamp(region.region->x0, 0, w)) *
+                                                double(std::clamp(region.region->y1, 0, h) - std::clamp(region.region->y0, 0, h)));
+            seconds_per_pixel = pass_seconds / pass_pixels;
             unpublished = true;
             // The frame schedule: is this pass's image worth making and drawing now?
             bool due = false;
@@ -602,8 +690,7 @@ void RenderWorker::run() {
             // image (guided by feature buffers refined one more step each frame) and the
             // pixel statistics.
             // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
-            if (denoise_.load())
-                display_features.refine_to(job, next_display_feature_samples(display_features), region.region);
+            if (denoise_.load()) display_features_for_frame(display_features, job, &preview_features, region.region);
             if (!prior_made && denoise_.load()) {
                 // The job's first full frame: the newest frame before it (an earlier job's) may
                 // be the best picture of the world yet, and this view takes what it can of it.
@@ -671,7 +758,21 @@ void RenderWorker::run() {
             last_full_scene = job.scene;
             last_full_settings = job.settings;
         }
+        const bool full_frame = frame->scale == 1;
         publish(std::move(frame));
+        // The view's first surfaces, which the next camera move's prior needs for this view's
+        // picture (keep_history): traced once a job, once its first full frame is on screen and
+        // while no edit waits, so that the move's own first frame does not trace them too (a
+        // scalar trace of every pixel's centre: at 1920x1080 about as long as a pass).
+        if (full_frame && denoise_.load() && !region.region && !stop_.load() && reprojectable(*job.scene) &&
+            !(view_hits_made && hits_generation == job.generation)) {
+            try {
+                view_hits_made = view_hits(*job.scene, w, h);
+                hits_generation = job.generation;
+            } catch (const std::bad_alloc&) {
+                view_hits_made.reset();  // the next move traces them itself
+            }
+        }
     }
 }
 

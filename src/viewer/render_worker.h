@@ -193,10 +193,26 @@ struct DisplayFeatures {
     // Refined to `total` camera samples a pixel (at most kFeatureSamples): the pixels of `box`
     // only, where given (a render region's: the others are not refined).
     void refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box = std::nullopt);
+    // Before their first camera sample: the buffers of a preview of the same view (`preview`,
+    // of a smaller image), each pixel taking those of the preview pixel it lies in. No sample
+    // is counted: the next refine_to(1) traces every pixel's first one and replaces them.
+    void take_preview(const DisplayFeatures& preview);
 };
+// A preview fine enough to guide the denoiser of a full frame: at least half the resolution.
+bool guides_full_frame(const DisplayFeatures& preview, int width, int height);
+// The display's feature buffers for the job's next full frame, as the render thread makes them:
+// the first full frame of an edit, without a region, takes those of the job's last preview
+// (`preview`, null where it had none) where guides_full_frame (their camera samples are paid
+// for already: at 1920x1080 one sample a pixel costs about a pass), and the next frame traces
+// both of its own samples (kDisplayFeatureSamples); otherwise each frame refines them by a
+// sample (next_display_feature_samples), within the region where there is one. So every frame
+// after an edit's first has kDisplayFeatureSamples, however many frames came before it.
+void display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
+                                const std::optional<PixelBox>& region);
 // The camera samples a pixel of the display's feature buffers at the next frame: the first full
-// frame of an edit traces one, the next one more (a sample costs about 1/8 of a pass;
-// kFeatureSamples, which Save and the feature views use, would hold up the first frames).
+// frame of an edit traces one (or takes its preview's, and the next frame traces both:
+// display_features_for_frame), the next one more (at 1920x1080 a sample costs about as much as
+// a pass; kFeatureSamples, which Save and the feature views use, would hold up the first frames).
 inline constexpr int kDisplayFeatureSamples = 2;
 int next_display_feature_samples(const DisplayFeatures& features);
 // A preview's feature buffers: its image is coarse anyway.
@@ -204,9 +220,15 @@ inline constexpr int kPreviewFeatureSamples = 2;
 
 // The frames the render thread publishes, as it makes them (the tests make the same):
 // a preview of `job` at 1/scale resolution (one pass of its own), with the display's denoised
-// radiance and the feature layers where asked;
+// radiance and the feature layers where asked (the display's feature buffers, of the
+// preview's resolution, moved to `kept` where given: display_features_for_frame takes them);
+// with a render `region`, only the preview pixels over it (preview_box) are sampled, their
+// features made and denoised (the others black, as in the region's full frames);
 void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool features, DenoiseWorkspace& workspace,
-                        Snapshot& frame);
+                        Snapshot& frame, DisplayFeatures* kept = nullptr,
+                        const std::optional<PixelBox>& region = std::nullopt);
+// The pixels of a 1/scale preview of a width x height image that cover some of `region`.
+std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int width, int height, int scale);
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
 // `features` (null: not denoised) and the pixel statistics. With a render `region`, only the
 // region's pixels are denoised where denoised_box says so, over the job's `previous` full
