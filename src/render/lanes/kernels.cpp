@@ -245,6 +245,286 @@ struct LaneScene<true> {
     }
 };
 
+// ---- The path loop's stages ----
+// trace_paths below runs them in this order, a bounce of every lane's path at a time. Each is
+// forced inline and keeps the blocks it would have in one function: GCC fuses a product into a
+// sum only within one basic block, so a stage's bounds must not move a product away from its
+// sum. Where GCC's block layout still decides (the emission's masked sum in the sixteen
+// lanes), the sum is fused explicitly (mul_add_lanes), so the images keep their bits.
+
+// Which sample each lane traces, and where the samples come from.
+struct LaneSamples {
+    int sample[kLanes];               // the sample each lane traces, -1: none
+    Sampler* sampler[kLanes] = {};    // its sampler (not for CameraColumns' Sobol columns)
+    int next = 0;                     // the next sample to start
+    bool sobol_lanes = true;          // Sobol samplers: their vertex numbers are drawn lane-wise
+};
+
+// 1. Lanes whose path has ended hand in its result and start the next sample's. The new
+// paths' state is blended in lane-wise: stores into single lanes would stall the vectors' next
+// loads. (A loop over the ended lanes' bits: testing the alive mask lane by lane is dearer,
+// docs/performance.md, "Design choices and their figures".)
+template <class Source>
+KR_LANES void start_samples(const Source& source, Sampler* const* samplers, int count, SampleResult* results,
+                            LaneSamples& lanes, Paths& paths) {
+    vm start{};
+    int start_sample[kLanes] = {};
+    const int first_started = lanes.next;
+    for (unsigned ended = ~lane_bits(paths.alive) & ((1u << kLanes) - 1); ended != 0; ended &= ended - 1) {
+        const int k = __builtin_ctz(ended);
+        if (lanes.sample[k] >= 0) {
+            SampleResult& r = results[lanes.sample[k]];
+            r.radiance = lane(paths.L, k);
+            r.primary_distance = paths.primary_distance[k];
+            r.rays = uint64_t(paths.rays[k]);
+            lanes.sample[k] = -1;
+        }
+        if (lanes.next == count) continue;
+        lanes.sample[k] = lanes.next;
+        if constexpr (!Source::kSobolOnly) lanes.sampler[k] = samplers[lanes.next];
+        start_sample[k] = lanes.next;
+        start[k] = -1;
+        ++lanes.next;
+    }
+    if (!any_lane(start)) return;
+    const V3 zero{vf{}, vf{}, vf{}};
+    source.start(start, start_sample, first_started, paths.o, paths.d);
+    paths.alive |= start;
+    paths.rays = start ? vm{} : paths.rays;
+    paths.depth = start ? vm{} : paths.depth;
+    paths.from = start ? vm{} - 1 : paths.from;
+    paths.into = start ? vm{} : paths.into;
+    paths.throughput = select(start, V3{splat(1), splat(1), splat(1)}, paths.throughput);
+    paths.medium_eta = select(start, splat(1), paths.medium_eta);
+    paths.radiance_scale = select(start, splat(1), paths.radiance_scale);
+    paths.L = select(start, zero, paths.L);
+    paths.full_emission |= start;
+    paths.last_bsdf_pdf = select(start, vf{}, paths.last_bsdf_pdf);
+    paths.last_p = select(start, zero, paths.last_p);
+    paths.last_sphere = start ? vm{} - 1 : paths.last_sphere;
+    paths.primary_distance = select(start, splat(kMissDepth), paths.primary_distance);
+    if constexpr (Source::kSobolOnly) {
+        // The samplers' state, from the source's columns, into the lanes; the vertices below
+        // advance it there.
+        source.start_sobol(start, start_sample, first_started, paths.sobol_key, paths.sobol_index,
+                           paths.sobol_dimension);
+    } else if (lanes.sobol_lanes) {
+        // The same from the samplers.
+        for (unsigned started = lane_bits(start); started != 0; started &= started - 1) {
+            const int k = __builtin_ctz(started);
+            paths.sobol_key[k] = lanes.sampler[k]->sobol_key();
+            paths.sobol_index[k] = lanes.sampler[k]->index_reversed();
+            paths.sobol_dimension[k] = lanes.sampler[k]->dimension();
+        }
+    }
+}
+
+// Where each lane's ray hit: the hit records (as fill_hit in render_scene.cpp).
+struct HitLanes {
+    vf t;
+    vm id, hit_id;  // the sphere hit; hit_id: sphere 0 standing in for ended paths
+    V3 centre;
+    vf radius;
+    V3 n, p;        // the outward normal, and the point projected back onto its sphere
+};
+
+// 2. The closest hits (a path whose ray leaves the scene ends) and their records. False: no
+// path goes on.
+template <bool kWide>
+KR_LANES bool find_hits(const LaneScene<kWide>& lane_scene, Paths& paths, HitLanes& h) {
+    paths.rays -= paths.alive;
+    vf t;
+    vm id;  // (locals: the sphere loop keeps them in registers, where h's would be stored)
+    lane_scene.closest(paths.o, paths.d, paths.from, paths.into, paths.alive, t, id);
+    h.t = t, h.id = id;
+    paths.alive &= h.id >= 0;
+    if (!any_lane(paths.alive)) return false;
+    paths.primary_distance = select(paths.alive & (paths.depth == 0), h.t, paths.primary_distance);
+    h.hit_id = paths.alive ? h.id : vm{};
+    h.centre = look_up(lane_scene.table.centre, h.hit_id);
+    h.radius = look_up(lane_scene.table.radius, h.hit_id);
+    const V3 offset = (paths.o + paths.d * h.t) - h.centre;
+    const vf offset_length = sqrt_lanes(dot(offset, offset));
+    h.n = select(offset_length > 0, offset * (1.0 / offset_length), -paths.d);
+    h.p = h.centre + h.n * h.radius;
+    return true;
+}
+
+// 3. Emission seen along the path: weighed against the last vertex's light sample where that
+// could have found it (vertex.h's emission_mis_weight), else counted whole.
+template <bool kWide>
+KR_LANES void add_emission(const LaneScene<kWide>& lane_scene, LightSampling sampling, const HitLanes& h,
+                           Paths& paths) {
+    const vm emits = paths.alive & lane_scene.emits(h.hit_id);
+    if (any_lane(emits)) {
+        const vm light = emits ? look_up(lane_scene.light, h.hit_id) : vm{};
+        const vm weighed = emits & ~paths.full_emission & (paths.last_sphere != h.id);
+        vf weight = splat(1.0);
+        if (any_lane(weighed))
+            weight = select(weighed,
+                            vertex::emission_mis_weight<Lanes>(sampling, h.centre, h.radius,
+                                                               look_up(lane_scene.lights.select_prob, light),
+                                                               paths.last_p, paths.d, h.t, h.n, paths.last_bsdf_pdf,
+                                                               weighed),
+                            weight);
+        // L + seen, seen = (throughput * scale * radiance) * weight, as one fused sum.
+        const V3 radiance = (paths.throughput * paths.radiance_scale) * look_up(lane_scene.lights.radiance, light);
+        paths.L = select(emits, mul_add_lanes(radiance, weight, paths.L), paths.L);
+    }
+}
+
+// 4. Each vertex's numbers, lane-wise: Sobol ones drawn in lanes (each lane reads those its
+// `use` names; the light choice is 0 where unread, as next_vertex gives), the others drawn one
+// lane at a time and gathered.
+KR_LANES VertexLanes draw_numbers(const LaneSamples& lanes, vm use, unsigned use_any, Paths& paths) {
+    using Numbers = Sampler::VertexNumbers;
+    VertexLanes u;
+    if (lanes.sobol_lanes) {
+        u = sobol_vertex_lanes(paths.sobol_key, paths.sobol_index, paths.sobol_dimension, use_any);
+        paths.sobol_dimension += 5;
+        u.light_pick = select((use & lane_int(Sampler::use_light_pick)) != 0, u.light_pick, vf{});
+    } else {
+        Numbers numbers[kLanes];  // 0 for those a vertex does not read, as next_vertex gives
+        for (int k = 0; k < kLanes; ++k)
+            if (paths.alive[k]) numbers[k] = lanes.sampler[k]->next_vertex(unsigned(use[k]));
+        u = {gather(numbers, &Numbers::light_pick), gather_x(numbers, &Numbers::light),
+             gather_y(numbers, &Numbers::light),    gather(numbers, &Numbers::lobe),
+             gather_x(numbers, &Numbers::bsdf),     gather_y(numbers, &Numbers::bsdf),
+             gather(numbers, &Numbers::roulette)};
+    }
+    return u;
+}
+
+// A light on a sphere that lanes sample lane-wise (step 5).
+struct SphereLightLanes {
+    vm lane{}, to{};     // the lanes that sample it; its sphere
+    vm index{};          // its row in the lanes' light table (lane), else 0
+    vf select{}, radius{};
+    V3 centre{};
+};
+
+// 5. Diffuse vertices whose chosen light is on a sphere seen from outside (not the hit sphere,
+// the point outside it) sample it lane-wise (step 7).
+template <bool kWide>
+KR_LANES SphereLightLanes choose_sphere_lights(const RenderScene& scene, const LaneScene<kWide>& lane_scene,
+                                               const HitLanes& h, vm smooth, vf light_pick) {
+    SphereLightLanes c;
+    // The chosen light's row in `lights` (negative: none, or a light off the spheres).
+    const vm area_index = smooth ? vertex::choose_light<Lanes>(scene, false, light_pick) -
+                                       lane_int(scene.lights_off_spheres)
+                                 : vm{} - 1;
+    c.index = (area_index >= 0) & area_index;
+    c.select = look_up(lane_scene.lights.select_prob, c.index);
+    c.to = look_up(lane_scene.lights.sphere, c.index);
+    c.centre = look_up(lane_scene.lights.centre, c.index);
+    c.radius = look_up(lane_scene.lights.radius, c.index);
+    const V3 from_light = h.p - c.centre;
+    c.lane = (area_index >= 0) & (c.select > 0) & (c.to != h.id) & (dot(from_light, from_light) > c.radius * c.radius);
+    return c;
+}
+
+// The vertices' shadow rays (from the hit points) and the light each brings if it is clear.
+struct ShadowLanes {
+    vm cast{}, into{}, to{};
+    V3 d, direct{};
+    vf tmax{};
+};
+
+// 6. Per lane, through the functions one path uses: the samples of other lights (lights off
+// the spheres, lights around the vertex, the `area` and `brief-area` strategies) at diffuse
+// vertices. Written to plain records and gathered into lanes after the loop: stores into
+// single lanes of a vector would stall its next load.
+KR_LANES void sample_lights_per_lane(const RenderScene& scene, const RenderSettings& settings, const HitLanes& h,
+                                     vm front, vm use, const VertexLanes& u, vm per_lane, const Paths& paths,
+                                     ShadowLanes& shadow) {
+    using Numbers = Sampler::VertexNumbers;
+    // (The hit's lanes read by index from copies: an indexed read of h's own would keep all of
+    // h in memory for the whole loop.)
+    const vf t = h.t;
+    const vm id = h.id;
+    const V3 p = h.p, n = h.n;
+    LaneVertex vertex[kLanes] = {};
+    for (unsigned left = lane_bits(per_lane); left != 0; left &= left - 1) {
+        const int k = __builtin_ctz(left);
+        Numbers lane_u;  // the lane's record, 0 for the numbers it does not read
+        if (use[k] & Sampler::use_light_pick) lane_u.light_pick = u.light_pick[k];
+        if (use[k] & Sampler::use_light) lane_u.light = {u.light_x[k], u.light_y[k]};
+        const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
+        const SurfacePoint sp{hit.n, front[k] != 0};
+        Ray ray;
+        Color light;
+        LaneVertex& v = vertex[k];
+        const Material& material = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
+        if (sample_one_light(scene, settings, material, hit, sp, lane_u.light_pick, lane_u.light, ray, light)) {
+            v.shadow = true;
+            v.shadow_d = ray.d;
+            v.shadow_tmax = ray.tmax;
+            v.shadow_into = ray.into_from_sphere ? -1 : 0;
+            v.shadow_to = ray.to_sphere;
+            v.direct = lane(paths.throughput, k) * double(paths.radiance_scale[k]) * light;
+        }
+    }
+    shadow.cast = gather_mask(vertex, &LaneVertex::shadow);
+    shadow.d = select(shadow.cast, gather(vertex, &LaneVertex::shadow_d), shadow.d);
+    shadow.tmax = gather(vertex, &LaneVertex::shadow_tmax);
+    shadow.into = gather(vertex, &LaneVertex::shadow_into), shadow.to = gather(vertex, &LaneVertex::shadow_to);
+    shadow.direct = gather(vertex, &LaneVertex::direct);
+}
+
+// 7. light_direct (vertex.inc) for the lanes of step 5: the sphere light's sample, and what it
+// brings (vertex.h).
+template <class M>
+KR_LANES void sample_sphere_lights(LightSampling sampling, const SphereLightLanes& c, const V3& light_radiance,
+                                   const HitLanes& h, const VertexLanes& u, const M& m, const V3& ns,
+                                   const Paths& paths, ShadowLanes& shadow) {
+    const vertex::LightSample<Lanes> ls =
+        vertex::sample_sphere_light<Lanes>(sampling, c.centre, c.radius, h.p, u.light_x, u.light_y, c.lane);
+    const vertex::DirectLight<Lanes> light = vertex::direct_light<Lanes>(ls, m, ns, light_radiance, c.select, true);
+    const vm lit = light.lit;
+    shadow.cast |= lit;
+    shadow.d = select(lit, ls.wi, shadow.d);
+    shadow.tmax = select(lit, ls.distance, shadow.tmax);
+    shadow.into = lit ? vm(dot(ls.wi, h.n) < 0) : shadow.into;
+    shadow.to = lit ? c.to : shadow.to;
+    shadow.direct = select(lit, (paths.throughput * paths.radiance_scale) * light.light, shadow.direct);
+}
+
+// 8. The light samples' shadow rays, together; each clear one adds its light.
+template <bool kWide>
+KR_LANES void cast_shadows(const LaneScene<kWide>& lane_scene, const HitLanes& h, const ShadowLanes& shadow,
+                           Paths& paths) {
+    paths.rays -= shadow.cast;
+    const vm clear =
+        shadow.cast & ~lane_scene.occluded(h.p, shadow.d, h.id, shadow.into, shadow.tmax, shadow.to, shadow.cast);
+    paths.L = select(clear, paths.L + shadow.direct, paths.L);
+}
+
+// 9. The next direction (vertex.h's sample_material), then the path's state, and Russian
+// roulette past the threshold depth.
+template <class M>
+KR_LANES void continue_paths(const RenderSettings& settings, bool naive, const M& m, const HitLanes& h, vm front,
+                             const V3& ns, const VertexLanes& u, Paths& paths) {
+    const vertex::Scatter<Lanes> scatter =
+        vertex::sample_material<Lanes>(m, paths.alive, paths.d, ns, front, u.lobe, u.bsdf_x, u.bsdf_y);
+    paths.alive &= scatter.ok;
+    paths.throughput = select(paths.alive, paths.throughput * scatter.weight, V3{vf{}, vf{}, vf{}});
+    const vm crossed = paths.alive & scatter.transmitted;
+    if (any_lane(crossed))
+        vertex::cross_medium<Lanes>(paths.medium_eta, paths.radiance_scale, crossed, front, scatter.eta);
+    paths.full_emission = naive ? ~vm{} : ~scatter.smooth;
+    paths.last_bsdf_pdf = scatter.pdf;
+    paths.last_p = h.p;
+    paths.last_sphere = h.id;
+    paths.o = h.p;
+    paths.d = scatter.direction;
+    paths.from = h.id;
+    paths.into = dot(scatter.direction, h.n) < 0;
+
+    const vm roulette = paths.alive & (paths.depth + 1 >= settings.rr_depth);
+    if (any_lane(roulette)) vertex::russian_roulette<Lanes>(paths.throughput, paths.alive, roulette, u.roulette);
+    paths.depth += 1;
+}
+
 // `count` samples, a path per lane, a bounce at a time: a lane whose path ends hands in its
 // result and takes the next sample, so lanes stay busy while paths have different lengths.
 // `source` gives the samples' camera rays (RayRecords or CameraColumns).
@@ -253,18 +533,14 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
                  Sampler* const* samplers, int count, SampleResult* results) {
     const bool naive = settings.integrator == Integrator::pt_naive;
     const bool next_event_possible = scene.light_count() > 0;
-    // Area-light samples lane-wise: the `brief` and `cone` strategies (the others per lane).
+    // Lights on spheres sampled lane-wise: the `brief` and `cone` strategies (the others per lane).
     const bool lane_lights = !naive && (settings.light_sampling == LightSampling::brief ||
                                         settings.light_sampling == LightSampling::cone);
     Paths paths{};  // no lane alive: each path's state is set where its lane starts it, below
-    int lane_sample[kLanes];
-    std::fill(lane_sample, lane_sample + kLanes, -1);  // the sample each lane traces
-    Sampler* lane_sampler[kLanes] = {};
-    int next_sample = 0;
-    // Sobol samplers draw their vertex numbers lane-wise; the others one lane at a time.
-    bool sobol_lanes = true;
+    LaneSamples lanes;
+    std::fill(lanes.sample, lanes.sample + kLanes, -1);
     if constexpr (!Source::kSobolOnly)
-        for (int k = 0; k < count; ++k) sobol_lanes &= samplers[k]->sobol();
+        for (int k = 0; k < count; ++k) lanes.sobol_lanes &= samplers[k]->sobol();
 
     // Per sphere: its material and what a vertex on it reads, and its light. Per light on a
     // sphere: what its samples read. Where the rays are cast: the spheres or the tree.
@@ -301,240 +577,42 @@ void trace_paths(const RenderScene& scene, const RenderSettings& settings, const
         lights.sphere.data()[row] = lane_int(light.sphere);
     }
     for (;;) {
-        // Lanes whose path has ended hand in its result and start the next sample's. The new
-        // paths' state is blended in lane-wise: stores into single lanes would stall the
-        // vectors' next loads.
-        // (A loop over the ended lanes' bits: testing the alive mask lane by lane is dearer,
-        // docs/performance.md, "Design choices and their figures".)
-        vm start{};
-        int start_sample[kLanes] = {};
-        const int first_started = next_sample;
-        for (unsigned ended = ~lane_bits(paths.alive) & ((1u << kLanes) - 1); ended != 0; ended &= ended - 1) {
-            const int k = __builtin_ctz(ended);
-            if (lane_sample[k] >= 0) {
-                SampleResult& r = results[lane_sample[k]];
-                r.radiance = lane(paths.L, k);
-                r.primary_distance = paths.primary_distance[k];
-                r.rays = uint64_t(paths.rays[k]);
-                lane_sample[k] = -1;
-            }
-            if (next_sample == count) continue;
-            lane_sample[k] = next_sample;
-            if constexpr (!Source::kSobolOnly) lane_sampler[k] = samplers[next_sample];
-            start_sample[k] = next_sample;
-            start[k] = -1;
-            ++next_sample;
-        }
-        if (any_lane(start)) {
-            const V3 zero{vf{}, vf{}, vf{}};
-            source.start(start, start_sample, first_started, paths.o, paths.d);
-            paths.alive |= start;
-            paths.rays = start ? vm{} : paths.rays;
-            paths.depth = start ? vm{} : paths.depth;
-            paths.from = start ? vm{} - 1 : paths.from;
-            paths.into = start ? vm{} : paths.into;
-            paths.throughput = select(start, V3{splat(1), splat(1), splat(1)}, paths.throughput);
-            paths.medium_eta = select(start, splat(1), paths.medium_eta);
-            paths.radiance_scale = select(start, splat(1), paths.radiance_scale);
-            paths.L = select(start, zero, paths.L);
-            paths.full_emission |= start;
-            paths.last_bsdf_pdf = select(start, vf{}, paths.last_bsdf_pdf);
-            paths.last_p = select(start, zero, paths.last_p);
-            paths.last_sphere = start ? vm{} - 1 : paths.last_sphere;
-            paths.primary_distance = select(start, splat(kMissDepth), paths.primary_distance);
-            if constexpr (Source::kSobolOnly) {
-                // The samplers' state, from the source's columns, into the lanes; the vertices
-                // below advance it there.
-                source.start_sobol(start, start_sample, first_started, paths.sobol_key, paths.sobol_index,
-                                   paths.sobol_dimension);
-            } else if (sobol_lanes) {
-                // The same from the samplers.
-                for (unsigned started = lane_bits(start); started != 0; started &= started - 1) {
-                    const int k = __builtin_ctz(started);
-                    paths.sobol_key[k] = lane_sampler[k]->sobol_key();
-                    paths.sobol_index[k] = lane_sampler[k]->index_reversed();
-                    paths.sobol_dimension[k] = lane_sampler[k]->dimension();
-                }
-            }
-        }
+        start_samples(source, samplers, count, results, lanes, paths);
         if (!any_lane(paths.alive)) break;
-
-        // Closest hits; a path whose ray leaves the scene ends.
-        paths.rays -= paths.alive;
-        vf t;
-        vm id;
-        lane_scene.closest(paths.o, paths.d, paths.from, paths.into, paths.alive, t, id);
-        paths.alive &= id >= 0;
-        if (!any_lane(paths.alive)) continue;
-        paths.primary_distance = select(paths.alive & (paths.depth == 0), t, paths.primary_distance);
-
-        // Hit records (as fill_hit in render_scene.cpp): the point projected back onto its sphere.
-        const vm hit_id = paths.alive ? id : vm{};  // sphere 0 stands in for ended paths
-        const V3 centre = look_up(table.centre, hit_id);
-        const vf radius = look_up(table.radius, hit_id);
-        const V3 offset = (paths.o + paths.d * t) - centre;
-        const vf offset_length = sqrt_lanes(dot(offset, offset));
-        const V3 n = select(offset_length > 0, offset * (1.0 / offset_length), -paths.d);
-        const V3 p = centre + n * radius;
-
-        // Emission seen along the path: weighed against the last vertex's light sample where
-        // that could have found it (vertex.h's emission_mis_weight), else counted whole.
-        const vm emits = paths.alive & lane_scene.emits(hit_id);
-        if (any_lane(emits)) {
-            const vm light = emits ? look_up(lane_scene.light, hit_id) : vm{};
-            const vm weighed = emits & ~paths.full_emission & (paths.last_sphere != id);
-            vf weight = splat(1.0);
-            if (any_lane(weighed))
-                weight = select(weighed,
-                                vertex::emission_mis_weight<Lanes>(settings.light_sampling, centre, radius,
-                                                                   look_up(lights.select_prob, light), paths.last_p,
-                                                                   paths.d, t, n, paths.last_bsdf_pdf, weighed),
-                                weight);
-            const V3 seen = (paths.throughput * paths.radiance_scale) * look_up(lights.radiance, light) * weight;
-            paths.L = select(emits, paths.L + seen, paths.L);
-        }
+        HitLanes h;
+        if (!find_hits(lane_scene, paths, h)) continue;
+        add_emission(lane_scene, settings.light_sampling, h, paths);
         paths.alive &= paths.depth < settings.max_depth;
         if (!any_lane(paths.alive)) continue;
 
-        const vm front = dot(paths.d, n) < 0;
-        const V3 ns = select(front, n, -n);
-
-        // Each vertex's material and the numbers it reads (vertex_numbers_used, from the tables;
-        // none in lanes that are not alive).
-        const vm type = look_up(table.type, hit_id);
-        const vm use = (look_up(table.use, hit_id) |
+        const vm front = dot(paths.d, h.n) < 0;
+        const V3 ns = select(front, h.n, -h.n);
+        // Each vertex's material and the numbers it reads (vertex_numbers_used, from the
+        // tables; none in lanes that are not alive).
+        const vm type = look_up(table.type, h.hit_id);
+        const vm use = (look_up(table.use, h.hit_id) |
                         ((paths.depth + 1 >= settings.rr_depth) & lane_int(Sampler::use_roulette))) &
                        paths.alive;
         unsigned use_any = 0;
         for (int k = 0; k < kLanes; ++k) use_any |= unsigned(use[k]);
-        const vm smooth = paths.alive & vertex::has_smooth_lobe<Lanes>(LaneMaterial<SphereTable<kWide>>{table, hit_id, type, {}});
-        // The vertex's numbers, lane-wise: Sobol ones drawn in lanes (each lane reads those its
-        // `use` names; the light choice is 0 where unread, as next_vertex gives), the others
-        // drawn one lane at a time and gathered.
-        using Numbers = Sampler::VertexNumbers;
-        VertexLanes u;
-        if (sobol_lanes) {
-            u = sobol_vertex_lanes(paths.sobol_key, paths.sobol_index, paths.sobol_dimension, use_any);
-            paths.sobol_dimension += 5;
-            u.light_pick = select((use & lane_int(Sampler::use_light_pick)) != 0, u.light_pick, vf{});
-        } else {
-            Numbers numbers[kLanes];  // 0 for those a vertex does not read, as next_vertex gives
-            for (int k = 0; k < kLanes; ++k)
-                if (paths.alive[k]) numbers[k] = lane_sampler[k]->next_vertex(unsigned(use[k]));
-            u = {gather(numbers, &Numbers::light_pick), gather_x(numbers, &Numbers::light),
-                 gather_y(numbers, &Numbers::light),    gather(numbers, &Numbers::lobe),
-                 gather_x(numbers, &Numbers::bsdf),     gather_y(numbers, &Numbers::bsdf),
-                 gather(numbers, &Numbers::roulette)};
-        }
+        const vm smooth =
+            paths.alive & vertex::has_smooth_lobe<Lanes>(LaneMaterial<SphereTable<kWide>>{table, h.hit_id, type, {}});
+        const VertexLanes u = draw_numbers(lanes, use, use_any, paths);
 
-        // Diffuse vertices whose chosen light is on a sphere seen from outside (not the hit
-        // sphere, the point outside it) sample it lane-wise, below.
-        vm light_lane{}, light_to{};
-        vm light_index{};  // the light a lane samples (light_lane), else 0
-        vf light_select{}, light_radius{};
-        V3 light_centre{};
-        if (lane_lights && scene.lights_off_spheres < scene.lights.size() && any_lane(smooth)) {
-            // The chosen light's row in `lights` (negative: none, or a light off the spheres).
-            const vm area_index = smooth ? vertex::choose_light<Lanes>(scene, false, u.light_pick) -
-                                               lane_int(scene.lights_off_spheres)
-                                         : vm{} - 1;
-            light_index = (area_index >= 0) & area_index;
-            light_select = look_up(lights.select_prob, light_index);
-            light_to = look_up(lights.sphere, light_index);
-            light_centre = look_up(lights.centre, light_index);
-            light_radius = look_up(lights.radius, light_index);
-            const V3 from_light = p - light_centre;
-            light_lane = (area_index >= 0) & (light_select > 0) & (light_to != id) &
-                         (dot(from_light, from_light) > light_radius * light_radius);
-        }
-
-        // Per lane, through the functions one path uses: the samples of other lights (point
-        // lights, lights around the vertex, the `area` and `brief-area` strategies) at diffuse
-        // vertices. Written to plain records and gathered into lanes after the loop: stores
-        // into single lanes of a vector would stall its next load.
-        const vm per_lane = next_event_possible ? smooth & ~light_lane : vm{};
-        vm shadow_cast{}, shadow_into{}, shadow_to{};
-        V3 shadow_d = ns, direct{};
-        vf shadow_tmax{};
-        if (any_lane(per_lane)) {
-            LaneVertex vertex[kLanes] = {};
-            for (unsigned left = lane_bits(per_lane); left != 0; left &= left - 1) {
-                const int k = __builtin_ctz(left);
-                Numbers lane_u;  // the lane's record, 0 for the numbers it does not read
-                if (use[k] & Sampler::use_light_pick) lane_u.light_pick = u.light_pick[k];
-                if (use[k] & Sampler::use_light) lane_u.light = {u.light_x[k], u.light_y[k]};
-                const Hit hit{t[k], int(id[k]), lane(p, k), lane(n, k)};
-                const SurfacePoint sp{hit.n, front[k] != 0};
-                Ray shadow;
-                Color light;
-                LaneVertex& v = vertex[k];
-                const Material& material = scene.materials[size_t(scene.sphere_material[size_t(id[k])])];
-                if (sample_one_light(scene, settings, material, hit, sp, lane_u.light_pick, lane_u.light, shadow,
-                                     light)) {
-                    v.shadow = true;
-                    v.shadow_d = shadow.d;
-                    v.shadow_tmax = shadow.tmax;
-                    v.shadow_into = shadow.into_from_sphere ? -1 : 0;
-                    v.shadow_to = shadow.to_sphere;
-                    v.direct = lane(paths.throughput, k) * double(paths.radiance_scale[k]) * light;
-                }
-            }
-            shadow_cast = gather_mask(vertex, &LaneVertex::shadow);
-            shadow_d = select(shadow_cast, gather(vertex, &LaneVertex::shadow_d), ns);
-            shadow_tmax = gather(vertex, &LaneVertex::shadow_tmax);
-            shadow_into = gather(vertex, &LaneVertex::shadow_into), shadow_to = gather(vertex, &LaneVertex::shadow_to);
-            direct = gather(vertex, &LaneVertex::direct);
-        }
-        const V3 rho = look_up_rho(table, hit_id);
-        const V3 shadow_o = p;
-        const vm shadow_from = id;
-
-        // light_direct (vertex.inc) for those lanes: the sphere light's sample, and what it
-        // brings (vertex.h).
-        if (any_lane(light_lane)) {
-            const V3 light_radiance = look_up(lights.radiance, light_index);
-            const vertex::LightSample<Lanes> ls = vertex::sample_sphere_light<Lanes>(
-                settings.light_sampling, light_centre, light_radius, p, u.light_x, u.light_y, light_lane);
-            const vertex::DirectLight<Lanes> light =
-                vertex::direct_light<Lanes>(ls, LaneMaterial<SphereTable<kWide>>{table, hit_id, type, rho}, ns,
-                                            light_radiance, light_select, true);
-            const vm lit = light.lit;
-            shadow_cast |= lit;
-            shadow_d = select(lit, ls.wi, shadow_d);
-            shadow_tmax = select(lit, ls.distance, shadow_tmax);
-            shadow_into = lit ? vm(dot(ls.wi, n) < 0) : shadow_into;
-            shadow_to = lit ? light_to : shadow_to;
-            direct = select(lit, (paths.throughput * paths.radiance_scale) * light.light, direct);
-        }
-
-        // The light samples' shadow rays, together; each clear one adds its light.
-        if (any_lane(shadow_cast)) {
-            paths.rays -= shadow_cast;
-            const vm clear = shadow_cast & ~lane_scene.occluded(shadow_o, shadow_d, shadow_from, shadow_into,
-                                                            shadow_tmax, shadow_to, shadow_cast);
-            paths.L = select(clear, paths.L + direct, paths.L);
-        }
-
-        // The next direction (vertex.h's sample_material), then the path's state.
-        const vertex::Scatter<Lanes> scatter = vertex::sample_material<Lanes>(
-            LaneMaterial<SphereTable<kWide>>{table, hit_id, type, rho}, paths.alive, paths.d, ns, front, u.lobe, u.bsdf_x, u.bsdf_y);
-        paths.alive &= scatter.ok;
-        paths.throughput = select(paths.alive, paths.throughput * scatter.weight, V3{vf{}, vf{}, vf{}});
-        const vm crossed = paths.alive & scatter.transmitted;
-        if (any_lane(crossed))
-            vertex::cross_medium<Lanes>(paths.medium_eta, paths.radiance_scale, crossed, front, scatter.eta);
-        paths.full_emission = naive ? ~vm{} : ~scatter.smooth;
-        paths.last_bsdf_pdf = scatter.pdf;
-        paths.last_p = p;
-        paths.last_sphere = id;
-        paths.o = p;
-        paths.d = scatter.direction;
-        paths.from = id;
-        paths.into = dot(scatter.direction, n) < 0;
-
-        const vm roulette = paths.alive & (paths.depth + 1 >= settings.rr_depth);
-        if (any_lane(roulette)) vertex::russian_roulette<Lanes>(paths.throughput, paths.alive, roulette, u.roulette);
-        paths.depth += 1;
+        SphereLightLanes sphere_lights;
+        if (lane_lights && scene.lights_off_spheres < scene.lights.size() && any_lane(smooth))
+            sphere_lights = choose_sphere_lights(scene, lane_scene, h, smooth, u.light_pick);
+        const vm per_lane = next_event_possible ? smooth & ~sphere_lights.lane : vm{};
+        ShadowLanes shadow;
+        shadow.d = ns;
+        if (any_lane(per_lane)) sample_lights_per_lane(scene, settings, h, front, use, u, per_lane, paths, shadow);
+        const V3 rho = look_up_rho(table, h.hit_id);
+        const LaneMaterial<SphereTable<kWide>> material{table, h.hit_id, type, rho};
+        if (any_lane(sphere_lights.lane))
+            sample_sphere_lights(settings.light_sampling, sphere_lights, look_up(lights.radiance, sphere_lights.index),
+                                 h, u, material, ns, paths, shadow);
+        if (any_lane(shadow.cast)) cast_shadows(lane_scene, h, shadow, paths);
+        continue_paths(settings, naive, material, h, front, ns, u, paths);
     }
 }
 

@@ -99,6 +99,23 @@ KR_LANES unsigned lane_bits(vm mask) {
 }
 
 KR_LANES vf abs_lanes(vf x) { return select(x < 0, -x, x); }
+// a * b + c rounded once where GCC builds the target with fused multiply-adds (x86-64-v3 and
+// v4), as it contracts such sums elsewhere; written out where a sum must not depend on whether
+// GCC finds the product in the sum's block (kernels.cpp, the path loop's stages). The x86-64
+// target has no fused form, and Clang builds the levels unfused (CMakeLists.txt): a * b + c.
+KR_LANES vf mul_add_lanes(vf a, vf b, vf c) {
+#if defined(__clang__)
+    return a * b + c;
+#elif defined(KR_LANES_V4)
+    return _mm512_fmadd_ps(a, b, c);
+#elif defined(KR_LANES_FLOAT)
+    return _mm256_fmadd_ps(a, b, c);
+#elif defined(KR_LANES_V3)
+    return _mm256_fmadd_pd(a, b, c);
+#else
+    return a * b + c;
+#endif
+}
 KR_LANES vm sign_bit(vf x) {  // all ones where x is negative (-0 included)
     vm bits;
     __builtin_memcpy(&bits, &x, sizeof bits);
@@ -114,6 +131,9 @@ KR_LANES V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, 
 KR_LANES V3 operator*(const V3& a, vf s) { return {a.x * s, a.y * s, a.z * s}; }
 KR_LANES V3 operator*(const V3& a, const V3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
 KR_LANES V3 operator-(const V3& a) { return {-a.x, -a.y, -a.z}; }
+KR_LANES V3 mul_add_lanes(const V3& a, vf b, const V3& c) {
+    return {mul_add_lanes(a.x, b, c.x), mul_add_lanes(a.y, b, c.y), mul_add_lanes(a.z, b, c.z)};
+}
 KR_LANES vf dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 KR_LANES V3 select(vm mask, const V3& a, const V3& b) {
     return {select(mask, a.x, b.x), select(mask, a.y, b.y), select(mask, a.z, b.z)};
