@@ -7,6 +7,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <mutex>
 #include <random>
 
 #include "render/progressive.h"
@@ -253,13 +255,51 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
         for (const auto& f : frames) most = std::max(most, f->carried_pixels);
         return most;
     };
+    // The prior always made before the first full frame, whatever it costs on this machine.
+    FrameSchedule prior_first;
+    prior_first.prior_budget = std::numeric_limits<double>::infinity();
     {
         RenderWorker worker;
+        worker.set_schedule(prior_first);
         EXPECT_EQ(carried(full_frames(worker, 1, before, settings, 32)), 0u);  // nothing earlier
         const auto frames = full_frames(worker, 2, after, settings, 64);
         EXPECT_GT(frames.front()->carried_pixels, size_t(kW * kH / 2));
         EXPECT_EQ(frames.back()->carried_pixels, 0u);  // the finished frame
         EXPECT_EQ(carried(full_frames(worker, 3, other_world, settings, 16)), 0u);
+    }
+    {
+        // A prior dearer than the budget (here any) waits for the first full frame: that frame
+        // comes without the earlier picture and the next one carries it. Frames at every
+        // balanced count (no interval), so the order does not depend on the machine's speed.
+        FrameSchedule prior_late;
+        prior_late.age_fraction = prior_late.min_interval = prior_late.max_interval = 0;
+        prior_late.cost_share = std::numeric_limits<double>::infinity();
+        prior_late.prior_budget = 0;
+        // Every frame as it is published (the callback runs on the render thread right after it).
+        std::mutex mutex;
+        std::vector<std::shared_ptr<const Snapshot>> published;
+        RenderWorker* self = nullptr;
+        RenderWorker worker([&] {
+            std::lock_guard lock(mutex);
+            if (self) published.push_back(self->latest());
+        });
+        {
+            std::lock_guard lock(mutex);
+            self = &worker;
+        }
+        worker.set_schedule(prior_late);
+        full_frames(worker, 1, before, settings, 32);
+        const auto polled = full_frames(worker, 2, after, settings, 64);
+        std::vector<std::shared_ptr<const Snapshot>> frames;
+        {
+            std::lock_guard lock(mutex);
+            for (const auto& f : published)
+                if (f && f->generation == 2 && f->scale == 1) frames.push_back(f);
+        }
+        ASSERT_GE(frames.size(), 3u);
+        EXPECT_EQ(frames[0]->carried_pixels, 0u);
+        EXPECT_GT(frames[1]->carried_pixels, size_t(kW * kH / 2));
+        EXPECT_EQ(polled.back()->carried_pixels, 0u);  // the finished frame
     }
     {
         RenderWorker worker;
