@@ -5,6 +5,7 @@
 // out by the target; and the render thread's first full frame after an orbit is better for it.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -300,6 +301,68 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
         EXPECT_EQ(frames[0]->carried_pixels, 0u);
         EXPECT_GT(frames[1]->carried_pixels, size_t(kW * kH / 2));
         EXPECT_EQ(polled.back()->carried_pixels, 0u);  // the finished frame
+    }
+    {
+        // An edit that comes right after such a first frame (submitted as it is published):
+        // the earlier picture (32 spp) still becomes the history, and the next move carries it
+        // on to 16 spp and beyond (a history of the interrupted view's 2 spp would fade out by 8).
+        Scene further_scene = orbited;
+        orbit(further_scene.cameras[size_t(further_scene.camera)], 10, 0);
+        const auto further = std::make_shared<const RenderScene>(prepare_scene(further_scene));
+        FrameSchedule every;
+        every.age_fraction = every.min_interval = every.max_interval = 0;
+        every.cost_share = std::numeric_limits<double>::infinity();
+        every.prior_budget = 0;
+        std::mutex mutex;
+        std::vector<std::shared_ptr<const Snapshot>> published;
+        RenderWorker* self = nullptr;
+        bool armed = false;
+        RenderWorker worker([&] {
+            std::lock_guard lock(mutex);
+            if (!self) return;
+            const auto f = self->latest();
+            published.push_back(f);
+            if (armed && f && f->generation == 2 && f->scale == 1) {
+                armed = false;
+                FrameSchedule now = every;
+                now.prior_budget = std::numeric_limits<double>::infinity();
+                self->set_schedule(now);
+                StopRule rule;
+                rule.max_passes = 64;
+                self->submit({3, further, settings, rule, nullptr, {}});
+            }
+        });
+        {
+            std::lock_guard lock(mutex);
+            self = &worker;
+        }
+        worker.set_schedule(every);
+        full_frames(worker, 1, before, settings, 32);
+        {
+            std::lock_guard lock(mutex);
+            armed = true;
+        }
+        StopRule open_ended;
+        open_ended.max_passes = kUnlimitedPasses;
+        worker.submit({2, after, settings, open_ended, nullptr, {}});
+        std::shared_ptr<const Snapshot> f;
+        for (int waits = 0; waits < 600 && !(f && f->generation == 3 && f->finished); ++waits)
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
+        ASSERT_TRUE(f && f->generation == 3 && f->finished);
+        std::lock_guard lock(mutex);
+        size_t second = 0, at16 = 0;
+        bool saw16 = false;
+        for (const auto& g : published) {
+            if (!g || g->scale != 1) continue;
+            if (g->generation == 2) {
+                ++second;
+                EXPECT_EQ(g->carried_pixels, 0u);
+            }
+            if (g->generation == 3 && g->spp == 16) saw16 = true, at16 = g->carried_pixels;
+        }
+        EXPECT_EQ(second, 1u);
+        ASSERT_TRUE(saw16);
+        EXPECT_GT(at16, size_t(kW * kH / 2));
     }
     {
         RenderWorker worker;

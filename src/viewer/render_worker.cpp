@@ -522,21 +522,31 @@ void RenderWorker::run() {
         std::shared_ptr<const RenderScene> scene;
         RenderSettings settings;
     } earlier;
-    auto make_prior = [&](int w, int h) {
-        const auto start = Clock::now();
+    auto forget_history = [&] {
+        history.reset();  // only the carried picture is lost, not the job
+        history_scene.reset();
+        history_spp = 0;
+        prior.reset();
+        view_hits_made.reset();
+    };
+    auto keep_earlier = [&] {
         try {
             keep_history(earlier.frame, earlier.scene, earlier.settings);
-            earlier = {};
+        } catch (const std::bad_alloc&) {
+            forget_history();
+        }
+        earlier = {};
+    };
+    auto make_prior = [&](int w, int h) {
+        const auto start = Clock::now();
+        keep_earlier();
+        try {
             if (!history_fits() || history->generation == job.generation) return;
             view_hits_made = view_hits(*job.scene, w, h);
             hits_generation = job.generation;
             prior = reproject(*job.scene, *view_hits_made, *history);
         } catch (const std::bad_alloc&) {
-            history.reset();  // only the carried picture is lost, not the job
-            history_scene.reset();
-            history_spp = 0;
-            prior.reset();
-            view_hits_made.reset();
+            forget_history();
             return;
         }
         prior_seconds_per_pixel = seconds_since(start) / std::max(1.0, double(w) * h);
@@ -799,7 +809,7 @@ void RenderWorker::run() {
         if (prior_deferred && full_frame) {
             prior_deferred = false;
             if (!finished && !stop_.load()) make_prior(w, h);
-            earlier = {};
+            else keep_earlier();  // still the history for the next camera move, as before the frame
         }
         // The view's first surfaces, which the next camera move's prior needs for this view's
         // picture (keep_history): traced once a job, once its first full frame is on screen and
