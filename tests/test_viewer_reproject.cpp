@@ -5,8 +5,11 @@
 // out by the target; and the render thread's first full frame after an orbit is better for it.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <mutex>
 #include <random>
 
 #include "render/progressive.h"
@@ -253,13 +256,113 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
         for (const auto& f : frames) most = std::max(most, f->carried_pixels);
         return most;
     };
+    // The prior always made before the first full frame, whatever it costs on this machine.
+    FrameSchedule prior_first;
+    prior_first.prior_budget = std::numeric_limits<double>::infinity();
     {
         RenderWorker worker;
+        worker.set_schedule(prior_first);
         EXPECT_EQ(carried(full_frames(worker, 1, before, settings, 32)), 0u);  // nothing earlier
         const auto frames = full_frames(worker, 2, after, settings, 64);
         EXPECT_GT(frames.front()->carried_pixels, size_t(kW * kH / 2));
         EXPECT_EQ(frames.back()->carried_pixels, 0u);  // the finished frame
         EXPECT_EQ(carried(full_frames(worker, 3, other_world, settings, 16)), 0u);
+    }
+    {
+        // A prior dearer than the budget (here any) waits for the first full frame: that frame
+        // comes without the earlier picture and the next one carries it. Frames at every
+        // balanced count (no interval), so the order does not depend on the machine's speed.
+        FrameSchedule prior_late;
+        prior_late.age_fraction = prior_late.min_interval = prior_late.max_interval = 0;
+        prior_late.cost_share = std::numeric_limits<double>::infinity();
+        prior_late.prior_budget = 0;
+        // Every frame as it is published (the callback runs on the render thread right after it).
+        std::mutex mutex;
+        std::vector<std::shared_ptr<const Snapshot>> published;
+        RenderWorker* self = nullptr;
+        RenderWorker worker([&] {
+            std::lock_guard lock(mutex);
+            if (self) published.push_back(self->latest());
+        });
+        {
+            std::lock_guard lock(mutex);
+            self = &worker;
+        }
+        worker.set_schedule(prior_late);
+        full_frames(worker, 1, before, settings, 32);
+        const auto polled = full_frames(worker, 2, after, settings, 64);
+        std::vector<std::shared_ptr<const Snapshot>> frames;
+        {
+            std::lock_guard lock(mutex);
+            for (const auto& f : published)
+                if (f && f->generation == 2 && f->scale == 1) frames.push_back(f);
+        }
+        ASSERT_GE(frames.size(), 3u);
+        EXPECT_EQ(frames[0]->carried_pixels, 0u);
+        EXPECT_GT(frames[1]->carried_pixels, size_t(kW * kH / 2));
+        EXPECT_EQ(polled.back()->carried_pixels, 0u);  // the finished frame
+    }
+    {
+        // An edit that comes right after such a first frame (submitted as it is published):
+        // the earlier picture (32 spp) still becomes the history, and the next move carries it
+        // on to 16 spp and beyond (a history of the interrupted view's 2 spp would fade out by 8).
+        Scene further_scene = orbited;
+        orbit(further_scene.cameras[size_t(further_scene.camera)], 10, 0);
+        const auto further = std::make_shared<const RenderScene>(prepare_scene(further_scene));
+        FrameSchedule every;
+        every.age_fraction = every.min_interval = every.max_interval = 0;
+        every.cost_share = std::numeric_limits<double>::infinity();
+        every.prior_budget = 0;
+        std::mutex mutex;
+        std::vector<std::shared_ptr<const Snapshot>> published;
+        RenderWorker* self = nullptr;
+        bool armed = false;
+        RenderWorker worker([&] {
+            std::lock_guard lock(mutex);
+            if (!self) return;
+            const auto f = self->latest();
+            published.push_back(f);
+            if (armed && f && f->generation == 2 && f->scale == 1) {
+                armed = false;
+                FrameSchedule now = every;
+                now.prior_budget = std::numeric_limits<double>::infinity();
+                self->set_schedule(now);
+                StopRule rule;
+                rule.max_passes = 64;
+                self->submit({3, further, settings, rule, nullptr, {}});
+            }
+        });
+        {
+            std::lock_guard lock(mutex);
+            self = &worker;
+        }
+        worker.set_schedule(every);
+        full_frames(worker, 1, before, settings, 32);
+        {
+            std::lock_guard lock(mutex);
+            armed = true;
+        }
+        StopRule open_ended;
+        open_ended.max_passes = kUnlimitedPasses;
+        worker.submit({2, after, settings, open_ended, nullptr, {}});
+        std::shared_ptr<const Snapshot> f;
+        for (int waits = 0; waits < 600 && !(f && f->generation == 3 && f->finished); ++waits)
+            f = worker.wait_newer(f ? f->serial : 0, std::chrono::milliseconds(1000));
+        ASSERT_TRUE(f && f->generation == 3 && f->finished);
+        std::lock_guard lock(mutex);
+        size_t second = 0, at16 = 0;
+        bool saw16 = false;
+        for (const auto& g : published) {
+            if (!g || g->scale != 1) continue;
+            if (g->generation == 2) {
+                ++second;
+                EXPECT_EQ(g->carried_pixels, 0u);
+            }
+            if (g->generation == 3 && g->spp == 16) saw16 = true, at16 = g->carried_pixels;
+        }
+        EXPECT_EQ(second, 1u);
+        ASSERT_TRUE(saw16);
+        EXPECT_GT(at16, size_t(kW * kH / 2));
     }
     {
         RenderWorker worker;

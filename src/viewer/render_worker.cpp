@@ -476,6 +476,11 @@ void RenderWorker::run() {
     int history_spp = 0;
     std::optional<Reprojection> prior;
     bool prior_made = false;
+    // The prior's cost (the new view's first surfaces and the reprojection), measured per
+    // pixel and carried across edits (0: none made yet; a pass's cost stands for it), and
+    // whether the job's prior waits for its first full frame to be on screen (prior_budget).
+    double prior_seconds_per_pixel = 0;
+    bool prior_deferred = false;
     // The first surfaces of a view a prior was made for (`hits_generation`'s job): its frame,
     // kept as the history later, takes them instead of tracing them again.
     std::optional<ViewHits> view_hits_made;
@@ -491,22 +496,60 @@ void RenderWorker::run() {
     auto history_fits = [&] { return history && history_scene && fits_job(*history_scene, history_settings); };
     // The newest full frame (an earlier job's) becomes the history when it could stand for
     // `job`'s view and has more samples than the history, or the history could not.
-    auto keep_history = [&] {
-        if (!last_full || !last_full_scene || last_full->denoised.pixels.empty() || last_full->spp < 2 ||
-            (history && history->generation == last_full->generation) || !fits_job(*last_full_scene, last_full_settings))
+    auto keep_history = [&](const std::shared_ptr<const Snapshot>& last, const std::shared_ptr<const RenderScene>& scene,
+                            const RenderSettings& settings) {
+        if (!last || !scene || last->denoised.pixels.empty() || last->spp < 2 ||
+            (history && history->generation == last->generation) || !fits_job(*scene, settings))
             return;
-        if (history_fits() && last_full->spp <= history_spp) return;
+        if (history_fits() && last->spp <= history_spp) return;
         ViewHistory h;
-        h.generation = last_full->generation;
-        if (view_hits_made && hits_generation == last_full->generation) h.hits = std::move(*view_hits_made);
-        else h.hits = view_hits(*last_full_scene, last_full->radiance.width, last_full->radiance.height);
+        h.generation = last->generation;
+        if (view_hits_made && hits_generation == last->generation) h.hits = std::move(*view_hits_made);
+        else h.hits = view_hits(*scene, last->radiance.width, last->radiance.height);
         view_hits_made.reset();
-        h.picture = last_full->denoised;
-        h.samples = last_full->sample_count;
+        h.picture = last->denoised;
+        h.samples = last->sample_count;
         history = std::move(h);
-        history_scene = last_full_scene;
-        history_settings = last_full_settings;
-        history_spp = last_full->spp;
+        history_scene = scene;
+        history_settings = settings;
+        history_spp = last->spp;
+    };
+    // The job's prior (the newest full frame before its first, `earlier`, kept as the history
+    // where it is the best picture of the world yet, then the view's first surfaces and the
+    // reprojection), and its measured cost per pixel.
+    struct Earlier {
+        std::shared_ptr<const Snapshot> frame;
+        std::shared_ptr<const RenderScene> scene;
+        RenderSettings settings;
+    } earlier;
+    auto forget_history = [&] {
+        history.reset();  // only the carried picture is lost, not the job
+        history_scene.reset();
+        history_spp = 0;
+        prior.reset();
+        view_hits_made.reset();
+    };
+    auto keep_earlier = [&] {
+        try {
+            keep_history(earlier.frame, earlier.scene, earlier.settings);
+        } catch (const std::bad_alloc&) {
+            forget_history();
+        }
+        earlier = {};
+    };
+    auto make_prior = [&](int w, int h) {
+        const auto start = Clock::now();
+        keep_earlier();
+        try {
+            if (!history_fits() || history->generation == job.generation) return;
+            view_hits_made = view_hits(*job.scene, w, h);
+            hits_generation = job.generation;
+            prior = reproject(*job.scene, *view_hits_made, *history);
+        } catch (const std::bad_alloc&) {
+            forget_history();
+            return;
+        }
+        prior_seconds_per_pixel = seconds_since(start) / std::max(1.0, double(w) * h);
     };
     // The full-resolution passes of `job` not yet in a frame, when the last frame was made and
     // what making it cost (seconds, smoothed).
@@ -569,6 +612,8 @@ void RenderWorker::run() {
                 job = std::move(*pending_);
                 prior.reset();
                 prior_made = false;
+                prior_deferred = false;
+                earlier = {};
                 pending_.reset();
                 stop_.store(false);  // under the lock: a newer submit sets it again after this
                 job_start_ = job.edited;
@@ -693,21 +738,20 @@ void RenderWorker::run() {
             if (denoise_.load()) display_features_for_frame(display_features, job, &preview_features, region.region);
             if (!prior_made && denoise_.load()) {
                 // The job's first full frame: the newest frame before it (an earlier job's) may
-                // be the best picture of the world yet, and this view takes what it can of it.
+                // be the best picture of the world yet, and this view takes what it can of it:
+                // now where that holds the frame up little (prior_budget), else once the frame
+                // is on screen (the next frame carries it).
                 prior_made = true;
-                try {
-                    if (!region.region) keep_history();
-                    if (!region.region && history_fits() && history->generation != job.generation) {
-                        view_hits_made = view_hits(*job.scene, w, h);
-                        hits_generation = job.generation;
-                        prior = reproject(*job.scene, *view_hits_made, *history);
+                if (!region.region) {
+                    earlier = {last_full, last_full_scene, last_full_settings};
+                    const double per_pixel = prior_seconds_per_pixel > 0 ? prior_seconds_per_pixel : seconds_per_pixel;
+                    double budget = 0;
+                    {
+                        std::lock_guard lock(mutex_);
+                        budget = schedule_.prior_budget;
                     }
-                } catch (const std::bad_alloc&) {
-                    history.reset();  // only the carried picture is lost, not the job
-                    history_scene.reset();
-                    history_spp = 0;
-                    prior.reset();
-                    view_hits_made.reset();
+                    if (per_pixel * double(w) * h <= budget) make_prior(w, h);
+                    else prior_deferred = true;
                 }
             }
             const auto start = Clock::now();
@@ -758,8 +802,15 @@ void RenderWorker::run() {
             last_full_scene = job.scene;
             last_full_settings = job.settings;
         }
-        const bool full_frame = frame->scale == 1;
+        const bool full_frame = frame->scale == 1, finished = frame->finished;
         publish(std::move(frame));
+        // A prior put off by the job's first full frame (prior_budget): made now that the frame
+        // is on screen, unless an edit waits or the job is done.
+        if (prior_deferred && full_frame) {
+            prior_deferred = false;
+            if (!finished && !stop_.load()) make_prior(w, h);
+            else keep_earlier();  // still the history for the next camera move, as before the frame
+        }
         // The view's first surfaces, which the next camera move's prior needs for this view's
         // picture (keep_history): traced once a job, once its first full frame is on screen and
         // while no edit waits, so that the move's own first frame does not trace them too (a

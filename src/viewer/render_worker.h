@@ -174,6 +174,12 @@ struct FrameSchedule {
     double min_interval = 1.0 / 60;
     double max_interval = 1.0;
     double cost_share = 0.2;
+    // The seconds the carried picture of an earlier view (reproject.h: the new view's first
+    // surfaces traced, the picture reprojected) may add before a camera move's first full
+    // frame, predicted from its measured cost per pixel (a pass's before it was measured): a
+    // dearer one (a large image; docs/viewer.md, "The render pipeline, measured") is made once
+    // that frame is on screen, and the frame after it carries the picture.
+    double prior_budget = 0.1;
     bool due(double age, double since_last, double cost, double next_wait = 0) const;
 };
 
@@ -215,8 +221,10 @@ void display_features_for_frame(DisplayFeatures& features, const RenderJob& job,
 // a pass; kFeatureSamples, which Save and the feature views use, would hold up the first frames).
 inline constexpr int kDisplayFeatureSamples = 2;
 int next_display_feature_samples(const DisplayFeatures& features);
-// A preview's feature buffers: its image is coarse anyway.
-inline constexpr int kPreviewFeatureSamples = 2;
+// A preview's feature buffers: one camera sample a preview pixel. Its image is coarse anyway,
+// and the 1/2 preview's, which guide the first full frame, make it no worse than a second
+// sample did (FirstFrames; docs/viewer.md), which at 1920x1080 cost more than the preview's pass.
+inline constexpr int kPreviewFeatureSamples = 1;
 
 // The frames the render thread publishes, as it makes them (the tests make the same):
 // a preview of `job` at 1/scale resolution (one pass of its own), with the display's denoised
