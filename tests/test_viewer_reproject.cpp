@@ -256,6 +256,15 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
         for (const auto& f : frames) most = std::max(most, f->carried_pixels);
         return most;
     };
+    // A frame at every balanced count (no interval, no cost share), so the frames' order does not
+    // depend on the machine's speed, and every prior dearer than the budget (here any).
+    const auto every_count_prior_late = [] {
+        FrameSchedule schedule;
+        schedule.age_fraction = schedule.min_interval = schedule.max_interval = 0;
+        schedule.cost_share = std::numeric_limits<double>::infinity();
+        schedule.prior_budget = 0;
+        return schedule;
+    };
     // The prior always made before the first full frame, whatever it costs on this machine.
     FrameSchedule prior_first;
     prior_first.prior_budget = std::numeric_limits<double>::infinity();
@@ -270,12 +279,8 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
     }
     {
         // A prior dearer than the budget (here any) waits for the first full frame: that frame
-        // comes without the earlier picture and the next one carries it. Frames at every
-        // balanced count (no interval), so the order does not depend on the machine's speed.
-        FrameSchedule prior_late;
-        prior_late.age_fraction = prior_late.min_interval = prior_late.max_interval = 0;
-        prior_late.cost_share = std::numeric_limits<double>::infinity();
-        prior_late.prior_budget = 0;
+        // comes without the earlier picture and the next one carries it.
+        const FrameSchedule prior_late = every_count_prior_late();
         // Every frame as it is published (the callback runs on the render thread right after it).
         std::mutex mutex;
         std::vector<std::shared_ptr<const Snapshot>> published;
@@ -309,10 +314,7 @@ TEST(Reproject, TheRenderThreadCarriesThePictureAcrossCameraMovesOnly) {
         Scene further_scene = orbited;
         orbit(further_scene.cameras[size_t(further_scene.camera)], 10, 0);
         const auto further = std::make_shared<const RenderScene>(prepare_scene(further_scene));
-        FrameSchedule every;
-        every.age_fraction = every.min_interval = every.max_interval = 0;
-        every.cost_share = std::numeric_limits<double>::infinity();
-        every.prior_budget = 0;
+        const FrameSchedule every = every_count_prior_late();
         std::mutex mutex;
         std::vector<std::shared_ptr<const Snapshot>> published;
         RenderWorker* self = nullptr;
