@@ -13,11 +13,13 @@
 #include <cstdio>
 #include <optional>
 #include <ostream>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include "core/rng.h"
 #include "render/precision.h"
+#include "render/aov.h"
 #include "render/progressive.h"
 #include "render/trace.h"
 #include "scene/load.h"
@@ -388,6 +390,90 @@ TEST_P(Lanes, RenderPassImageIsOneByOnes) {
             }
         EXPECT_LE(differ, 64 * 64 / 500) << "scene " << n;
         EXPECT_NEAR(double(state.rays), double(rays), double(rays) * 1e-3) << "scene " << n;
+    }
+}
+
+// First hits of camera rays cast in lanes (camera_hits: the viewer's first surfaces and the
+// feature buffers) against intersects one by one: the same sphere, and then the same hit to
+// double's rounding (it is taken in double, by accepted_root where the BVH tests blocks of
+// four), for all but rays that graze a silhouette within the lanes' rounding. On scenes 3 (through its lens too) and 8 (one BVH leaf), the many-sphere scene
+// (the lane tree or clusters) and the Whitted scene 1 (lanes cast even where they trace no
+// path); batches of 1 (one by one), 7 (a partial vector) and 600 (past kSampleBatch).
+TEST_P(Lanes, CameraHitsAreOneByOnes) {
+    std::vector<std::pair<std::string, RenderScene>> scenes;
+    for (int n : {1, 3, 8}) scenes.emplace_back("scene " + std::to_string(n), brief_scene(n));
+    scenes.emplace_back("scene 3, lens", brief_scene(3));
+    scenes.back().second.camera.lens_radius = 0.2;
+    scenes.emplace_back("40 spheres", many_spheres(40, 2, 40));
+    for (const auto& [name, scene] : scenes) {
+        const RenderSettings settings = settings_of(scene);
+        const int width = scene.renderer.width, height = scene.renderer.height;
+        int rays_cast = 0, hits = 0, differ = 0;
+        for (int count : {1, 7, 600}) {
+            std::vector<std::optional<Sampler>> storage(static_cast<size_t>(count));
+            std::vector<Sampler*> samplers(static_cast<size_t>(count));
+            std::vector<int> xs(static_cast<size_t>(count)), ys(static_cast<size_t>(count));
+            for (int k = 0; k < count; ++k) {
+                xs[size_t(k)] = (k * 37 + count) % width, ys[size_t(k)] = (k * 101 + 3 * count) % height;
+                const uint64_t pixel = uint64_t(ys[size_t(k)]) * uint64_t(width) + uint64_t(xs[size_t(k)]);
+                samplers[size_t(k)] = &storage[size_t(k)].emplace(Estimator::sobol, 4, pixel, uint32_t(k % 5), 16);
+            }
+            std::vector<Ray> rays(static_cast<size_t>(count));
+            camera_rays(scene, settings, width, height, xs.data(), ys.data(), samplers.data(), count, rays.data());
+            std::vector<Hit> together(static_cast<size_t>(count));
+            camera_hits(casting_kernels(scene, settings), scene, rays.data(), count, together.data());
+            for (int k = 0; k < count; ++k) {
+                Hit alone;
+                const bool found = scene.intersects(rays[size_t(k)], alone);
+                const Hit& h = together[size_t(k)];
+                ++rays_cast;
+                hits += found;
+                if (h.sphere != alone.sphere) {
+                    ++differ;
+                    continue;
+                }
+                if (!found) continue;
+                EXPECT_TRUE(close(h.t, alone.t, 1e-12)) << name << " ray " << k;
+                for (int axis = 0; axis < 3; ++axis) {
+                    EXPECT_TRUE(close(h.p[axis], alone.p[axis], 1e-12)) << name << " ray " << k;
+                    EXPECT_TRUE(close(h.n[axis], alone.n[axis], 1e-12)) << name << " ray " << k;
+                }
+            }
+        }
+        EXPECT_GT(hits, rays_cast / 2) << name;
+        EXPECT_LE(differ, rays_cast / 500) << name;
+    }
+}
+
+// The feature buffers (render/aov.h), whose Sobol camera samples the float lanes make and cast
+// themselves (camera_surfaces) and whose other kernels cast their camera rays' first hits
+// (camera_hits), against the same buffers traced one path at a time: per pixel the same
+// albedo and a normal within the float lanes' rounding, but for pixels where a grazing ray
+// meets another sphere. Scenes 3 (glass and mirrors, followed one by one; also through a
+// lens) and 8, and the 40-sphere scene (clusters or the lane tree).
+TEST_P(Lanes, FeatureBuffersAreOneByOnes) {
+    std::vector<std::pair<std::string, RenderScene>> scenes;
+    for (int n : {3, 8}) scenes.emplace_back("scene " + std::to_string(n), brief_scene(n));
+    scenes.emplace_back("scene 3, lens", brief_scene(3));
+    scenes.back().second.camera.lens_radius = 0.2;
+    scenes.emplace_back("40 spheres", many_spheres(40, 2, 40));
+    for (const auto& [name, scene] : scenes) {
+        RenderSettings lanes = settings_of(scene), one = lanes;
+        one.kernels = LaneChoice::off;
+        const int width = scene.renderer.width, height = scene.renderer.height;
+        const SurfaceLayers a = averaged_surface_layers(scene, lanes, width, height, 3);
+        const SurfaceLayers b = averaged_surface_layers(scene, one, width, height, 3);
+        int differ = 0, lit = 0;
+        for (size_t i = 0; i < a.albedo.size(); ++i) {
+            lit += length(b.normal[i]) > 0;
+            bool same = true;
+            for (int axis = 0; axis < 3; ++axis)
+                same &= close(a.albedo[i][axis], b.albedo[i][axis], 1e-9) &&
+                        std::abs(a.normal[i][axis] - b.normal[i][axis]) <= 1e-5;
+            differ += !same;
+        }
+        EXPECT_GT(lit, int(a.albedo.size()) / 2) << name;
+        EXPECT_LE(differ, int(a.albedo.size()) / 200) << name;
     }
 }
 

@@ -561,6 +561,56 @@ TEST(RenderThread, ARegionsPassesLeaveTheOtherPixelsHalvesAsTheyWere) {
     EXPECT_GE(changed, 2 * 9 * 6 - 4);  // the box's pixels grew both halves
 }
 
+// An edit stops the frame of the view it replaced (make_full_frame's cancel, the worker's
+// stop flag): set before the frame, or before the filter's passes (denoise_atrous), the frame
+// is left unfinished; unset, the frame is the one made without it, bit for bit, whole and in a
+// region's box.
+TEST(RenderThread, AnEditStopsTheFrameOfTheViewItReplaced) {
+    const auto scene = small_scene(3, 48, 40);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    const RenderJob job{7, scene, settings, StopRule{16}};
+    RenderState state(48, 40);
+    for (int i = 0; i < 4; ++i) render_pass(*scene, settings, state);
+    DisplayFeatures features;
+    features.reset(48, 40);
+    features.refine_to(job, 2);
+    DenoiseWorkspace workspace;
+    std::atomic<bool> cancel{false};
+    Snapshot plain, kept;
+    make_full_frame(job, state, &features, workspace, plain);
+    EXPECT_TRUE(make_full_frame(job, state, &features, workspace, kept, nullptr, std::nullopt, &cancel));
+    ASSERT_EQ(kept.denoised.pixels.size(), plain.denoised.pixels.size());
+    EXPECT_EQ(std::memcmp(kept.denoised.pixels.data(), plain.denoised.pixels.data(),
+                          plain.denoised.pixels.size() * sizeof(Color)), 0);
+    const PixelBox box{10, 6, 30, 22};
+    Snapshot boxed;
+    EXPECT_TRUE(make_full_frame(job, state, &features, workspace, boxed, &plain, box, &cancel));
+    EXPECT_FALSE(boxed.denoised.pixels.empty());
+    cancel = true;
+    Snapshot stopped, stopped_box;
+    EXPECT_FALSE(make_full_frame(job, state, &features, workspace, stopped, nullptr, std::nullopt, &cancel));
+    EXPECT_FALSE(make_full_frame(job, state, &features, workspace, stopped_box, &plain, box, &cancel));
+    EXPECT_TRUE(stopped.radiance.pixels.empty());
+    // The filter itself: stopped before its first pass, an empty image; the workspace still
+    // serves the next frame, which is the same as before.
+    RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerVariance);
+    DevelopOptions options;
+    options.denoise = Denoise::on;
+    options.interactive = true;
+    options.sampling = settings;
+    options.workspace = &workspace;
+    options.cancel = &cancel;
+    estimates.albedo = features.albedo;
+    estimates.normal = features.normal;
+    EXPECT_TRUE(denoised_image(estimates, estimates.radiance, options).pixels.empty());
+    cancel = false;
+    Snapshot again;
+    EXPECT_TRUE(make_full_frame(job, state, &features, workspace, again, nullptr, std::nullopt, &cancel));
+    EXPECT_EQ(std::memcmp(again.denoised.pixels.data(), plain.denoised.pixels.data(),
+                          plain.denoised.pixels.size() * sizeof(Color)), 0);
+}
+
 // A region's full frames denoise its pixels alone, over the previous frame's picture: the
 // others keep it bit for bit (their samples did not change), the box's is the estimate's
 // (close to the whole image's filter; its edges filtered as the image's borders).

@@ -12,11 +12,20 @@
 namespace kr {
 
 FirstSurface first_surface(const RenderScene& scene, Ray ray, int max_chain) {
+    Hit hit;
+    scene.intersects(ray, hit);
+    return first_surface_from(scene, ray, hit, max_chain);
+}
+
+FirstSurface first_surface_from(const RenderScene& scene, Ray ray, Hit hit, int max_chain) {
     FirstSurface out;
     Color tint(1.0);
     for (int chain = 0; chain <= max_chain; ++chain) {
-        Hit hit;
-        if (!scene.intersects(ray, hit)) break;
+        if (chain > 0) {
+            hit = Hit();
+            scene.intersects(ray, hit);
+        }
+        if (hit.sphere < 0) break;
         const Material& m = scene.materials[size_t(scene.sphere_material[size_t(hit.sphere)])];
         const SurfacePoint sp{hit.n, dot(ray.d, hit.n) < 0};
         // Delta lobes are followed: a mirror reflects, a sharp dielectric refracts
@@ -93,21 +102,59 @@ namespace {
 template <class Range>
 void add_box_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                      const PixelBox& box, SurfaceLayers& sums, const Range& range) {
+    const bool sobol = settings.estimator == Estimator::sobol;
+    const LaneKernels kernels = casting_kernels(scene, settings);
 #pragma omp parallel
     {
         std::vector<std::optional<Sampler>> samplers(kSampleBatch);
         std::vector<Sampler*> pointers(kSampleBatch);
-        std::vector<int> xs(kSampleBatch), ys(kSampleBatch);
+        std::vector<int> xs(kSampleBatch), ys(kSampleBatch), spheres(kSampleBatch);
+        std::vector<uint32_t> indices(kSampleBatch), keys(kSampleBatch), reversed(kSampleBatch);
         std::vector<size_t> pixels(kSampleBatch);
         std::vector<Ray> rays(kSampleBatch);
+        std::vector<Hit> hits(kSampleBatch);
+        std::vector<float> normals(3 * size_t(kSampleBatch));
         int pending = 0;
+        const auto add = [&](int k, const Color& albedo, const Color& normal) {
+            sums.albedo[pixels[size_t(k)]] += albedo;
+            sums.normal[pixels[size_t(k)]] += normal;
+        };
         const auto flush = [&] {
             if (pending == 0) return;
+            // Sobol samples in the float lanes where they apply: their rays made and cast there,
+            // a diffuse or glossy first surface taken whole; one that is followed (a mirror or
+            // glass) or split by Fresnel, one by one from its ray.
+            if (sobol && camera_surfaces(kernels, scene, width, height, xs.data(), ys.data(), keys.data(),
+                                         reversed.data(), pending, spheres.data(), normals.data())) {
+                for (int k = 0; k < pending; ++k) {
+                    const int sphere = spheres[size_t(k)];
+                    if (sphere < 0) continue;  // nothing: zero layers
+                    const Material& m = scene.materials[size_t(scene.sphere_material[size_t(sphere)])];
+                    const vertex::MaterialLobes lobes = vertex::material_lobes(m.type);
+                    if ((lobes.smooth || lobes.rough) && !lobes.fresnel_split) {
+                        const float* n = &normals[3 * size_t(k)];
+                        const Color normal(n[0], n[1], n[2]);
+                        add(k, m.rho, normal / length(normal));  // unit in double, as one path's
+                        continue;
+                    }
+                    Sampler sampler(keys[size_t(k)], indices[size_t(k)], reversed[size_t(k)]);
+                    const FirstSurface s =
+                        first_surface(scene, camera_ray(scene, width, height, xs[size_t(k)], ys[size_t(k)], sampler));
+                    add(k, s.albedo, s.normal);
+                }
+                pending = 0;
+                return;
+            }
+            for (int k = 0; k < pending; ++k)
+                pointers[size_t(k)] =
+                    sobol ? &samplers[size_t(k)].emplace(keys[size_t(k)], indices[size_t(k)], reversed[size_t(k)])
+                          : &samplers[size_t(k)].emplace(settings.estimator, settings.seed, pixels[size_t(k)],
+                                                         indices[size_t(k)], settings.target_spp);
             camera_rays(scene, settings, width, height, xs.data(), ys.data(), pointers.data(), pending, rays.data());
+            camera_hits(kernels, scene, rays.data(), pending, hits.data());
             for (int k = 0; k < pending; ++k) {
-                const FirstSurface s = first_surface(scene, rays[size_t(k)]);
-                sums.albedo[pixels[size_t(k)]] += s.albedo;
-                sums.normal[pixels[size_t(k)]] += s.normal;
+                const FirstSurface s = first_surface_from(scene, rays[size_t(k)], hits[size_t(k)]);
+                add(k, s.albedo, s.normal);
             }
             pending = 0;
         };
@@ -117,14 +164,14 @@ void add_box_samples(const RenderScene& scene, const RenderSettings& settings, i
                 const size_t pixel = size_t(y) * size_t(width) + size_t(x);
                 const auto [first, count] = range(pixel);
                 // The pixel's camera samples first..first+count-1, made as render_pass makes them.
+                const uint32_t key = sobol ? Sampler::pixel_key(settings.seed, pixel) : 0;
                 for (int k = 0; k < count; ++k) {
                     if (pending == kSampleBatch) flush();
                     const uint32_t index = uint32_t(first + k);
                     const size_t slot = size_t(pending++);
-                    pointers[slot] = settings.estimator == Estimator::sobol
-                                         ? &samplers[slot].emplace(Sampler::pixel_key(settings.seed, pixel), index)
-                                         : &samplers[slot].emplace(settings.estimator, settings.seed, pixel, index,
-                                                                   settings.target_spp);
+                    indices[slot] = index;
+                    keys[slot] = key;
+                    reversed[slot] = reverse_bits(index);
                     xs[slot] = x;
                     ys[slot] = y;
                     pixels[slot] = pixel;

@@ -24,6 +24,9 @@ struct FirstSurface {
     bool hit = false;
 };
 FirstSurface first_surface(const RenderScene& scene, Ray ray, int max_chain = 16);
+// The same where the ray's first hit is known (`hit.sphere` -1: a miss), cast in lanes with
+// others (camera_hits, render/trace.h).
+FirstSurface first_surface_from(const RenderScene& scene, Ray ray, Hit hit, int max_chain = 16);
 
 // The layers of every pixel: first_surface of the pixel centre's camera ray through the lens
 // centre. One ray chain per pixel, parallel over rows: a small fraction of one render pass.
@@ -34,7 +37,8 @@ SurfaceLayers first_surface_layers(const RenderScene& scene, int width, int heig
 
 // The layers averaged over `samples` camera rays per pixel, drawn as the pixel's first
 // `samples` camera samples are (settings' estimator and seed: the same sub-pixel and lens
-// positions), so anti-aliased edges and depth of field come out as in the radiance. The
+// positions), so anti-aliased edges and depth of field come out as in the radiance. Their
+// first hits are cast in lanes (camera_hits). The
 // normals are averaged, not renormalised: a pixel half on a sphere and half on nothing has a
 // normal of length 1/2. The denoiser's feature buffers; parallel over rows.
 SurfaceLayers averaged_surface_layers(const RenderScene& scene, const RenderSettings& settings, int width, int height,

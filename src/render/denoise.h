@@ -5,6 +5,7 @@
 // display and its Save give the same image.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -103,8 +104,10 @@ struct DenoiseWorkspace {
 // filtered standard deviation, propagated through the passes), the albedo multiplied back,
 // then blended towards the raw radiance as a pixel's relative standard error drops, so a
 // converged image is left as it is. Parallel over rows (OpenMP); the inner loops run along
-// rows over planes of floats, which the compiler vectorises (denoise_atrous.cpp).
-Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr);
+// rows over planes of floats, which the compiler vectorises (denoise_atrous.cpp). Once
+// `cancel` is set (by another thread) it stops before its next pass and returns an empty image.
+Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {}, DenoiseWorkspace* workspace = nullptr,
+                     const std::atomic<bool>* cancel = nullptr);
 
 // The final filter's parameters (docs/denoising.md says how they were chosen).
 struct NlmParams {

@@ -119,7 +119,8 @@ void atrous_row(const AtrousPass& a, int y) {
 
 }  // namespace
 
-Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, DenoiseWorkspace* workspace) {
+Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, DenoiseWorkspace* workspace,
+                     const std::atomic<bool>* cancel) {
     DenoiseWorkspace local;
     DenoiseWorkspace& p = prepared_planes(input, workspace, local);
     const int w = p.w, h = p.h;
@@ -132,9 +133,14 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, Deno
     // The first pass's luminance stop takes the variance 3x3-prefiltered; later passes' is
     // filtered already.
     blur3(w, h, p.base.variance, p.base.scratch);
-    // One team of threads for every pass (each loop ends at a barrier).
+    // One team of threads for every pass (each loop ends at a barrier). Whether to stop is
+    // read by one thread before each pass and seen by all after the barrier that follows.
+    bool cancelled = false;
 #pragma omp parallel
     for (int it = 0; it < params.iterations; ++it) {
+#pragma omp single
+        cancelled = cancel && cancel->load(std::memory_order_relaxed);
+        if (cancelled) break;
         const int step = 1 << it;
         const AtrousPass a{
             p.base.luminance.data(),
@@ -163,6 +169,7 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params, Deno
             std::swap(p.base.luminance, p.atrous.luminance);
         }
     }
+    if (cancelled) return Image();
     remodulate_and_fade(input, params.fade_error, p, out);
     return out;
 }

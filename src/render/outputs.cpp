@@ -116,7 +116,7 @@ Image denoised_image(const RenderEstimates& estimates, const Image& radiance, co
     const bool whitted_raw = options.sampling.integrator == Integrator::wrt &&
                              (!options.interactive || mean_samples(estimates.samples) >= kWhittedRawSpp);
     return whitted_raw           ? radiance
-           : options.interactive ? denoise_atrous(input, {}, options.workspace)
+           : options.interactive ? denoise_atrous(input, {}, options.workspace, options.cancel)
                                  : denoise_nlmeans(input, {}, options.workspace);
 }
 

@@ -5,6 +5,7 @@
 // with write_files_atomic.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -55,6 +56,9 @@ struct DevelopOptions {
     RenderSettings sampling;
     // The denoiser's planes, where the caller keeps them between develops (the viewer).
     DenoiseWorkspace* workspace = nullptr;
+    // Set by another thread when the picture is no longer wanted (the viewer's frame of a view
+    // an edit replaced): the interactive filter stops at its next pass and gives an empty image.
+    const std::atomic<bool>* cancel = nullptr;
 };
 // The feature buffers' camera samples per pixel (render/aov.h averaged_surface_layers).
 inline constexpr int kFeatureSamples = 8;

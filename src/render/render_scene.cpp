@@ -74,6 +74,13 @@ bool RenderScene::intersects(const Ray& ray, Hit& hit) const {
     return true;
 }
 
+bool RenderScene::hit_on(const Ray& ray, int sphere, Hit& hit) const {
+    const double t = accepted_root(spheres[size_t(sphere)], sphere, ray, false);
+    if (!(t < kInfinity)) return false;
+    fill_hit(*this, ray, sphere, t, hit);
+    return true;
+}
+
 bool RenderScene::is_occluded(const Ray& ray) const { return linear_scan ? is_occluded_linear(ray) : bvh.any(ray); }
 
 bool RenderScene::intersects_linear(const Ray& ray, Hit& hit) const {

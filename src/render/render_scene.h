@@ -81,6 +81,9 @@ struct RenderScene {
     bool is_occluded(const Ray& ray) const;
     // The same two by testing every sphere in turn: the plain path the BVH is checked against.
     bool intersects_linear(const Ray& ray, Hit& hit) const;
+    // The hit of `ray` on sphere `sphere` as intersects gives it where that sphere is the
+    // closest; false where the ray does not hit it (accepted_root).
+    bool hit_on(const Ray& ray, int sphere, Hit& hit) const;
     bool is_occluded_linear(const Ray& ray) const;
     // Builds the BVH over `spheres` (after edits to them or to the lights) and checks the gaps
     // between them again.

@@ -76,6 +76,27 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
 void trace_camera_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
                           const int* xs, const int* ys, Sampler* const* samplers, int count, SampleResult* results);
 
+// The kernels whose lanes cast first hits for camera_hits and camera_surfaces: lane_kernels'
+// choice for path tracing with these settings, whatever their integrator (once per image: under
+// `best` the float lanes' size check may walk the scene's spheres).
+LaneKernels casting_kernels(const RenderScene& scene, const RenderSettings& settings);
+// The closest hit of each of `count` camera rays (from no sphere, over [0, inf); hit.sphere
+// -1: none), as intersects gives it up to rounding: the sphere cast for in the lanes of
+// `kernels` (casting_kernels), its hit then taken in double (RenderScene::hit_on), so that
+// where the lanes find intersects' sphere (all but grazing rays) the hit is intersects' to
+// double's rounding; one by one for one path. The viewer's first surfaces, and the feature
+// buffers' (render/aov.h).
+void camera_hits(LaneKernels kernels, const RenderScene& scene, const Ray* rays, int count, Hit* hits);
+// The first surfaces of `count` camera samples of Sobol samplers known by their pixel keys and
+// bit-reversed sample indices (as trace_sobol_camera_samples takes them), made and cast in the
+// single-precision lanes of `kernels` (casting_kernels): the sphere each camera ray hits first
+// (-1: none) and the unit normal there, facing the ray (3 floats a sample), to the lanes'
+// rounding of one path's. False, and nothing written, where `kernels` are not such lanes (the
+// caller traces one by one). The feature buffers' first hits (render/aov.h).
+bool camera_surfaces(LaneKernels kernels, const RenderScene& scene, int width, int height, const int* xs,
+                     const int* ys, const uint32_t* keys, const uint32_t* index_reversed, int count, int* spheres,
+                     float* normals);
+
 // What trace_samples runs for path tracing with these settings on this scene (a SIMD target
 // of render/lanes/targets.h, or one path), as the settings' kernels, the CPU and the scene
 // decide (under `best`, each target only up to the sphere count where one path at a time

@@ -217,9 +217,10 @@ namespace {
 // (Save and `render --denoise` develop with the final one), guided by `features` of their
 // resolution, which are lent to the estimates for it (nothing is copied).
 Image denoised_radiance(const RenderJob& job, RenderEstimates& estimates, DisplayFeatures& features,
-                        DenoiseWorkspace& workspace) {
+                        DenoiseWorkspace& workspace, const std::atomic<bool>* cancel = nullptr) {
     DevelopOptions options;
     options.workspace = &workspace;
+    options.cancel = cancel;
     options.denoise = Denoise::on;
     options.interactive = true;  // the live display: the a-trous filter (Save: the final one)
     options.sampling = job.settings;
@@ -235,7 +236,8 @@ Image denoised_radiance(const RenderJob& job, RenderEstimates& estimates, Displa
 // filtered as an image of its own, its edges as the image's borders, and the pixels outside it,
 // whose samples a region's passes leave as they were, keep their picture.
 Image denoised_radiance_in(const RenderJob& job, const RenderEstimates& estimates, const DisplayFeatures& features,
-                           const PixelBox& box, const Image& base, DenoiseWorkspace& workspace) {
+                           const PixelBox& box, const Image& base, DenoiseWorkspace& workspace,
+                           const std::atomic<bool>* cancel = nullptr) {
     const int w = estimates.radiance.width, bw = box.x1 - box.x0, bh = box.y1 - box.y0;
     RenderEstimates crop;
     crop.radiance = Image(bw, bh);
@@ -254,7 +256,8 @@ Image denoised_radiance_in(const RenderJob& job, const RenderEstimates& estimate
         std::copy_n(features.albedo.begin() + long(3 * from), 3 * bw, crop_features.albedo.begin() + long(3 * to));
         std::copy_n(features.normal.begin() + long(3 * from), 3 * bw, crop_features.normal.begin() + long(3 * to));
     }
-    const Image filtered = denoised_radiance(job, crop, crop_features, workspace);
+    const Image filtered = denoised_radiance(job, crop, crop_features, workspace, cancel);
+    if (filtered.pixels.empty()) return filtered;  // cancelled
     Image out = base;
     for (int y = 0; y < bh; ++y)
         std::copy_n(filtered.pixels.begin() + long(y) * bw, bw,
@@ -415,20 +418,24 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
     if (kept) *kept = box ? DisplayFeatures{} : std::move(preview_features);
 }
 
-void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
+bool make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
                      DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous,
-                     const std::optional<PixelBox>& region) {
+                     const std::optional<PixelBox>& region, const std::atomic<bool>* cancel) {
+    const auto cancelled = [&] { return cancel && cancel->load(); };
     RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
+    if (cancelled()) return false;
     const std::optional<PixelBox> box =
         features ? denoised_box(region, state.width, state.height, previous, job.generation, estimates.samples) : std::nullopt;
     if (box) {
         const Image* earlier = earlier_picture(previous, job.generation, state.width, state.height);
         frame.denoised = denoised_radiance_in(job, estimates, *features, *box, earlier ? *earlier : estimates.radiance,
-                                              workspace);
+                                              workspace, cancel);
     }
-    else if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace);
+    else if (features) frame.denoised = denoised_radiance(job, estimates, *features, workspace, cancel);
+    if (cancelled()) return false;
     frame.radiance = std::move(estimates.radiance);
     record_pixel_statistics(state, std::move(estimates), frame);
+    return true;
 }
 
 void RenderWorker::run() {
@@ -505,7 +512,7 @@ void RenderWorker::run() {
         ViewHistory h;
         h.generation = last->generation;
         if (view_hits_made && hits_generation == last->generation) h.hits = std::move(*view_hits_made);
-        else h.hits = view_hits(*scene, last->radiance.width, last->radiance.height);
+        else h.hits = view_hits(*scene, last->radiance.width, last->radiance.height, settings);
         view_hits_made.reset();
         h.picture = last->denoised;
         h.samples = last->sample_count;
@@ -542,7 +549,7 @@ void RenderWorker::run() {
         keep_earlier();
         try {
             if (!history_fits() || history->generation == job.generation) return;
-            view_hits_made = view_hits(*job.scene, w, h);
+            view_hits_made = view_hits(*job.scene, w, h, job.settings);
             hits_generation = job.generation;
             prior = reproject(*job.scene, *view_hits_made, *history);
         } catch (const std::bad_alloc&) {
@@ -755,8 +762,11 @@ void RenderWorker::run() {
                 }
             }
             const auto start = Clock::now();
-            make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame,
-                            last_full.get(), region.region);
+            // An edit that comes meanwhile (stop_) drops this frame of the view it replaced:
+            // the next turn starts the new job.
+            if (!make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame,
+                                 last_full.get(), region.region, &stop_))
+                continue;
             if (features_.load()) {
                 frame->features = full_features();
                 frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
@@ -818,7 +828,7 @@ void RenderWorker::run() {
         if (full_frame && denoise_.load() && !region.region && !stop_.load() && reprojectable(*job.scene) &&
             !(view_hits_made && hits_generation == job.generation)) {
             try {
-                view_hits_made = view_hits(*job.scene, w, h);
+                view_hits_made = view_hits(*job.scene, w, h, job.settings);
                 hits_generation = job.generation;
             } catch (const std::bad_alloc&) {
                 view_hits_made.reset();  // the next move traces them itself

@@ -240,10 +240,13 @@ std::optional<PixelBox> preview_box(const std::optional<PixelBox>& region, int w
 // and a full-resolution frame of `state`: the radiance, the denoised radiance guided by
 // `features` (null: not denoised) and the pixel statistics. With a render `region`, only the
 // region's pixels are denoised where denoised_box says so, over the job's `previous` full
-// frame's picture (or the raw one, black, where no other pixel has a sample).
-void make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
+// frame's picture (or the raw one, black, where no other pixel has a sample). False, the
+// frame left unfinished, where `cancel` was set (an edit replaced the view) before it was done:
+// its steps check between them, and the filter between its passes.
+bool make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
                      DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous = nullptr,
-                     const std::optional<PixelBox>& region = std::nullopt);
+                     const std::optional<PixelBox>& region = std::nullopt,
+                     const std::atomic<bool>* cancel = nullptr);
 // The pixels a full frame denoises alone: the render region clipped to the image, where the
 // job's previous full frame (of `generation`) has a denoised picture to keep outside it, or
 // where no pixel outside it has a sample yet (`samples`: per pixel; the raw radiance, black,

@@ -32,7 +32,7 @@ bool inner_pixel(const ViewHits& view, int x, int y) {
 
 }  // namespace
 
-ViewHits view_hits(const RenderScene& scene, int width, int height) {
+ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings) {
     ViewHits out;
     out.width = width;
     out.height = height;
@@ -40,19 +40,29 @@ ViewHits view_hits(const RenderScene& scene, int width, int height) {
     const size_t n = size_t(width) * size_t(height);
     out.sphere.assign(n, -1);
     out.distance.assign(n, std::numeric_limits<float>::infinity());
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < height; ++y)
-        for (int x = 0; x < width; ++x) {
-            const CameraRay cr = centre_ray(scene.camera, width, height, x, y);
-            Ray ray;
-            ray.o = cr.origin;
-            ray.d = cr.direction;
-            Hit hit;
-            if (!scene.intersects(ray, hit)) continue;
-            const size_t i = size_t(y) * size_t(width) + size_t(x);
-            out.sphere[i] = hit.sphere;
-            out.distance[i] = float(hit.t);
+    const LaneKernels kernels = casting_kernels(scene, settings);
+#pragma omp parallel
+    {
+        std::vector<Ray> rays(size_t(std::max(width, 0)));
+        std::vector<Hit> hits(rays.size());
+#pragma omp for schedule(dynamic, 4)
+        for (int y = 0; y < height; ++y) {
+            for (int x = 0; x < width; ++x) {
+                const CameraRay cr = centre_ray(scene.camera, width, height, x, y);
+                rays[size_t(x)] = Ray();
+                rays[size_t(x)].o = cr.origin;
+                rays[size_t(x)].d = cr.direction;
+            }
+            camera_hits(kernels, scene, rays.data(), width, hits.data());
+            for (int x = 0; x < width; ++x) {
+                const Hit& hit = hits[size_t(x)];
+                if (hit.sphere < 0) continue;
+                const size_t i = size_t(y) * size_t(width) + size_t(x);
+                out.sphere[i] = hit.sphere;
+                out.distance[i] = float(hit.t);
+            }
         }
+    }
     return out;
 }
 

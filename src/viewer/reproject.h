@@ -16,18 +16,20 @@
 #include "core/image.h"
 #include "core/sampling.h"
 #include "render/render_scene.h"
+#include "render/settings.h"
 
 namespace kr::viewer {
 
 // A view's first surfaces: per pixel, the sphere its centre ray hits first (-1: none) and how
-// far along the ray.
+// far along the ray; cast in the lanes `settings` trace the scene with (camera_hits,
+// render/trace.h), a row at a time.
 struct ViewHits {
     int width = 0, height = 0;
     CameraModel camera;
     std::vector<int> sphere;
     std::vector<float> distance;
 };
-ViewHits view_hits(const RenderScene& scene, int width, int height);
+ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings = {});
 
 // Where a world point lands in a view: its continuous pixel coordinates (pixel (i, j)'s centre
 // ray at (i, j)), or none behind the camera.

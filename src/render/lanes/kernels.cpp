@@ -633,6 +633,26 @@ void trace_lanes(const RenderScene& scene, const RenderSettings& settings, const
     trace_paths_of(scene, settings, RayRecords{rays}, samplers, count, results);
 }
 
+// The closest sphere of each camera ray (-1: none), by the path loop's cast (find_hits), a
+// vector of rays at a time; lanes past `count` repeat the first ray.
+template <bool kWide>
+void closest_spheres_of(const RenderScene& scene, const Ray* rays, int count, int* spheres) {
+    const LaneScene<kWide> lane_scene(scene);
+    for (int first = 0; first < count; first += kLanes) {
+        const int n = std::min(kLanes, count - first);
+        const auto ray = [&](size_t k) -> const Ray& { return rays[first + (int(k) < n ? int(k) : 0)]; };
+        const V3 o = lanes_of_vec3([&](size_t k) -> const Vec3& { return ray(k).o; });
+        const V3 d = lanes_of_vec3([&](size_t k) -> const Vec3& { return ray(k).d; });
+        vf t;
+        vm id;
+        lane_scene.closest(o, d, vm{} - 1, vm{}, ~vm{}, t, id);
+        for (int k = 0; k < n; ++k) spheres[first + k] = int(id[k]);
+    }
+}
+void closest_spheres(const RenderScene& scene, const Ray* rays, int count, int* spheres) {
+    (wide_scene(scene) ? closest_spheres_of<true> : closest_spheres_of<false>)(scene, rays, count, spheres);
+}
+
 // A camera ray per lane for Sobol samplers at their first dimension: camera_rays' steps
 // (Sampler::pixel and the lens numbers, raster_to_camera, CameraModel::generate) lane-wise.
 KR_LANES void camera_lanes(const CameraModel& camera, bool lens, int width, int height, vw key, vw index_reversed, vf x, vf y,
@@ -711,6 +731,51 @@ void trace_sobol_camera_lanes(const RenderScene& scene, const RenderSettings& se
                                           : (lens ? trace_camera_chunks<false, true> : trace_camera_chunks<false, false>);
     chunks(scene, settings, width, height, xs, ys, keys, index_reversed, count, results);
 }
+// The first surfaces of camera samples given as trace_sobol_camera_lanes takes them (their
+// rays made by camera_lanes): the sphere each ray hits first (-1: none) and the unit normal
+// there turned to face the ray, three floats a sample (the hit record of find_hits). The
+// feature buffers' first hits (render/aov.h), a vector of samples at a time; lanes past
+// `count` repeat the first sample.
+template <bool kWide>
+void camera_surfaces_of(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
+                        const uint32_t* keys, const uint32_t* index_reversed, int count, int* spheres,
+                        float* normals) {
+    LaneScene<kWide> lane_scene(scene);
+    for (size_t s = 0; s < scene.spheres.size(); ++s) lane_scene.table.centre.set(s, scene.spheres[s].centre);
+    const bool lens = scene.camera.lens_radius > 0;
+    for (int group = 0; group < count; group += kLanes) {
+        const int n = std::min(kLanes, count - group);
+        const auto sample = [&](size_t k) { return group + (int(k) < n ? int(k) : 0); };
+        const vw key = lanes_of<vw>([&](size_t k) { return keys[sample(k)]; });
+        const vw index = lanes_of<vw>([&](size_t k) { return index_reversed[sample(k)]; });
+        const vm x = lanes_of<vm>([&](size_t k) { return xs[sample(k)]; });
+        const vm y = lanes_of<vm>([&](size_t k) { return ys[sample(k)]; });
+        V3 origin, unit;
+        camera_lanes(scene.camera, lens, width, height, key, index, __builtin_convertvector(x, vf),
+                     __builtin_convertvector(y, vf), origin, unit);
+        vf t;
+        vm id;
+        lane_scene.closest(origin, unit, vm{} - 1, vm{}, ~vm{}, t, id);
+        // The outward normal at the hit (find_hits' record), then the side the ray meets.
+        const vm hit_id = id >= 0 ? id : vm{};
+        const vf reach = select(id >= 0, t, vf{});
+        const V3 offset = (origin + unit * reach) - look_up(lane_scene.table.centre, hit_id);
+        const vf offset_length = sqrt_lanes(dot(offset, offset));
+        const V3 outward = select(offset_length > 0, offset * (1.0 / offset_length), -unit);
+        const V3 facing = select(dot(unit, outward) < 0, outward, -outward);
+        for (int k = 0; k < n; ++k) {
+            spheres[group + k] = int(id[k]);
+            normals[3 * (group + k)] = float(facing.x[k]);
+            normals[3 * (group + k) + 1] = float(facing.y[k]);
+            normals[3 * (group + k) + 2] = float(facing.z[k]);
+        }
+    }
+}
+void camera_surfaces(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
+                     const uint32_t* keys, const uint32_t* index_reversed, int count, int* spheres, float* normals) {
+    (wide_scene(scene) ? camera_surfaces_of<true> : camera_surfaces_of<false>)(scene, width, height, xs, ys, keys,
+                                                                                 index_reversed, count, spheres, normals);
+}
 // The same for Sobol samplers: their keys and indices read, and the samplers moved past the
 // camera's dimensions, as one path's camera ray moves them.
 void trace_camera_lanes(const RenderScene& scene, const RenderSettings& settings, int width, int height,
@@ -776,10 +841,11 @@ void camera_rays(const RenderScene& scene, int width, int height, const int* xs,
 
 // This target's entry points, for lanes.cpp.
 #ifdef KR_LANES_FLOAT
-const TargetKernels kernels{true,       nullptr, trace_lanes, trace_sobol_camera_lanes, trace_camera_lanes,
-                            accumulate_batch};
+const TargetKernels kernels{true,           nullptr,         trace_lanes, trace_sobol_camera_lanes, trace_camera_lanes,
+                            accumulate_batch, closest_spheres, camera_surfaces};
 #else
-const TargetKernels kernels{true, camera_rays, trace_lanes, nullptr, nullptr, accumulate_batch};
+const TargetKernels kernels{true,           camera_rays, trace_lanes, nullptr, nullptr, accumulate_batch,
+                            closest_spheres, nullptr};
 #endif
 
 }  // namespace kr::lanes::KR_LANE_TARGET

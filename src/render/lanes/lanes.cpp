@@ -73,12 +73,10 @@ LaneKernels highest(bool single) {
 // A target where this CPU runs it, else one path.
 LaneKernels if_runs(LaneKernels kernels) { return runs(target(kernels)) ? kernels : LaneKernels::one_path; }
 
-// Where lanes apply: path tracing on a scene whose rays the lanes can cast (one leaf of our
-// BVH, or the lane tree: SphereBvh::lanes_cast), not the plain path. Scenes with Embree's tree
-// only cast rays one by one.
-bool lanes_apply(const RenderScene& scene, const RenderSettings& settings) {
-    return settings.integrator != Integrator::wrt && !scene.linear_scan && scene.bvh.lanes_cast();
-}
+// Where lanes can cast a scene's rays: one leaf of our BVH, or the lane tree
+// (SphereBvh::lanes_cast), not the plain path. Scenes with Embree's tree only cast rays one by
+// one.
+bool lanes_cast(const RenderScene& scene) { return !scene.linear_scan && scene.bvh.lanes_cast(); }
 
 // The kernels the CPU and the settings pick, before a scene has a say: under `best` the
 // single-precision lanes of the highest level the CPU has.
@@ -150,8 +148,8 @@ bool float_lanes_fit(const RenderScene& scene) {
 
 LaneKernels cpu_lane_kernels(LaneChoice choice) { return choice_kernels(choice); }
 
-LaneKernels lane_kernels(const RenderScene& scene, const RenderSettings& settings) {
-    if (!lanes_apply(scene, settings)) return LaneKernels::one_path;
+LaneKernels casting_kernels(const RenderScene& scene, const RenderSettings& settings) {
+    if (!lanes_cast(scene)) return LaneKernels::one_path;
     LaneKernels kernels = choice_kernels(settings.kernels);
     if (kernels != LaneKernels::one_path && target(kernels).single && !float_lanes_fit(scene))
         kernels = highest(false);
@@ -164,6 +162,34 @@ LaneKernels lane_kernels(const RenderScene& scene, const RenderSettings& setting
     if (settings.kernels == LaneChoice::best && !scene.bvh.one_leaf() && scene.spheres.size() > most)
         return LaneKernels::one_path;
     return kernels;
+}
+
+LaneKernels lane_kernels(const RenderScene& scene, const RenderSettings& settings) {
+    // Whitted renders trace one path at a time (docs/performance.md: lanes would not pay).
+    return settings.integrator == Integrator::wrt ? LaneKernels::one_path : casting_kernels(scene, settings);
+}
+
+void camera_hits(LaneKernels kernels, const RenderScene& scene, const Ray* rays, int count, Hit* hits) {
+    if (kernels == LaneKernels::one_path || count < 2) {
+        for (int k = 0; k < count; ++k) {
+            hits[k] = Hit();
+            scene.intersects(rays[k], hits[k]);
+        }
+        return;
+    }
+    int spheres[kSampleBatch];
+    for (int first = 0; first < count; first += kSampleBatch) {
+        const int n = std::min(kSampleBatch, count - first);
+        target(kernels).kernels->closest_spheres(scene, rays + first, n, spheres);
+        for (int k = 0; k < n; ++k) {
+            Hit& hit = hits[first + k];
+            hit = Hit();
+            // The lanes' sphere, its hit in double; where the double test misses it (a graze
+            // the lanes rounded into a hit), the closest hit one by one.
+            if (spheres[k] >= 0 && !scene.hit_on(rays[first + k], spheres[k], hit))
+                scene.intersects(rays[first + k], hit);
+        }
+    }
 }
 
 void camera_rays(const RenderScene& scene, const RenderSettings& settings, int width, int height, const int* xs,
@@ -182,6 +208,15 @@ void trace_samples(const RenderScene& scene, const RenderSettings& settings, con
             rays[k].tmin == 0 && rays[k].tmax == kInf && rays[k].from_sphere < 0 && rays[k].to_sphere < 0;
     if (camera_rays) return target(kernels).kernels->trace_rays(scene, settings, rays, samplers, count, results);
     for (int k = 0; k < count; ++k) results[k] = trace_sample(scene, settings, rays[k], *samplers[k]);
+}
+
+bool camera_surfaces(LaneKernels kernels, const RenderScene& scene, int width, int height, const int* xs,
+                     const int* ys, const uint32_t* keys, const uint32_t* index_reversed, int count, int* spheres,
+                     float* normals) {
+    if (kernels == LaneKernels::one_path || !target(kernels).kernels->camera_surfaces) return false;
+    target(kernels).kernels->camera_surfaces(scene, width, height, xs, ys, keys, index_reversed, count, spheres,
+                                             normals);
+    return true;
 }
 
 bool sobol_camera_lanes(LaneKernels kernels) {

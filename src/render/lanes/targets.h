@@ -64,7 +64,8 @@ namespace lanes {
 
 // A target's entry points (kernels.cpp says what each does); null where the target has none:
 // the single-precision targets take their camera rays from a double one (camera_rays), and
-// only they make camera rays from Sobol keys (trace_sobol_camera, trace_camera).
+// only they make camera rays from Sobol keys (trace_sobol_camera, trace_camera,
+// camera_surfaces).
 struct TargetKernels {
     bool built;  // false where this build cannot compile the target (CMakeLists.txt)
     void (*camera_rays)(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
@@ -79,6 +80,14 @@ struct TargetKernels {
     // A batch's samples added to their pixels (pixel_sums.h's accumulate).
     void (*accumulate)(const PixelSums& sums, const size_t* pixels, const SampleResult* results, int count,
                        uint64_t& rays, uint64_t& nonfinite);
+    // The closest sphere of each of `count` rays from the camera (no from or to sphere, tmin 0,
+    // tmax infinite), -1 where none: the paths' first cast alone.
+    void (*closest_spheres)(const RenderScene& scene, const Ray* rays, int count, int* spheres);
+    // The first surfaces of `count` camera samples given as trace_sobol_camera takes them: the
+    // sphere each ray hits first (-1: none) and the unit normal there facing the ray (3 floats).
+    void (*camera_surfaces)(const RenderScene& scene, int width, int height, const int* xs, const int* ys,
+                            const uint32_t* keys, const uint32_t* index_reversed, int count, int* spheres,
+                            float* normals);
 };
 
 // Each target's, defined by its build of kernels.cpp.
