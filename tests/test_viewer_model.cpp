@@ -25,6 +25,7 @@
 #include "viewer/model.h"
 #include "viewer/navigation.h"
 #include "viewer/render_worker.h"
+#include "viewer/reproject.h"
 #include "viewer/scene_edit.h"
 #include "viewer/status.h"
 
@@ -609,6 +610,25 @@ TEST(RenderThread, AnEditStopsTheFrameOfTheViewItReplaced) {
     EXPECT_TRUE(make_full_frame(job, state, &features, workspace, again, nullptr, std::nullopt, &cancel));
     EXPECT_EQ(std::memcmp(again.denoised.pixels.data(), plain.denoised.pixels.data(),
                           plain.denoised.pixels.size() * sizeof(Color)), 0);
+    // What a frame of the next view needs first stops too: its feature buffers (refine_to, no
+    // sample added, so a later refinement is still that of an uninterrupted one) and its first
+    // surfaces for the carried picture (view_hits: no row cast).
+    cancel = true;
+    DisplayFeatures stopped_features;
+    stopped_features.reset(48, 40);
+    EXPECT_FALSE(stopped_features.refine_to(job, 2, std::nullopt, &cancel));
+    EXPECT_EQ(stopped_features.samples, 0);
+    EXPECT_TRUE(std::all_of(stopped_features.counts.begin(), stopped_features.counts.end(),
+                            [](uint8_t c) { return c == 0; }));
+    const viewer::ViewHits none = view_hits(*scene, 48, 40, settings, &cancel);
+    EXPECT_TRUE(std::all_of(none.sphere.begin(), none.sphere.end(), [](int s) { return s < 0; }));
+    cancel = false;
+    EXPECT_TRUE(stopped_features.refine_to(job, 2, std::nullopt, &cancel));
+    EXPECT_EQ(stopped_features.albedo, features.albedo);
+    EXPECT_EQ(stopped_features.normal, features.normal);
+    const viewer::ViewHits all = view_hits(*scene, 48, 40, settings, &cancel);
+    EXPECT_EQ(all.sphere, view_hits(*scene, 48, 40, settings).sphere);
+    EXPECT_GT(std::count_if(all.sphere.begin(), all.sphere.end(), [](int s) { return s >= 0; }), 48 * 40 / 2);
 }
 
 // A region's full frames denoise its pixels alone, over the previous frame's picture: the

@@ -101,7 +101,8 @@ namespace {
 // added in order of their index, so the sums are the same in any number of calls.
 template <class Range>
 void add_box_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
-                     const PixelBox& box, SurfaceLayers& sums, const Range& range) {
+                     const PixelBox& box, SurfaceLayers& sums, const Range& range,
+                     const std::atomic<bool>* cancel = nullptr) {
     const bool sobol = settings.estimator == Estimator::sobol;
     const LaneKernels kernels = casting_kernels(scene, settings);
 #pragma omp parallel
@@ -160,6 +161,7 @@ void add_box_samples(const RenderScene& scene, const RenderSettings& settings, i
         };
 #pragma omp for schedule(dynamic, 4)
         for (int y = box.y0; y < box.y1; ++y) {
+            if (cancel && cancel->load(std::memory_order_relaxed)) continue;  // rows not begun: untouched
             for (int x = box.x0; x < box.x1; ++x) {
                 const size_t pixel = size_t(y) * size_t(width) + size_t(x);
                 const auto [first, count] = range(pixel);
@@ -201,19 +203,24 @@ void add_surface_samples(const RenderScene& scene, const RenderSettings& setting
                     [&](size_t) { return std::pair{first, count}; });
 }
 
-void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
-                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums) {
+bool add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums,
+                         const std::atomic<bool>* cancel) {
     const size_t n = size_t(width) * size_t(height);
     size_sums(n, sums);
     if (counts.size() != n) counts.assign(n, 0);
     const PixelBox inside{std::max(0, box.x0), std::max(0, box.y0), std::min(width, box.x1), std::min(height, box.y1)};
-    if (inside.x0 >= inside.x1 || inside.y0 >= inside.y1) return;
+    if (inside.x0 >= inside.x1 || inside.y0 >= inside.y1) return true;
     total = std::clamp(total, 0, kSampleBatch);
-    add_box_samples(scene, settings, width, height, inside, sums, [&](size_t pixel) {
-        const int first = counts[pixel];
-        counts[pixel] = uint8_t(std::max(first, total));  // each pixel's own entry: no race
-        return std::pair{first, total - first};
-    });
+    add_box_samples(
+        scene, settings, width, height, inside, sums,
+        [&](size_t pixel) {
+            const int first = counts[pixel];
+            counts[pixel] = uint8_t(std::max(first, total));  // each pixel's own entry: no race
+            return std::pair{first, total - first};
+        },
+        cancel);
+    return !(cancel && cancel->load());
 }
 
 }  // namespace kr

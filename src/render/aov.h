@@ -3,6 +3,7 @@
 // state (render/outputs.h).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -53,8 +54,11 @@ void add_surface_samples(const RenderScene& scene, const RenderSettings& setting
 // The same for the pixels of `box` only (clipped to the image), each refined from its own
 // count of samples (`counts`, one per pixel, sized and zeroed here on the first call) to
 // `total`: a render region's pixels first, the others when they are asked for. Once every
-// pixel is at n, the sums are those of samples 0..n-1, bit for bit.
-void add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
-                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums);
+// pixel is at n, the sums are those of samples 0..n-1, bit for bit. Once `cancel` is set (by
+// another thread) the rows not yet begun are left as they were, their counts with them, and
+// the call returns false.
+bool add_surface_samples(const RenderScene& scene, const RenderSettings& settings, int width, int height,
+                         const PixelBox& box, int total, std::vector<uint8_t>& counts, SurfaceLayers& sums,
+                         const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace kr

@@ -300,14 +300,17 @@ void DisplayFeatures::reset(int w, int h) {
     normal.clear();
 }
 
-void DisplayFeatures::refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box) {
+bool DisplayFeatures::refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box,
+                                const std::atomic<bool>* cancel) {
     total = std::min(total, kFeatureSamples);
-    if (total <= whole) return;
+    if (total <= whole) return true;
     const PixelBox pixels = box.value_or(PixelBox{0, 0, width, height});
-    add_surface_samples(*job.scene, job.settings, width, height, pixels, total, counts, sums);
+    if (!add_surface_samples(*job.scene, job.settings, width, height, pixels, total, counts, sums, cancel))
+        return false;
     feature_buffers_from_sums(sums, counts, width, pixels, albedo, normal);
     samples = std::max(samples, total);
     if (!box) whole = total;
+    return true;
 }
 
 void DisplayFeatures::take_preview(const DisplayFeatures& preview) {
@@ -336,18 +339,19 @@ bool guides_full_frame(const DisplayFeatures& preview, int width, int height) {
            preview.normal.size() == preview.albedo.size();
 }
 
-void display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
-                                const std::optional<PixelBox>& region) {
+bool display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
+                                const std::optional<PixelBox>& region, const std::atomic<bool>* cancel) {
     if (!region && features.samples == 0 && features.albedo.empty() && preview &&
         guides_full_frame(*preview, features.width, features.height)) {
         features.take_preview(*preview);
-        return;
+        return true;
     }
     // After a frame guided by the preview's buffers, both samples at once: every frame after
     // the first then has the same buffers however many frames the schedule made before it
     // (the image a scripted run or Save takes does not depend on the machine's speed).
     const bool took_preview = features.samples == 0 && !features.albedo.empty();
-    features.refine_to(job, took_preview ? kDisplayFeatureSamples : next_display_feature_samples(features), region);
+    return features.refine_to(job, took_preview ? kDisplayFeatureSamples : next_display_feature_samples(features),
+                              region, cancel);
 }
 
 int next_display_feature_samples(const DisplayFeatures& features) {
@@ -549,9 +553,16 @@ void RenderWorker::run() {
         keep_earlier();
         try {
             if (!history_fits() || history->generation == job.generation) return;
-            view_hits_made = view_hits(*job.scene, w, h, job.settings);
+            // An edit meanwhile stops both (rows not begun are skipped) and drops what they
+            // made: the prior was this job's, and the new one makes its own.
+            view_hits_made = view_hits(*job.scene, w, h, job.settings, &stop_);
             hits_generation = job.generation;
-            prior = reproject(*job.scene, *view_hits_made, *history);
+            if (!stop_.load()) prior = reproject(*job.scene, *view_hits_made, *history, &stop_);
+            if (stop_.load()) {
+                view_hits_made.reset();
+                prior.reset();
+                return;
+            }
         } catch (const std::bad_alloc&) {
             forget_history();
             return;
@@ -742,7 +753,10 @@ void RenderWorker::run() {
             // image (guided by feature buffers refined one more step each frame) and the
             // pixel statistics.
             // The feature buffers' refinement is paid once an edit: the schedule counts the rest.
-            if (denoise_.load()) display_features_for_frame(display_features, job, &preview_features, region.region);
+            // (An edit meanwhile stops them, as it stops the frame below.)
+            if (denoise_.load() &&
+                !display_features_for_frame(display_features, job, &preview_features, region.region, &stop_))
+                continue;
             if (!prior_made && denoise_.load()) {
                 // The job's first full frame: the newest frame before it (an earlier job's) may
                 // be the best picture of the world yet, and this view takes what it can of it:
@@ -828,8 +842,9 @@ void RenderWorker::run() {
         if (full_frame && denoise_.load() && !region.region && !stop_.load() && reprojectable(*job.scene) &&
             !(view_hits_made && hits_generation == job.generation)) {
             try {
-                view_hits_made = view_hits(*job.scene, w, h, job.settings);
+                view_hits_made = view_hits(*job.scene, w, h, job.settings, &stop_);
                 hits_generation = job.generation;
+                if (stop_.load()) view_hits_made.reset();  // cut short by an edit: the next move traces them
             } catch (const std::bad_alloc&) {
                 view_hits_made.reset();  // the next move traces them itself
             }

@@ -197,8 +197,11 @@ struct DisplayFeatures {
 
     void reset(int w, int h);
     // Refined to `total` camera samples a pixel (at most kFeatureSamples): the pixels of `box`
-    // only, where given (a render region's: the others are not refined).
-    void refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box = std::nullopt);
+    // only, where given (a render region's: the others are not refined). False where `cancel`
+    // was set before it was done (an edit replaced the view): the buffers are then left
+    // unfinished, for the job that is dropped.
+    bool refine_to(const RenderJob& job, int total, const std::optional<PixelBox>& box = std::nullopt,
+                   const std::atomic<bool>* cancel = nullptr);
     // Before their first camera sample: the buffers of a preview of the same view (`preview`,
     // of a smaller image), each pixel taking those of the preview pixel it lies in. No sample
     // is counted: the next refine_to(1) traces every pixel's first one and replaces them.
@@ -213,8 +216,9 @@ bool guides_full_frame(const DisplayFeatures& preview, int width, int height);
 // both of its own samples (kDisplayFeatureSamples); otherwise each frame refines them by a
 // sample (next_display_feature_samples), within the region where there is one. So every frame
 // after an edit's first has kDisplayFeatureSamples, however many frames came before it.
-void display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
-                                const std::optional<PixelBox>& region);
+// False where `cancel` stopped them (refine_to).
+bool display_features_for_frame(DisplayFeatures& features, const RenderJob& job, const DisplayFeatures* preview,
+                                const std::optional<PixelBox>& region, const std::atomic<bool>* cancel = nullptr);
 // The camera samples a pixel of the display's feature buffers at the next frame: the first full
 // frame of an edit traces one (or takes its preview's, and the next frame traces both:
 // display_features_for_frame), the next one more (at 1920x1080 a sample costs about as much as

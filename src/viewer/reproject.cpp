@@ -32,7 +32,8 @@ bool inner_pixel(const ViewHits& view, int x, int y) {
 
 }  // namespace
 
-ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings) {
+ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings,
+                   const std::atomic<bool>* cancel) {
     ViewHits out;
     out.width = width;
     out.height = height;
@@ -47,6 +48,7 @@ ViewHits view_hits(const RenderScene& scene, int width, int height, const Render
         std::vector<Hit> hits(rays.size());
 #pragma omp for schedule(dynamic, 4)
         for (int y = 0; y < height; ++y) {
+            if (cancel && cancel->load(std::memory_order_relaxed)) continue;
             for (int x = 0; x < width; ++x) {
                 const CameraRay cr = centre_ray(scene.camera, width, height, x, y);
                 rays[size_t(x)] = Ray();
@@ -77,7 +79,8 @@ std::optional<Vec2> project_to_pixel(const CameraModel& camera, int width, int h
     return Vec2{fx * width, fy * height - 1};
 }
 
-Reprojection reproject(const RenderScene& scene, const ViewHits& now, const ViewHistory& history) {
+Reprojection reproject(const RenderScene& scene, const ViewHits& now, const ViewHistory& history,
+                       const std::atomic<bool>* cancel) {
     const int w = now.width, h = now.height;
     const ViewHits& before = history.hits;
     Reprojection out;
@@ -89,7 +92,8 @@ Reprojection reproject(const RenderScene& scene, const ViewHits& now, const View
         return scene.materials[size_t(scene.sphere_material[size_t(sphere)])].type == MaterialType::diffuse;
     };
 #pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < h; ++y)
+    for (int y = 0; y < h; ++y) {
+        if (cancel && cancel->load(std::memory_order_relaxed)) continue;
         for (int x = 0; x < w; ++x) {
             const size_t i = size_t(y) * size_t(w) + size_t(x);
             const int sphere = now.sphere[i];
@@ -136,6 +140,7 @@ Reprojection reproject(const RenderScene& scene, const ViewHits& now, const View
             out.colour.pixels[i] = colour / total;
             out.weight[i] = worth;
         }
+    }
     return out;
 }
 

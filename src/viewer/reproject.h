@@ -9,6 +9,7 @@
 // a pixel's colour is a blur over many surface points.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -22,14 +23,16 @@ namespace kr::viewer {
 
 // A view's first surfaces: per pixel, the sphere its centre ray hits first (-1: none) and how
 // far along the ray; cast in the lanes `settings` trace the scene with (camera_hits,
-// render/trace.h), a row at a time.
+// render/trace.h), a row at a time. Once `cancel` is set (by another thread) the rows not yet
+// begun are left without hits: the caller drops the result.
 struct ViewHits {
     int width = 0, height = 0;
     CameraModel camera;
     std::vector<int> sphere;
     std::vector<float> distance;
 };
-ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings = {});
+ViewHits view_hits(const RenderScene& scene, int width, int height, const RenderSettings& settings = {},
+                   const std::atomic<bool>* cancel = nullptr);
 
 // Where a world point lands in a view: its continuous pixel coordinates (pixel (i, j)'s centre
 // ray at (i, j)), or none behind the camera.
@@ -50,8 +53,10 @@ struct Reprojection {
     Image colour;
     std::vector<float> weight;
 };
-// `scene` is the new view's (the same world as the history's: same_world, render_scene.h), `now` its hits.
-Reprojection reproject(const RenderScene& scene, const ViewHits& now, const ViewHistory& history);
+// `scene` is the new view's (the same world as the history's: same_world, render_scene.h), `now`
+// its hits. Once `cancel` is set, the rows not yet begun take nothing (view_hits' rule).
+Reprojection reproject(const RenderScene& scene, const ViewHits& now, const ViewHistory& history,
+                       const std::atomic<bool>* cancel = nullptr);
 
 // Whether a view can take or give a history: a pinhole camera.
 inline bool reprojectable(const RenderScene& scene) { return scene.camera.lens_radius <= 0; }
