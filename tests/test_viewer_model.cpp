@@ -562,15 +562,22 @@ TEST(RenderThread, ARegionsPassesLeaveTheOtherPixelsHalvesAsTheyWere) {
     EXPECT_GE(changed, 2 * 9 * 6 - 4);  // the box's pixels grew both halves
 }
 
+// The job the frame tests below make frames of: scene 3 at 48x40, 16 spp.
+RenderJob frame_test_job() {
+    const auto scene = small_scene(3, 48, 40);
+    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
+    settings.target_spp = 16;
+    return RenderJob{7, scene, settings, StopRule{16}};
+}
+
 // An edit stops the frame of the view it replaced (make_full_frame's cancel, the worker's
 // stop flag): set before the frame, or before the filter's passes (denoise_atrous), the frame
 // is left unfinished; unset, the frame is the one made without it, bit for bit, whole and in a
 // region's box.
 TEST(RenderThread, AnEditStopsTheFrameOfTheViewItReplaced) {
-    const auto scene = small_scene(3, 48, 40);
-    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
-    settings.target_spp = 16;
-    const RenderJob job{7, scene, settings, StopRule{16}};
+    const RenderJob job = frame_test_job();
+    const auto& scene = job.scene;
+    const RenderSettings& settings = job.settings;
     RenderState state(48, 40);
     for (int i = 0; i < 4; ++i) render_pass(*scene, settings, state);
     DisplayFeatures features;
@@ -635,10 +642,9 @@ TEST(RenderThread, AnEditStopsTheFrameOfTheViewItReplaced) {
 // others keep it bit for bit (their samples did not change), the box's is the estimate's
 // (close to the whole image's filter; its edges filtered as the image's borders).
 TEST(RenderThread, ARegionsFramesDenoiseItsPixelsOverThePreviousPicture) {
-    const auto scene = small_scene(3, 48, 40);
-    RenderSettings settings = RenderSettings::from_scene(scene->renderer);
-    settings.target_spp = 16;
-    const RenderJob job{7, scene, settings, StopRule{16}};
+    const RenderJob job = frame_test_job();
+    const auto& scene = job.scene;
+    const RenderSettings& settings = job.settings;
     RenderState state(48, 40);
     RegionHooks region;
     const StopRule rule{16};
