@@ -138,12 +138,10 @@ void add_box_samples(const RenderScene& scene, const RenderSettings& settings, i
                         add(k, m.rho, normal / length(normal));  // unit in double, as one path's
                         continue;
                     }
-                    // The ray in double, its first hit on the lanes' sphere (camera_hits' rule).
+                    // The ray in double, its first hit on the lanes' sphere.
                     Sampler sampler(keys[size_t(k)], indices[size_t(k)], reversed[size_t(k)]);
                     const Ray ray = camera_ray(scene, width, height, xs[size_t(k)], ys[size_t(k)], sampler);
-                    Hit hit;
-                    if (!scene.hit_on(ray, sphere, hit)) scene.intersects(ray, hit);
-                    const FirstSurface s = first_surface_from(scene, ray, hit);
+                    const FirstSurface s = first_surface_from(scene, ray, lanes_sphere_hit(scene, ray, sphere));
                     add(k, s.albedo, s.normal);
                 }
                 pending = 0;

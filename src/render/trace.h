@@ -87,6 +87,10 @@ LaneKernels casting_kernels(const RenderScene& scene, const RenderSettings& sett
 // double's rounding; one by one for one path. The viewer's first surfaces, and the feature
 // buffers' (render/aov.h).
 void camera_hits(LaneKernels kernels, const RenderScene& scene, const Ray* rays, int count, Hit* hits);
+// camera_hits' rule for one ray whose closest sphere the lanes found (`sphere`, -1: none): its
+// hit on that sphere in double, or where the double test misses it (a graze the lanes rounded
+// into a hit) the closest hit one by one.
+Hit lanes_sphere_hit(const RenderScene& scene, const Ray& ray, int sphere);
 // The first surfaces of `count` camera samples of Sobol samplers known by their pixel keys and
 // bit-reversed sample indices (as trace_sobol_camera_samples takes them), made and cast in the
 // single-precision lanes of `kernels` (casting_kernels): the sphere each camera ray hits first

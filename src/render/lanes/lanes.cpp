@@ -181,15 +181,14 @@ void camera_hits(LaneKernels kernels, const RenderScene& scene, const Ray* rays,
     for (int first = 0; first < count; first += kSampleBatch) {
         const int n = std::min(kSampleBatch, count - first);
         target(kernels).kernels->closest_spheres(scene, rays + first, n, spheres);
-        for (int k = 0; k < n; ++k) {
-            Hit& hit = hits[first + k];
-            hit = Hit();
-            // The lanes' sphere, its hit in double; where the double test misses it (a graze
-            // the lanes rounded into a hit), the closest hit one by one.
-            if (spheres[k] >= 0 && !scene.hit_on(rays[first + k], spheres[k], hit))
-                scene.intersects(rays[first + k], hit);
-        }
+        for (int k = 0; k < n; ++k) hits[first + k] = lanes_sphere_hit(scene, rays[first + k], spheres[k]);
     }
+}
+
+Hit lanes_sphere_hit(const RenderScene& scene, const Ray& ray, int sphere) {
+    Hit hit;
+    if (sphere >= 0 && !scene.hit_on(ray, sphere, hit)) scene.intersects(ray, hit);
+    return hit;
 }
 
 void camera_rays(const RenderScene& scene, const RenderSettings& settings, int width, int height, const int* xs,
