@@ -4,6 +4,7 @@
 
 #include <omp.h>
 
+#include <atomic>
 #include <cmath>
 #include <random>
 
@@ -13,6 +14,7 @@
 #include "render/outputs.h"
 #include "render/options.h"
 #include "render/progressive.h"
+#include "render/render_pass.h"
 #include "render/render_scene.h"
 #include "scene/load.h"
 #include "test_util.h"
@@ -453,6 +455,40 @@ TEST(Denoise, HalvesSplitTheSamplesIntoTwoIndependentSets) {
     EXPECT_GT(diff, 0);
 }
 
+// render_pass keeps the halves: the second half's sum is, bit for bit, that of the sums'
+// differences across passes 2, 4 and 6 (each pixel's sums before and after its pass), and a
+// pass stopped before its first row changes no half.
+TEST(Denoise, HalvesAreThePassesDifferencesOfTheSums) {
+    const Scene scene = test::brief_scene(3, 16);
+    const RenderScene rs = prepare_scene(scene);
+    RenderSettings settings = RenderSettings::from_scene(scene.renderer);
+    RenderState state(16, 16);
+    state.track_halves();
+    const size_t n = 16 * 16;
+    std::vector<Color> second(n, Color());
+    std::atomic<bool> stop{true};
+    for (int pass = 0; pass < 7; ++pass) {
+        std::vector<Color> before(n);
+        for (size_t i = 0; i < n; ++i) before[i] = state.radiance_sum()[i] + state.radiance_compensation()[i];
+        const RenderState::Halves kept = state.halves();
+        EXPECT_FALSE(render_pass(rs, settings, state, &stop));
+        const RenderState::Halves after_stop = state.halves();
+        for (int h = 0; h < 2; ++h) {
+            EXPECT_EQ(kept.count[h], after_stop.count[h]);
+            EXPECT_EQ(kept.mean[h].pixels, after_stop.mean[h].pixels);
+        }
+        ASSERT_TRUE(render_pass(rs, settings, state));
+        if (pass % 2 == 1)
+            for (size_t i = 0; i < n; ++i)
+                second[i] += -1.0 * before[i], second[i] += state.radiance_sum()[i] + state.radiance_compensation()[i];
+    }
+    const RenderState::Halves halves = state.halves();
+    for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(halves.count[1][i], 3u);
+        EXPECT_EQ(halves.mean[1].pixels[i], second[i] / 3.0) << i;
+    }
+}
+
 // Path-traced: scene `n` at `size` px and `spp` (the halves tracked, as render --denoise
 // does), developed raw and denoised by each filter (0: the interactive a-trous, 1: the final
 // one), against a high-spp reference of the same settings (another seed), as relMSE of the
@@ -479,7 +515,7 @@ PathTraced path_traced(Scene scene, int size, int spp, int reference_spp) {
     };
     const Image reference = render(reference_spp, 99).radiance();
     const RenderState state = render(spp, 1);
-    const RenderEstimates estimates = render_estimates(state, kAllLayers);
+    const RenderEstimates estimates = render_estimates(state, kAllLayers | kLayerHalves);
     EXPECT_EQ(estimates.halves.count[1].size(), size_t(size) * size_t(size));
     PathTraced out;
     for (int f = 0; f < 2; ++f) {

@@ -231,6 +231,22 @@ TEST_F(SaveDialog, DefaultPathsAndWhatEachKindWrites) {
     full.depth.assign(12, 1.0);
     full.sample_count.assign(12, 1);
     full.variance.assign(12, Color());
+    // The denoised display's image (the default) waits for a frame with the two halves of the
+    // samples, which the final filter reads: a frame of a render still refining has none.
+    ASSERT_NE(m.settings().denoise, DenoiseView::off);
+    EXPECT_TRUE(save_waits_for_halves(kr::ImageFormat::ppm, m, &full));
+    EXPECT_FALSE(save_waits_for_halves(SaveKind::scene, m, &full));
+    EXPECT_THROW(save_output(kr::ImageFormat::ppm, dir / "a.ppm", m, &full), std::exception);
+    EXPECT_FALSE(std::filesystem::exists(dir / "a.ppm"));
+    m.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.denoise = DenoiseView::off; });
+    EXPECT_FALSE(save_waits_for_halves(kr::ImageFormat::ppm, m, &full));  // a raw image needs none
+    m.edit(Edit::tone_map, [&](Scene&, ViewerSettings& s) { s.denoise = DenoiseView::on; });
+    full.generation = m.generation();
+    for (int h = 0; h < 2; ++h) {
+        full.halves.mean[h] = Image(4, 3);
+        full.halves.count[h].assign(12, 0);
+    }
+    EXPECT_FALSE(save_waits_for_halves(kr::ImageFormat::ppm, m, &full));
     EXPECT_EQ(save_output(kr::ImageFormat::ppm, dir / "a.ppm", m, &full), "saved " + (dir / "a.ppm").string());
     EXPECT_EQ(read_image(dir / "a.ppm").width, 4);
     EXPECT_EQ(read_image(dir / "a-depth.ppm").width, 4);
@@ -273,6 +289,7 @@ TEST_F(SaveDialog, ImageFilesAreTheRenderOutputsOfTheSameState) {
     frame.generation = m.generation();
     frame.radiance = state.radiance();
     record_pixel_statistics(state, frame);
+    frame.halves = state.halves();  // as the frame of a finished or paused render carries them
 
     // Raw and denoised (Save develops with the final filter over the halves, as render --denoise).
     for (const DenoiseView view : {DenoiseView::off, DenoiseView::on})

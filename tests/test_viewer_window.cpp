@@ -526,6 +526,35 @@ TEST_F(ViewerWindow, SaveAndQuitSavesABundledSceneElsewhereThenQuits) {
     EXPECT_NE(saved.cameras[size_t(saved.camera)].position, file.cameras[size_t(file.camera)].position);  // the orbit
 }
 
+// Issue 45: Save EXR clicked while the render refines, with the denoised display: the frame
+// shown then carries no halves of the samples (they cost every frame), so the save waits for
+// the next frame, which does, and writes what `render --denoise on` writes of that many
+// passes, byte for byte (uniform passes: the file's samples layer says how many).
+TEST_F(ViewerWindow, SaveWhileRefiningWritesTheNextFrameAsRenderWould) {
+    if (!have_xdotool()) GTEST_SKIP() << "xdotool is not installed (scripts/setup.sh installs it)";
+    nlohmann::json scene = nlohmann::json::parse(kr::test::read_file(kr::test::brief_scene_file(3)));
+    scene["scene"]["renderer"]["dimensions"] = {96, 64};
+    scene["scene"]["renderer"]["output"] = "saved.ppm";
+    const fs::path file = dir / "small.json";
+    std::ofstream(file) << scene.dump(2);
+    auto r = drive(dir, "save_refining", 3, file);
+    ASSERT_EQ(r.count("error"), 0u) << r["error"];
+    EXPECT_EQ(r["saved"], "1");
+    EXPECT_EQ(r["error_after"], "0");
+    const kr::HdrImage saved = kr::read_hdr(dir / "saved.exr");
+    ASSERT_EQ(saved.samples.size(), 96u * 64u);
+    const uint32_t passes = saved.samples[0];
+    EXPECT_GE(passes, 1u);
+    for (const uint32_t n : saved.samples) ASSERT_EQ(n, passes);
+    const fs::path rendered = dir / "rendered.exr";
+    const ViewRun cli = keithray("render '" + file.string() + "' --spp " + std::to_string(passes) +
+                                     " --allocation uniform --denoise on -q -o '" + rendered.string() + "'",
+                                 false);
+    ASSERT_EQ(cli.status, 0) << cli.err;
+    EXPECT_TRUE(kr::test::read_file(dir / "saved.exr") == kr::test::read_file(rendered))
+        << "the saved image (" << passes << " passes) is not what render writes of them";
+}
+
 // Issue 47 B5: the status bar at the default size shows every field; at the minimum window,
 // 640x400, the rate, elapsed time and progress bar give way and the state, spp, noise and
 // PSNR stay (the window shots, bar_default.ppm and bar_small.ppm, are for the eye).

@@ -22,7 +22,10 @@ export XDG_CONFIG_HOME="$dir/config" KEITHRAY_FILE_CHOOSER=builtin
 [[ $scenario == drop ]] && start_edits=(--drop "$dir/mine/ref.ppm" --drop "$dir/mine/notes.txt" --drop "$dir/example.json")
 # A monitor at 144 dpi: GLFW reports a content scale of 1.5 (Xft.dpi, as desktops set it).
 [[ $scenario == ui_scale ]] && xprop -root -f RESOURCE_MANAGER 8s -set RESOURCE_MANAGER "Xft.dpi:	144"
-"$keithray" view "$scene" --spp 2 "${start_edits[@]}" --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
+# A save while the render refines: a target far off, every pixel a sample a pass.
+spp=2 ready='state=done'
+[[ $scenario == save_refining ]] && spp=16000000 ready='state=rendering spp=[1-9]' start_edits=(--allocation uniform)
+"$keithray" view "$scene" --spp "$spp" "${start_edits[@]}" --status-file "$status" >"$dir/view.out" 2>"$dir/view.err" &
 pid=$!
 # On the way out the viewer is ended and waited for: the test then removes the work folder,
 # which a viewer still writing its status file would race.
@@ -56,6 +59,19 @@ wait_changed() {
     return 1
 }
 
+# The widget NAME's centre in window points (the status line's at=, ui_widgets.h mark_item).
+at_of() { field at | tr ';' '\n' | sed -nE "s/^$1:([0-9-]+),([0-9-]+)$/\1 \2/p" | head -1; }
+click_at() {  # click_at NAME: click the widget NAME, after the pointer is seen there
+    local xy
+    wait_for "at=.*$1:" || return 1  # drawn (a tab just brought to the front draws a frame later)
+    xy=$(at_of "$1")
+    [[ -n $xy ]] || { echo "error=no widget $1 in at=$(field at)"; return 1; }
+    read -r cx cy <<<"$xy"
+    xdotool mousemove --window "$wid" "$cx" "$cy"
+    wait_for "pointer=$cx,$cy" || return 1
+    xdotool click 1
+}
+
 wid=$(xdotool search --sync --name '^keithray' | head -1)
 [[ -n $wid ]] || { echo "error=no window"; exit 1; }
 if [[ $scenario == broken_start ]]; then
@@ -77,7 +93,7 @@ if [[ $scenario == broken_start ]]; then
     echo "exit_status=$?"
     exit 0
 fi
-wait_for 'state=done' || exit 1
+wait_for "$ready" || exit 1
 xdotool windowfocus --sync "$wid" 2>/dev/null || xdotool windowfocus "$wid"
 # Over the image (left part of the window, clear of the panel and the status bar).
 xdotool mousemove --window "$wid" 250 330
@@ -116,6 +132,19 @@ save_where)
     xdotool key F1
     wait_for 'help=1' || exit 1
     echo "question_after=$(sed -E 's/.*question=([^ ]*).*/\1/' "$status")"
+    ;;
+save_refining)
+    # Issue 45: Save EXR while the render refines, with the denoised display (the default).
+    # The frames of a refining render carry no halves of the samples, which the final filter
+    # reads, so the save waits for the next frame (which carries them) and writes it.
+    click_at "tab:scene" || exit 1  # the Save panel's tab
+    click_at "save:exr" || exit 1
+    end=$((SECONDS + limit))
+    while [[ ! -f $dir/saved.exr ]] && ((SECONDS < end)); do sleep 0.1; done
+    [[ -f $dir/saved.exr ]] || { echo "error=no saved.exr (status: $(cat "$status"))"; exit 1; }
+    echo "saved=1"
+    echo "state_after=$(field state)"
+    echo "error_after=$(field error)"
     ;;
 jitter_click)
     # Press, one pixel of jitter each way while held, release: a click, not an orbit. Each
@@ -595,18 +624,7 @@ outliner)
     # Issue 47 C: the outliner and the image select the same thing; one click on a colour
     # recolours the selected sphere; "." frames the selection and numpad 7 gives the top view
     # (camera edits: Ctrl+Z undoes them); a point light's row selects the light; the tabs.
-    # Widgets are clicked where the status line's at= says they are (window points).
-    at_of() { field at | tr ';' '\n' | sed -nE "s/^$1:([0-9-]+),([0-9-]+)$/\1 \2/p" | head -1; }
-    click_at() {  # click_at NAME: click the widget NAME, after the pointer is seen there
-        local xy
-        wait_for "at=.*$1:" || return 1  # drawn (a tab just brought to the front draws a frame later)
-        xy=$(at_of "$1")
-        [[ -n $xy ]] || { echo "error=no widget $1 in at=$(field at)"; return 1; }
-        read -r cx cy <<<"$xy"
-        xdotool mousemove --window "$wid" "$cx" "$cy"
-        wait_for "pointer=$cx,$cy" || return 1
-        xdotool click 1
-    }
+    # Widgets are clicked where the status line's at= says they are (click_at).
     echo "tab_first=$(field tab)"
     echo "camera_first=$(field camera)"
     python3 "$(dirname "$0")/x_window_shot.py" "$wid" "$dir/light_before.ppm" || { echo "error=no window shot"; exit 1; }

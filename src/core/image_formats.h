@@ -24,6 +24,9 @@ enum RenderLayer : unsigned {
     kLayerNormal = 1u << 3,    // and its normal
     kLayerSamples = 1u << 4,   // samples per pixel
     kLayerVariance = 1u << 5,  // the variance of the mean radiance (left out of a blurred render)
+    // Not a file's: the two halves of each pixel's samples, which the final denoiser reads
+    // (render/outputs.h render_estimates, develop_reads).
+    kLayerHalves = 1u << 6,
 };
 inline constexpr unsigned kAllLayers =
     kLayerRadiance | kLayerDepth | kLayerAlbedo | kLayerNormal | kLayerSamples | kLayerVariance;

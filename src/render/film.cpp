@@ -34,23 +34,14 @@ void Film::track_halves() {
     px_.half_count.assign(n, 0);
 }
 
-void Film::add_sums_to_half(int sign, const uint8_t* rows_on, const uint8_t* active, const uint8_t* planned) {
-    if (!tracks_halves()) return;
-    // Only the pixels the pass samples (its rows, the noise rule's mask and the plan:
-    // render_pass skips the others), whose sums are the only ones it changes: a region's or an
-    // adaptive pass costs what its pixels cost, and the others' halves stay as they are, bit
-    // for bit.
-    const size_t w = size_t(width);
-    const long rows = long(px_.half_sum.size() / std::max<size_t>(1, w));
-#pragma omp parallel for schedule(static)
-    for (long r = 0; r < rows; ++r) {
-        const size_t y = held_.empty() ? size_t(r) : size_t(held_[size_t(r)]);
-        if (rows_on && !rows_on[y]) continue;
-        for (size_t i = size_t(r) * w; i < size_t(r + 1) * w; ++i) {
-            if ((active && !active[i]) || (planned && !planned[i])) continue;
-            px_.half_sum[i] += double(sign) * (px_.radiance_sum[i] + px_.radiance_compensation[i]);
-            px_.half_count[i] += uint32_t(sign) * px_.sample_count[i];  // modulo 2^32, exact
-        }
+void Film::add_row_to_half(int sign, size_t start, const uint8_t* active, const uint8_t* planned) {
+    // Only the pixels the pass samples, whose sums are the only ones it changes: a region's or
+    // an adaptive pass costs what its pixels cost, and the others' halves stay as they are,
+    // bit for bit.
+    for (size_t i = start; i < start + size_t(width); ++i) {
+        if ((active && !active[i]) || (planned && !planned[i])) continue;
+        px_.half_sum[i] += double(sign) * (px_.radiance_sum[i] + px_.radiance_compensation[i]);
+        px_.half_count[i] += uint32_t(sign) * px_.sample_count[i];  // modulo 2^32, exact
     }
 }
 

@@ -129,11 +129,11 @@ public:
     // Keeps the two halves of each pixel's samples from the next pass on (PixelBuffers::half_sum).
     void track_halves();
     bool tracks_halves() const { return !px_.half_sum.empty(); }
-    // Adds `sign` x the sums of the pixels a pass samples to the half (a no-op unless
-    // tracking): those of the rows `rows_on` marks (nullptr: every row), the pixels `active`
-    // marks and those `planned` gives a sample (nullptr: all). RenderState::begin_half_pass
-    // and end_half_pass call it around a pass.
-    void add_sums_to_half(int sign, const uint8_t* rows_on, const uint8_t* active, const uint8_t* planned);
+    // Adds `sign` x the sums of the pixels a pass samples in the row starting at buffer pixel
+    // `start` (row_start) to the half: those `active` marks and those `planned` gives a
+    // sample (nullptr: all; both indexed as the buffers). render_pass calls it around each row
+    // of a pass after an odd number of passes, where the film tracks the halves.
+    void add_row_to_half(int sign, size_t start, const uint8_t* active, const uint8_t* planned);
     // The mean radiance of each half (zero where a half has no sample) and their counts.
     struct Halves {
         Image mean[2];

@@ -41,10 +41,8 @@ RenderEstimates render_estimates(const Film& film, unsigned layers) {
     if (layers & kLayerRadiance) out.radiance = film.radiance();
     if (layers & kLayerDepth) out.depth = film.mean_depth();
     if (layers & kLayerSamples) out.samples = film.sample_count();
-    if (layers & kLayerVariance) {
-        out.variance = film.variance_of_mean();
-        if (film.tracks_halves()) out.halves = film.halves();
-    }
+    if (layers & kLayerVariance) out.variance = film.variance_of_mean();
+    if ((layers & kLayerHalves) && film.tracks_halves()) out.halves = film.halves();
     return out;
 }
 
@@ -124,7 +122,9 @@ unsigned develop_reads(const DevelopOptions& options) {
     if (options.denoise == Denoise::off) return 0;
     // The interactive filter leaves a Whitted render raw past its first passes: it counts them.
     const bool counts = options.interactive && options.sampling.integrator == Integrator::wrt;
-    return unsigned(kLayerDepth | kLayerVariance) | (counts ? unsigned(kLayerSamples) : 0u);
+    // The final filter reads the two halves of the samples; the interactive one does not.
+    return unsigned(kLayerDepth | kLayerVariance) | (counts ? unsigned(kLayerSamples) : 0u) |
+           (options.interactive ? 0u : unsigned(kLayerHalves));
 }
 
 Developed develop(const RenderScene& scene, RenderEstimates estimates, const DevelopOptions& options,

@@ -39,7 +39,7 @@ struct RenderEstimates {
     Film::Halves halves;
 };
 // The estimates of `film` (a RenderState's) for the layers `layers` asks for (RenderLayer
-// bits); with the variance, the halves where the film tracks them.
+// bits); kLayerHalves: the halves, where the film tracks them.
 RenderEstimates render_estimates(const Film& film, unsigned layers);
 
 // How a render is developed into its images. A new step (a denoiser reading the albedo and

@@ -22,13 +22,11 @@ bool ProgressiveDriver::pass(const StopRule& rule, const std::atomic<bool>* canc
     const auto start = std::chrono::steady_clock::now();
     const RowShare* share = hooks_ ? hooks_->rows() : nullptr;
     // The planner, the film, the row share: plan the pass, narrow it to this process's rows,
-    // add its samples (and the halves'), then share what the next step reads.
+    // add its samples (and the halves': render_pass), then share what the next step reads.
     if (hooks_) hooks_->before_plan(state_);
     plan_pass(state_, settings_, share);
     if (hooks_) hooks_->before_pass(state_);
-    state_.begin_half_pass();
     if (!render_pass(scene_, settings_, state_, cancel)) return false;
-    state_.end_half_pass();
     const bool noise_check = noise_check_due(rule, state_.passes);
     if (hooks_) hooks_->after_pass(state_, noise_check || plan_reads_statistics(settings_, state_));
     if (noise_check) noise_met_ = noise_target_met(state_, rule, share);

@@ -201,6 +201,12 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
     const uint8_t* const rows_active = state.active_rows.empty() ? nullptr : state.active_rows.data();
     const AccumulateBatch accumulate = accumulation(true);
     const LaneKernels kernels = lane_kernels(scene, settings);
+    // The samples of a pass after an odd number of passes go to the film's half, as the
+    // difference of each row's sums after and before it (the row's sums in the cache).
+    const bool half_pass = state.tracks_halves() && state.passes % 2 == 1;
+    const auto data = [](const std::vector<uint8_t>& v) { return v.empty() ? nullptr : v.data(); };
+    const uint8_t* const active = data(state.plan.active);
+    const uint8_t* const planned = data(state.plan.pass_samples);
 #pragma omp parallel reduction(+ : rays, nonfinite) reduction(|| : stopped)
     {
         PassThread thread(scene, settings, state, accumulate, kernels);
@@ -216,7 +222,9 @@ bool render_pass(const RenderScene& scene, const RenderSettings& settings, Rende
                 stopped = true;  // each thread's own copy, or-ed together at the end (no data race)
                 continue;
             }
+            if (half_pass) state.add_row_to_half(-1, state.row_start(y), active, planned);
             thread.sample_row(y);
+            if (half_pass) state.add_row_to_half(+1, state.row_start(y), active, planned);
         }
         rays += thread.rays;
         nonfinite += thread.nonfinite;

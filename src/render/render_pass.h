@@ -13,7 +13,9 @@ namespace kr {
 
 // Adds one sample to every pixel of `state`'s film, or the number its plan gives
 // (state.plan.pass_samples; sample index = the pixel's own count of samples drawn), on the
-// rows state.active_rows leaves on and the pixels the noise rule's mask does.
+// rows state.active_rows leaves on and the pixels the noise rule's mask does; where the film
+// tracks the halves (Film::track_halves), a pass after an odd number of passes adds its
+// samples to the half too, the others' halves staying as they are, bit for bit.
 // Parallel over rows with OpenMP; each sample has its own RNG stream seeded by
 // (seed, pixel, sample index), so the image does not depend on threads or scheduling.
 // If `stop` becomes true the pass ends early and returns false; pixels it reached keep their

@@ -28,21 +28,6 @@ struct RenderState : Film {
     RenderState(int w, int h) { reset(w, h); }
     // A fresh render of w x h pixels holding the rows `held` (Film::reset): no pass, no plan.
     void reset(int w, int h, std::vector<int> held = {});
-
-    // Around a pass (ProgressiveDriver): the samples of a pass after an odd number of passes
-    // go to the film's half, as the difference of the sums after and before it, for the
-    // pixels the pass samples (its rows, the noise rule's mask and the plan: render_pass skips
-    // the others, whose halves stay as they are, bit for bit). A no-op unless the film tracks
-    // the halves, or for the other passes.
-    void begin_half_pass() {
-        if (passes % 2 == 1) add_pass_to_half(-1);
-    }
-    void end_half_pass() {
-        if (passes % 2 == 0) add_pass_to_half(+1);
-    }
-
-private:
-    void add_pass_to_half(int sign);
 };
 
 // The bytes per pixel a RenderState holds once every buffer is in use: its film's (halves

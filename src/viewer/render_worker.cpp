@@ -167,6 +167,14 @@ void RenderWorker::set_features(bool on) {
     changed_.notify_all();
 }
 
+void RenderWorker::set_halves(bool on) {
+    {
+        std::lock_guard lock(mutex_);
+        halves_.store(on);
+    }
+    changed_.notify_all();
+}
+
 void RenderWorker::set_schedule(const FrameSchedule& schedule) {
     std::lock_guard lock(mutex_);
     schedule_ = schedule;
@@ -424,9 +432,10 @@ void make_preview_frame(const RenderJob& job, int scale, bool denoise, bool feat
 
 bool make_full_frame(const RenderJob& job, const RenderState& state, DisplayFeatures* features,
                      DenoiseWorkspace& workspace, Snapshot& frame, const Snapshot* previous,
-                     const std::optional<PixelBox>& region, const std::atomic<bool>* cancel) {
+                     const std::optional<PixelBox>& region, const std::atomic<bool>* cancel, bool with_halves) {
     const auto cancelled = [&] { return cancel && cancel->load(); };
-    RenderEstimates estimates = render_estimates(state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance);
+    RenderEstimates estimates = render_estimates(
+        state, kLayerRadiance | kLayerDepth | kLayerSamples | kLayerVariance | (with_halves ? kLayerHalves : 0u));
     if (cancelled()) return false;
     const std::optional<PixelBox> box =
         features ? denoised_box(region, state.width, state.height, previous, job.generation, estimates.samples) : std::nullopt;
@@ -608,8 +617,17 @@ void RenderWorker::run() {
             return features_.load() && driver && latest_ && latest_->generation == job.generation &&
                    latest_->scale == 1 && latest_->error.empty() && !latest_->features;
         };
+        // Save asked for the halves while no pass is coming: the newest full frame again, with
+        // them (under the lock).
+        auto halves_due = [&] {
+            return halves_.load() && driver && latest_ && latest_->generation == job.generation &&
+                   latest_->scale == 1 && latest_->error.empty() && latest_->halves.count[0].empty();
+        };
         std::shared_ptr<const Snapshot> republish;
         bool publish_estimate = false;  // a frame of passes already taken (paused, stopped)
+        // Whether this turn's full frame carries the halves: asked for (set_halves), or the
+        // frame of a finished or paused render, which Save takes as it is.
+        bool frame_halves = false;
         // A pause holds the passes once the job has a full-resolution frame: one that comes
         // during the previews (or with an edit) still brings the picture to its first full
         // frame, never a frozen preview (under the lock).
@@ -618,12 +636,12 @@ void RenderWorker::run() {
         {
             std::unique_lock lock(mutex_);
             changed_.wait(lock, [&] {
-                return quit_ || pending_ || refining() || features_due() ||
+                return quit_ || pending_ || refining() || features_due() || halves_due() ||
                        (driver && unpublished);
             });
             if (quit_) return;
             if (!pending_ && !refining()) {
-                if (unpublished) publish_estimate = true;
+                if (unpublished) publish_estimate = frame_halves = true;
                 else republish = latest_;
             }
             if (pending_) {
@@ -681,15 +699,19 @@ void RenderWorker::run() {
 
         const int w = job.scene->renderer.width, h = job.scene->renderer.height;
         if (republish) {
+            // No pass since the newest frame: the state is still its samples.
             try {
                 auto frame = std::make_shared<Snapshot>(*republish);
-                frame->features = full_features();
-                frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
+                if (features_.load() && !frame->features) {
+                    frame->features = full_features();
+                    frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
+                }
+                if (halves_.load() && frame->halves.count[0].empty()) frame->halves = state.halves();
                 publish(std::move(frame));
             } catch (const std::bad_alloc&) {
                 driver.reset();
-                publish_error(job.generation, "not enough memory for the feature layers of a " + std::to_string(w) +
-                                                  "x" + std::to_string(h) + " image");
+                publish_error(job.generation, "not enough memory for the feature layers or halves of a " +
+                                                  std::to_string(w) + "x" + std::to_string(h) + " image");
             }
             continue;
         }
@@ -744,7 +766,11 @@ void RenderWorker::run() {
                     (!full_frame_made ||
                      schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load(),
                                    pass_seconds * (next_frame_spp(state.passes, first) - state.passes)));
-                due = by_schedule || paused_ || stop_reason() || (features_.load() && !(latest_ && latest_->features));
+                frame_halves = halves_.load() || paused_ || stop_reason();
+                const bool halves_wanted = halves_.load() && !(latest_ && latest_->generation == job.generation &&
+                                                               !latest_->halves.count[0].empty());
+                due = by_schedule || paused_ || stop_reason() || halves_wanted ||
+                      (features_.load() && !(latest_ && latest_->features));
             }
             if (!due) continue;
         }
@@ -779,7 +805,7 @@ void RenderWorker::run() {
             // An edit that comes meanwhile (stop_) drops this frame of the view it replaced:
             // the next turn starts the new job.
             if (!make_full_frame(job, state, denoise_.load() ? &display_features : nullptr, denoise_planes, *frame,
-                                 last_full.get(), region.region, &stop_))
+                                 last_full.get(), region.region, &stop_, frame_halves))
                 continue;
             if (features_.load()) {
                 frame->features = full_features();

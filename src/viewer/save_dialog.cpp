@@ -30,17 +30,27 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
         throw std::invalid_argument(quoted_path(path) + ": a " + format.name + " image needs a name ending in " +
                                     format.extension);
     }
+    // Denoised where the display is, with the final filter, as `render --denoise` develops it:
+    // from the two halves of the samples (save_waits_for_halves).
+    const bool denoised = model.settings().denoise != DenoiseView::off;
+    if (denoised && shown->halves.count[0].size() != n)
+        throw std::runtime_error("the image's two halves of the samples are not there yet");
     RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance, {}, {}, shown->halves};
     OutputRequest request;
     request.path = path;
     request.display = model.settings().tone;
-    // Denoised where the display is, with the final filter, as `render --denoise` develops it.
-    request.develop.denoise = model.settings().denoise != DenoiseView::off ? Denoise::on : Denoise::off;
+    request.develop.denoise = denoised ? Denoise::on : Denoise::off;
     request.develop.sampling = model.settings().render;
     write_files_atomic(output_files(*model.prepared(), std::move(estimates), request));
 }
 
 }  // namespace
+
+bool save_waits_for_halves(SaveKind kind, const ViewerModel& model, const Snapshot* shown) {
+    return kind.what == SaveKind::image && model.settings().denoise != DenoiseView::off && shown &&
+           shown->scale == 1 && shown->generation == model.generation() && shown->error.empty() &&
+           shown->halves.count[0].size() != shown->radiance.pixels.size();
+}
 
 bool scene_file_read_only(const fs::path& file, const std::optional<DataDir>& data) {
     if (data && path_inside(file, data->path)) return true;

@@ -61,5 +61,9 @@ std::vector<std::filesystem::path> save_targets(SaveKind kind, const std::filesy
 // line; throws std::exception with the reason when nothing was written.
 std::string save_output(SaveKind kind, const std::filesystem::path& path, ViewerModel& model, const Snapshot* shown,
                         const std::string& convergence_csv = {});
+// Whether saving `kind` now must wait for a frame with the two halves of the samples: a
+// denoised image (the final filter reads them) whose `shown` frame of the current scene is a
+// full-resolution one without them (a render still refining: RenderWorker::set_halves asks).
+bool save_waits_for_halves(SaveKind kind, const ViewerModel& model, const Snapshot* shown);
 
 }  // namespace kr::viewer

@@ -186,6 +186,10 @@ void ViewerApp::sync_worker() {
     // The feature layers only while a view shows them: the default render path makes none.
     if (const bool f = is_feature_view(ui_.compare.comparison.settings.mode); f != sub.features)
         worker_->set_features(sub.features = f);
+    // The halves only while a save of a denoised image waits for them (or a scripted run will
+    // save one): the others' frames carry them once the render is finished or paused.
+    if (const bool h = ui_.save.waiting.has_value() || options_.save_image.has_value(); h != sub.halves)
+        worker_->set_halves(sub.halves = h);
     const StopRule rule = s.stop_rule();
     if (model_.generation() != sub.generation) {
         sub.generation = model_.generation();
@@ -513,6 +517,7 @@ bool ViewerApp::draw_frame() {
     input_.apply_button_positions();
     glfwGetFramebufferSize(window_, &ui_.framebuffer_width, &ui_.framebuffer_height);
     fetch_frame();
+    finish_waiting_save(ctx_);
     if (model_.has_scene() && inside_checked_generation_ != model_.generation()) {
         inside_checked_generation_ = model_.generation();
         ui_.inside_sphere = sphere_containing(model_.scene(), model_.camera().position);

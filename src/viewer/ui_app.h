@@ -91,6 +91,7 @@ private:
         std::optional<PixelBox> region;
         bool denoise = true;
         bool features = false;
+        bool halves = false;
     } submitted_;
     DenoiseView shown_view_ = DenoiseView::on;  // the view of the frame in the texture
 

@@ -122,10 +122,17 @@ inline constexpr const char* kDiscardQuestion = "Unsaved edits";
 inline constexpr const char* kOverwriteQuestion = "Overwrite?";
 inline constexpr const char* kSaveWhereQuestion = "Save the scene as";
 
-// The Save panel's paths (edited by the user) and the save awaiting the overwrite question.
+// The Save panel's paths (edited by the user), the save awaiting the overwrite question and
+// a denoised image's save awaiting its frame's halves (save_waits_for_halves).
 struct SaveTool {
     SavePaths paths;
     std::optional<std::pair<SaveKind, std::filesystem::path>> pending;
+    struct Waiting {
+        SaveKind kind;
+        std::filesystem::path path;
+        uint64_t generation = 0;  // the scene's when asked: an edit before the frame cancels it
+    };
+    std::optional<Waiting> waiting;
     bool ask_overwrite = false;  // open that question this frame
     bool ask_where = false;      // Save of a read-only scene (a bundled one): ask where, this frame
     bool read_only = false;      // the scene's file is not to be written (scene_file_read_only)
@@ -220,8 +227,13 @@ void open_scene(PanelContext& ctx, const std::filesystem::path& file, bool keep_
 void open_scene_asking(PanelContext& ctx, const std::filesystem::path& file);
 
 // Writes `kind` to `path` (viewer/save_dialog.h), asking first when a file would be
-// replaced; the outcome is the status message (ui_panel_save.cpp).
+// replaced; the outcome is the status message (ui_panel_save.cpp). A denoised image of a
+// render still refining is written with the next frame, which carries the halves
+// (SaveTool::waiting, finish_waiting_save).
 void request_save(PanelContext& ctx, SaveKind kind, const std::filesystem::path& path);
+// Each frame, after the newest frame is fetched: writes the save waiting for the halves once
+// the shown frame has them, or drops it, saying so, where the scene changed meanwhile.
+void finish_waiting_save(PanelContext& ctx);
 // Save: the scene over its own file, without asking (Ctrl+S).
 void save_scene_in_place(PanelContext& ctx);
 // The overwrite question (request_save asks for it), drawn every frame after the other windows.

@@ -5,9 +5,11 @@
 #include <imgui.h>
 #include <imgui_stdlib.h>
 
+#include "core/text.h"
 #include "viewer/save_dialog.h"
 #include "viewer/ui_file_dialog.h"
 #include "viewer/ui_panels.h"
+#include "viewer/ui_widgets.h"
 
 namespace kr::viewer {
 
@@ -25,6 +27,7 @@ void panel_save(PanelContext& ctx) {
         if (&format != &kImageFormats.front()) ImGui::SameLine();
         if (ImGui::Button((std::string("Save ") + format.name).c_str()))
             request_save(ctx, format.format, image_save_path(format.format, paths.image));
+        if (ImGui::IsItemVisible()) mark_item(ctx, std::string("save:") + (format.extension + 1));
     }
     // Any folder and name (the file chooser, else the built-in browser); its extension picks the format.
     if (ImGui::Button("Save image as...")) {
@@ -47,6 +50,11 @@ void panel_save(PanelContext& ctx) {
 namespace {
 
 void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
+    if (save_waits_for_halves(kind, ctx.model, ctx.ui.shown.get())) {
+        ctx.ui.save.waiting = SaveTool::Waiting{kind, path, ctx.model.generation()};
+        ctx.messages.show_status("saving " + show_user_text(path.string()) + " with the next frame");
+        return;
+    }
     try {
         ctx.messages.show_status(save_output(kind, path, ctx.model, ctx.ui.shown.get(), ctx.ui.compare.convergence.csv()));
         // Saving over the watched file should not read like an outside change; Save As
@@ -65,6 +73,21 @@ void save_now(PanelContext& ctx, SaveKind kind, const fs::path& path) {
 }
 
 }  // namespace
+
+void finish_waiting_save(PanelContext& ctx) {
+    auto& waiting = ctx.ui.save.waiting;
+    if (!waiting) return;
+    if (waiting->generation != ctx.model.generation()) {
+        ctx.messages.show_error("not saved: " + show_user_text(waiting->path.string()) +
+                                ": the image changed before its next frame came");
+        waiting.reset();
+        return;
+    }
+    if (save_waits_for_halves(waiting->kind, ctx.model, ctx.ui.shown.get())) return;
+    const SaveTool::Waiting now = *waiting;
+    waiting.reset();
+    save_now(ctx, now.kind, now.path);
+}
 
 void save_scene_in_place(PanelContext& ctx) {
     if (!ctx.model.has_scene()) return;

@@ -81,6 +81,9 @@ bool ScriptRun::step(PanelContext& ctx, const PixelRect& rect, const ReadBack& r
     // The screenshot waits for the render thread, never for time: N whole passes.
     const int needed = script_passes_needed(options_, model.settings());
     if (!(current && current->scale == 1 && current->spp >= needed)) return false;
+    // A denoised image is saved from a frame with the halves (set_halves asks every frame for them).
+    if (options_.save_image && save_waits_for_halves(image_save_kind(*options_.save_image), model, current))
+        return false;
     const std::filesystem::path* writing = nullptr;  // the output being made, for its error
     try {
         if (options_.screenshot) {
