@@ -34,14 +34,39 @@ void Film::track_halves() {
     px_.half_count.assign(n, 0);
 }
 
+namespace {
+
+// add_row_to_half's loop over the row's pixels [begin, end), specialised on which masks there
+// are so that a pass of every pixel runs without them.
+template <bool kActive, bool kPlanned>
+void add_pixels_to_half(PixelBuffers& px, double sign, size_t begin, size_t end, const uint8_t* active,
+                        const uint8_t* planned) {
+    Color* const half = px.half_sum.data();
+    uint32_t* const half_count = px.half_count.data();
+    const Color* const sum = px.radiance_sum.data();
+    const Color* const compensation = px.radiance_compensation.data();
+    const uint32_t* const count = px.sample_count.data();
+    const uint32_t count_sign = uint32_t(int32_t(sign));
+    for (size_t i = begin; i < end; ++i) {
+        if ((kActive && !active[i]) || (kPlanned && !planned[i])) continue;
+        half[i] += sign * (sum[i] + compensation[i]);
+        half_count[i] += count_sign * count[i];  // modulo 2^32, exact
+    }
+}
+
+}  // namespace
+
 void Film::add_row_to_half(int sign, size_t start, const uint8_t* active, const uint8_t* planned) {
     // Only the pixels the pass samples, whose sums are the only ones it changes: a region's or
     // an adaptive pass costs what its pixels cost, and the others' halves stay as they are,
     // bit for bit.
-    for (size_t i = start; i < start + size_t(width); ++i) {
-        if ((active && !active[i]) || (planned && !planned[i])) continue;
-        px_.half_sum[i] += double(sign) * (px_.radiance_sum[i] + px_.radiance_compensation[i]);
-        px_.half_count[i] += uint32_t(sign) * px_.sample_count[i];  // modulo 2^32, exact
+    const size_t end = start + size_t(width);
+    if (active) {
+        if (planned) add_pixels_to_half<true, true>(px_, sign, start, end, active, planned);
+        else add_pixels_to_half<true, false>(px_, sign, start, end, active, planned);
+    } else {
+        if (planned) add_pixels_to_half<false, true>(px_, sign, start, end, active, planned);
+        else add_pixels_to_half<false, false>(px_, sign, start, end, active, planned);
     }
 }
 
