@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/image.h"
 #include "core/image_hdr.h"
@@ -67,6 +68,35 @@ TEST_F(Cli, HelpDocumentsEveryFlag) {
                              "stratified", "--tonemap", "sigmoid", "linear", "--blur", "--seed", "--threads", "-o",
                              "--light-sampling", "--depth", "psnr", "--checkpoint", "--every", "--resume", "mpirun"})
         EXPECT_NE(r.out.find(flag), std::string::npos) << flag;
+}
+
+// `view` runs itself again with a short OpenMP spin (GOMP_SPINCOUNT=10000) unless the
+// environment sets the waiting; `render` keeps libgomp's default. libgomp prints what it read
+// at each start (OMP_DISPLAY_ENV), so the last count printed is the one the viewer runs with.
+TEST_F(Cli, ViewerRunsWithAShortOpenMpSpinUnlessTheEnvironmentSetsOne) {
+    const auto spin_counts = [&](const std::string& env, const std::string& args) {
+        const CliRun r = kr::test::run_command("env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT OMP_DISPLAY_ENV=verbose " + env +
+                                               " '" + KEITHRAY_EXE + "' " + args,
+                                           dir);
+        EXPECT_EQ(r.status, 0) << r.err;
+        std::vector<std::string> counts;
+        std::istringstream lines(r.err);
+        for (std::string line; std::getline(lines, line);)
+            if (const size_t at = line.find("GOMP_SPINCOUNT = '"); at != std::string::npos)
+                counts.push_back(line.substr(at + 18, line.find('\'', at + 18) - at - 18));
+        return counts;
+    };
+    const std::vector<std::string> view = spin_counts("", "view --help");
+    // LLVM's libomp (the ThreadSanitizer build's) prints no GOMP_SPINCOUNT and ignores it.
+    if (view.empty()) GTEST_SKIP() << "the OpenMP runtime is not libgomp";
+    ASSERT_EQ(view.size(), 2u);  // read before main, then again after the exec
+    EXPECT_NE(view[0], "10000");
+    EXPECT_EQ(view[1], "10000");
+    const std::vector<std::string> render = spin_counts("", "render --help");
+    ASSERT_EQ(render.size(), 1u);
+    EXPECT_NE(render[0], "10000");
+    EXPECT_EQ(spin_counts("GOMP_SPINCOUNT=5", "view --help"), std::vector<std::string>{"5"});
+    EXPECT_EQ(spin_counts("OMP_WAIT_POLICY=passive", "view --help"), std::vector<std::string>{"0"});
 }
 
 TEST_F(Cli, RendersImageAndDepthBesideIt) {

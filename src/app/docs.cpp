@@ -238,6 +238,10 @@ worker threads (as \fB\-\-threads\fR)
 \fBpassive\fR lets idle worker threads sleep at once: better on a machine whose cores
 other jobs share
 .TP
+.B GOMP_SPINCOUNT
+how long idle worker threads spin before they sleep; \fBkeithray view\fR runs itself
+again with 10000 (about 0.1 ms) unless this or \fBOMP_WAIT_POLICY\fR is set
+.TP
 .BR DISPLAY ", " WAYLAND_DISPLAY
 the display \fBkeithray view\fR opens its window on
 .SH "EXIT STATUS"
