@@ -176,7 +176,7 @@ struct FrameSchedule {
     double cost_share = 0.2;
     // The seconds the carried picture of an earlier view (reproject.h: the new view's first
     // surfaces traced, the picture reprojected) may add before a camera move's first full
-    // frame, predicted from its measured cost per pixel (a pass's before it was measured): a
+    // frame, predicted from its measured cost per pixel (twice a pass's before it was measured): a
     // dearer one (a large image; docs/viewer.md, "The render pipeline, measured") is made once
     // that frame is on screen, and the frame after it carries the picture.
     double prior_budget = 0.1;
