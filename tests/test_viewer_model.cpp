@@ -866,6 +866,14 @@ TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
     EXPECT_EQ(next_frame_spp(8, 4), 16);
     EXPECT_EQ(next_frame_spp(13, 4), 16);
     EXPECT_EQ(next_frame_spp(16, 4), 24);
+    // The carried picture before the first frame where it costs at most prior_budget: as last
+    // measured, else at twice a pass's cost per pixel (a 1920x1080 pass of 60 ms: 0.12 s, after).
+    const double hd = 1920.0 * 1080.0;
+    EXPECT_FALSE(s.prior_first(0, 0.060 / hd, hd));
+    EXPECT_TRUE(s.prior_first(0, 0.045 / hd, hd));
+    EXPECT_TRUE(s.prior_first(0.09 / hd, 0.060 / hd, hd));  // measured: 0.09 s
+    EXPECT_FALSE(s.prior_first(0.11 / hd, 0.010 / hd, hd));
+    EXPECT_TRUE(s.prior_first(0, 0.015 / (512.0 * 512.0), 512.0 * 512.0));
 }
 
 // The status bar's elapsed time is the wall time since the edit, not the passes' time alone:

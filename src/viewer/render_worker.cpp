@@ -54,14 +54,18 @@ bool FrameSchedule::due(double age, double since_last, double cost, double next_
     return since_last >= 0.5 * interval && late > early;
 }
 
+bool FrameSchedule::prior_first(double prior_seconds_per_pixel, double pass_seconds_per_pixel, double pixels) const {
+    // Before its cost was measured, twice a pass's per pixel: it measures 0.9 to 2.1 times a
+    // pass's at 512x512, 1.3 to 3 times at 1920x1080 (scenes 3, 4, 8 and gallery_100), where
+    // a pass's alone let a dear one hold the first frame up.
+    const double per_pixel = prior_seconds_per_pixel > 0 ? prior_seconds_per_pixel : 2 * pass_seconds_per_pixel;
+    return per_pixel * pixels <= prior_budget;
+}
+
 bool frame_spp(int spp, int first) {
     if (spp < first) return false;
     return spp <= 8 ? (spp & (spp - 1)) == 0 : spp % 8 == 0;
 }
-
-// A prior not yet measured is predicted at this many passes' cost per pixel (run: the
-// carried picture of a camera move).
-constexpr double kUnmeasuredPriorPasses = 2;
 
 int first_frame_spp(const RenderScene& scene) { return scene.camera.lens_radius > 0 ? 4 : 2; }
 
@@ -795,17 +799,12 @@ void RenderWorker::run() {
                 prior_made = true;
                 if (!region.region) {
                     earlier = {last_full, last_full_scene, last_full_settings};
-                    // Before its cost was measured, twice a pass's per pixel: it measures 0.9 to
-                    // 2.1 times a pass's at 512x512, 1.3 to 3 times at 1920x1080 (scenes 3, 4, 8
-                    // and gallery_100), where a pass's alone let a dear one hold the frame up.
-                    const double per_pixel =
-                        prior_seconds_per_pixel > 0 ? prior_seconds_per_pixel : kUnmeasuredPriorPasses * seconds_per_pixel;
-                    double budget = 0;
+                    bool first = false;
                     {
                         std::lock_guard lock(mutex_);
-                        budget = schedule_.prior_budget;
+                        first = schedule_.prior_first(prior_seconds_per_pixel, seconds_per_pixel, double(w) * h);
                     }
-                    if (per_pixel * double(w) * h <= budget) make_prior(w, h);
+                    if (first) make_prior(w, h);
                     else prior_deferred = true;
                 }
             }

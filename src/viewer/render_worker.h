@@ -176,11 +176,15 @@ struct FrameSchedule {
     double cost_share = 0.2;
     // The seconds the carried picture of an earlier view (reproject.h: the new view's first
     // surfaces traced, the picture reprojected) may add before a camera move's first full
-    // frame, predicted from its measured cost per pixel (twice a pass's before it was measured): a
+    // frame, predicted from its measured cost per pixel (prior_first): a
     // dearer one (a large image; docs/viewer.md, "The render pipeline, measured") is made once
     // that frame is on screen, and the frame after it carries the picture.
     double prior_budget = 0.1;
     bool due(double age, double since_last, double cost, double next_wait = 0) const;
+    // Whether the carried picture of `pixels` pixels is made before the first full frame: its
+    // cost per pixel as measured last (`prior_seconds_per_pixel`; 0: never), else twice a
+    // pass's (`pass_seconds_per_pixel`), within prior_budget.
+    bool prior_first(double prior_seconds_per_pixel, double pass_seconds_per_pixel, double pixels) const;
 };
 
 // The display's feature buffers of one image (albedo and normal, render/outputs.h): refined a
