@@ -677,8 +677,16 @@ TEST(Denoise, ViewerShowsRawDenoisedOrSplit) {
     EXPECT_EQ(split.at(1, 1).x, 0.0);
     EXPECT_EQ(split.at(2, 1).x, 1.0);
     EXPECT_EQ(viewer::shown_word(frame, DenoiseView::split), "split");
+    // The display uploads the frame's own image where the shown one is it whole.
+    EXPECT_EQ(viewer::shown_image_in_place(frame, DenoiseView::off), &frame.radiance);
+    EXPECT_EQ(viewer::shown_image_in_place(frame, DenoiseView::on, 4, 2), &frame.denoised);
+    EXPECT_EQ(viewer::shown_image_in_place(frame, DenoiseView::split), nullptr);
+    frame.scale = 2;  // a preview of an 8x4 image: upscaled
+    EXPECT_EQ(viewer::shown_image_in_place(frame, DenoiseView::on, 8, 4), nullptr);
+    frame.scale = 1;
     frame.denoised = Image();  // a frame the worker did not denoise shows raw
     EXPECT_EQ(viewer::shown_word(frame, DenoiseView::on), "raw");
+    EXPECT_EQ(viewer::shown_image_in_place(frame, DenoiseView::on), &frame.radiance);
 }
 
 // bench/denoise_scenes.py, the scenes the denoiser's goals are measured on

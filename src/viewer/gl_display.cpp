@@ -74,19 +74,25 @@ Display::~Display() {
 }
 
 void Display::upload(const Image& radiance) {
-    std::vector<float> texels(radiance.pixels.size() * 3);
+    texels_.resize(radiance.pixels.size() * 3);
     for (size_t i = 0; i < radiance.pixels.size(); ++i)
         for (int k = 0; k < 3; ++k) {
             const double v = radiance.pixels[i][k];
             // Means are finite (the renderer drops non-finite samples); keep float finite too.
-            texels[3 * i + k] = static_cast<float>(std::clamp(v, -double(FLT_MAX), double(FLT_MAX)));
+            texels_[3 * i + k] = static_cast<float>(std::clamp(v, -double(FLT_MAX), double(FLT_MAX)));
         }
     gl_.ActiveTexture(GL_TEXTURE0);
     gl_.BindTexture(GL_TEXTURE_2D, texture_);
     gl_.PixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, radiance.width, radiance.height, 0, GL_RGB, GL_FLOAT,
-                   texels.data());
+    // The texture's storage is kept while the image's size is (a frame after another of the
+    // same image); a new size allocates it again.
+    if (radiance.width == tex_width_ && radiance.height == tex_height_)
+        gl_.TexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, radiance.width, radiance.height, GL_RGB, GL_FLOAT, texels_.data());
+    else
+        gl_.TexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, radiance.width, radiance.height, 0, GL_RGB, GL_FLOAT,
+                       texels_.data());
     tex_width_ = radiance.width;
+    tex_height_ = radiance.height;
     inv_max_ = linear_tonemap_scale(radiance);
 }
 

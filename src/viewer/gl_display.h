@@ -2,6 +2,8 @@
 // radiance goes to a float texture and the shaders in shaders/ tone map it on the GPU.
 #pragma once
 
+#include <vector>
+
 #include "core/image.h"
 #include "viewer/edit.h"
 #include "viewer/gl_functions.h"
@@ -45,7 +47,8 @@ private:
     GLuint program_ = 0, texture_ = 0, bytes_texture_ = 0, vertex_array_ = 0;
     int bytes_width_ = 0;
     GLint rect_loc_ = -1, op_loc_ = -1, exposure_loc_ = -1, inv_max_loc_ = -1, sampler_loc_ = -1;
-    int tex_width_ = 0;
+    int tex_width_ = 0, tex_height_ = 0;
+    std::vector<float> texels_;  // the upload's floats, kept between frames
     double inv_max_ = 0;
     bool smooth_ = false;
 };

@@ -51,6 +51,7 @@ namespace kr::viewer {
     X(BindTexture, PFNGLBINDTEXTUREPROC)                     \
     X(ActiveTexture, PFNGLACTIVETEXTUREPROC)                 \
     X(TexImage2D, PFNGLTEXIMAGE2DPROC)                       \
+    X(TexSubImage2D, PFNGLTEXSUBIMAGE2DPROC)                 \
     X(TexParameteri, PFNGLTEXPARAMETERIPROC)
 
 struct GlFunctions {

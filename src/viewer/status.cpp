@@ -111,7 +111,15 @@ std::optional<std::vector<double>> TypedFields::take(unsigned id) {
     return values;
 }
 
+const Image* shown_image_in_place(const Snapshot& frame, DenoiseView view, int width, int height) {
+    if (frame.scale > 1 && width > 0 && height > 0) return nullptr;  // upscaled
+    const bool denoised = frame.denoised.pixels.size() == frame.radiance.pixels.size();
+    if (view == DenoiseView::off || !denoised) return &frame.radiance;
+    return view == DenoiseView::on ? &frame.denoised : nullptr;  // split: composed
+}
+
 Image shown_radiance(const Snapshot& frame, DenoiseView view, int width, int height) {
+    if (const Image* in_place = shown_image_in_place(frame, view, width, height)) return *in_place;
     const Image& denoised = frame.denoised;
     Image out;
     if (view == DenoiseView::off || denoised.pixels.size() != frame.radiance.pixels.size()) out = frame.radiance;

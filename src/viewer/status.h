@@ -71,6 +71,10 @@ std::string window_title(std::string_view scene_name, const RunStatus& status, b
 // A preview, given the image's full `width` and `height`, is upscaled to it smoothly
 // (core/image.h upscale_linear): a coarse image, not blocks.
 Image shown_radiance(const Snapshot& frame, DenoiseView view, int width = 0, int height = 0);
+// The frame's own image where shown_radiance would be a copy of it (its radiance or its
+// denoised radiance, at full resolution); null where the shown image is composed (split,
+// upscaled): what the display uploads without a copy.
+const Image* shown_image_in_place(const Snapshot& frame, DenoiseView view, int width = 0, int height = 0);
 // The 8-bit picture the window shows of `frame` at 1:1 with the display's tone map.
 Rgb8Image displayed_picture(const Snapshot& frame, DenoiseView view, int width, int height,
                             const DisplaySettings& display);

@@ -231,7 +231,11 @@ bool ViewerApp::fetch_frame() {
         return false;
     }
     const RendererSettings& image = model_.scene().renderer;
-    display_->upload(shown_radiance(*frame, shown_view_ = view, image.width, image.height));
+    shown_view_ = view;
+    if (const Image* in_place = shown_image_in_place(*frame, view, image.width, image.height))
+        display_->upload(*in_place);  // no copy of the frame's image
+    else
+        display_->upload(shown_radiance(*frame, view, image.width, image.height));
     ui_.shown = std::move(frame);
     return true;
 }
