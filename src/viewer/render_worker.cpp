@@ -629,7 +629,7 @@ void RenderWorker::run() {
         // them (under the lock).
         auto halves_due = [&] {
             return halves_.load() && driver && latest_ && latest_->generation == job.generation &&
-                   latest_->scale == 1 && latest_->error.empty() && latest_->halves.count[0].empty();
+                   latest_->scale == 1 && latest_->error.empty() && !latest_->has_halves();
         };
         std::shared_ptr<const Snapshot> republish;
         bool publish_estimate = false;  // a frame of passes already taken (paused, stopped)
@@ -714,7 +714,7 @@ void RenderWorker::run() {
                     frame->features = full_features();
                     frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
                 }
-                if (halves_.load() && frame->halves.count[0].empty()) frame->halves = state.halves();
+                if (halves_.load() && !frame->has_halves()) frame->halves = state.halves();
                 publish(std::move(frame));
             } catch (const std::bad_alloc&) {
                 driver.reset();
@@ -774,10 +774,11 @@ void RenderWorker::run() {
                     (!full_frame_made ||
                      schedule_.due(job_seconds(), seconds_since(last_frame), frame_cost + display_cost_.load(),
                                    pass_seconds * (next_frame_spp(state.passes, first) - state.passes)));
-                frame_halves = halves_.load() || paused_ || stop_reason();
-                const bool halves_wanted = halves_.load() && !(latest_ && latest_->generation == job.generation &&
-                                                               !latest_->halves.count[0].empty());
-                due = by_schedule || paused_ || stop_reason() || halves_wanted ||
+                const bool last_before_a_stop = paused_ || stop_reason();  // a frame Save takes as it is
+                frame_halves = halves_.load() || last_before_a_stop;
+                const bool halves_wanted =
+                    halves_.load() && !(latest_ && latest_->generation == job.generation && latest_->has_halves());
+                due = by_schedule || last_before_a_stop || halves_wanted ||
                       (features_.load() && !(latest_ && latest_->features));
             }
             if (!due) continue;

@@ -147,6 +147,9 @@ struct Snapshot {
     std::shared_ptr<const FeatureBuffers> features;
     std::vector<float> hit_depth;
     RenderState::Halves halves;  // the two halves of the samples (the final denoiser's guides)
+    // Whether the frame carries the halves (a full frame of a finished or paused render, or
+    // while RenderWorker::set_halves asks for them).
+    bool has_halves() const { return halves.count[0].size() == radiance.pixels.size(); }
     uint64_t nonfinite_samples = 0;
     // Pixels whose display image took an earlier view's picture (viewer/reproject.h): after a
     // camera move, until the job nears its target.

@@ -33,7 +33,7 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
     // Denoised where the display is, with the final filter, as `render --denoise` develops it:
     // from the two halves of the samples (save_waits_for_halves).
     const bool denoised = model.settings().denoise != DenoiseView::off;
-    if (denoised && shown->halves.count[0].size() != n)
+    if (denoised && !shown->has_halves())
         throw std::runtime_error("the image's two halves of the samples are not there yet");
     RenderEstimates estimates{shown->radiance, shown->depth, shown->sample_count, shown->variance, {}, {}, shown->halves};
     OutputRequest request;
@@ -49,7 +49,7 @@ void save_image(SaveKind kind, const fs::path& path, const ViewerModel& model, c
 bool save_waits_for_halves(SaveKind kind, const ViewerModel& model, const Snapshot* shown) {
     return kind.what == SaveKind::image && model.settings().denoise != DenoiseView::off && shown &&
            shown->scale == 1 && shown->generation == model.generation() && shown->error.empty() &&
-           shown->halves.count[0].size() != shown->radiance.pixels.size();
+           !shown->has_halves();
 }
 
 bool scene_file_read_only(const fs::path& file, const std::optional<DataDir>& data) {
