@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/lanes/levels.h"
 #include "render/trace.h"
 
 namespace kr {
@@ -36,8 +37,8 @@ void Film::track_halves() {
 
 namespace {
 
-// add_row_to_half's loop over the row's pixels [begin, end), specialised on which masks there
-// are so that a pass of every pixel runs without them.
+// add_row_to_half's loop over the pixels of the row's [begin, end) that its masks pick,
+// specialised on which masks there are.
 template <bool kActive, bool kPlanned>
 void add_pixels_to_half(PixelBuffers& px, double sign, size_t begin, size_t end, const uint8_t* active,
                         const uint8_t* planned) {
@@ -54,6 +55,25 @@ void add_pixels_to_half(PixelBuffers& px, double sign, size_t begin, size_t end,
     }
 }
 
+// A row of every pixel: the channels of its sums as one run of doubles (three a pixel) and
+// its counts, so that each loop is vectorised whole. Subtracting is adding the negated sum,
+// so the halves' bits are add_pixels_to_half's.
+KR_LOOP_CLONES
+void add_channels_to_half(double* half, const double* sum, const double* compensation, size_t channels, int sign) {
+    if (sign > 0)
+        for (size_t i = 0; i < channels; ++i) half[i] += sum[i] + compensation[i];
+    else
+        for (size_t i = 0; i < channels; ++i) half[i] -= sum[i] + compensation[i];
+}
+
+KR_LOOP_CLONES
+void add_counts_to_half(uint32_t* half_count, const uint32_t* count, size_t pixels, int sign) {
+    if (sign > 0)
+        for (size_t i = 0; i < pixels; ++i) half_count[i] += count[i];  // modulo 2^32, exact
+    else
+        for (size_t i = 0; i < pixels; ++i) half_count[i] -= count[i];
+}
+
 }  // namespace
 
 void Film::add_row_to_half(int sign, size_t start, const uint8_t* active, const uint8_t* planned) {
@@ -61,12 +81,18 @@ void Film::add_row_to_half(int sign, size_t start, const uint8_t* active, const 
     // an adaptive pass costs what its pixels cost, and the others' halves stay as they are,
     // bit for bit.
     const size_t end = start + size_t(width);
+    if (!active && !planned) {
+        static_assert(sizeof(Color) == 3 * sizeof(double), "a row's colours are one run of doubles");
+        add_channels_to_half(&px_.half_sum[start].x, &px_.radiance_sum[start].x, &px_.radiance_compensation[start].x,
+                             3 * size_t(width), sign);
+        add_counts_to_half(px_.half_count.data() + start, px_.sample_count.data() + start, size_t(width), sign);
+        return;
+    }
     if (active) {
         if (planned) add_pixels_to_half<true, true>(px_, sign, start, end, active, planned);
         else add_pixels_to_half<true, false>(px_, sign, start, end, active, planned);
     } else {
-        if (planned) add_pixels_to_half<false, true>(px_, sign, start, end, active, planned);
-        else add_pixels_to_half<false, false>(px_, sign, start, end, active, planned);
+        add_pixels_to_half<false, true>(px_, sign, start, end, active, planned);
     }
 }
 
