@@ -586,12 +586,15 @@ void RenderWorker::run() {
         }
         prior_seconds_per_pixel = seconds_since(start) / std::max(1.0, double(w) * h);
     };
-    // The full-resolution passes of `job` not yet in a frame, when the last frame was made and
-    // what making it cost (seconds, smoothed).
+    // The full-resolution passes of `job` not yet in a frame, and when the last frame was made.
     bool unpublished = false;
     bool full_frame_made = false;
     Clock::time_point last_frame{};
-    double frame_cost = 0;
+    // What making a full frame costs (seconds, smoothed), carried across edits while the image
+    // keeps its size (`frame_cost_pixels`): an edit's first frame often costs more than the
+    // frames of a settled view (the window is still drawing the edit's previews beside it),
+    // and alone it would space the next frame as if every frame cost that much.
+    double frame_cost = 0, frame_cost_pixels = 0;
     // The feature views' buffers of `job` at full resolution: the display's, completed.
     auto full_features = [&] {
         if (!features) {
@@ -820,7 +823,9 @@ void RenderWorker::run() {
                 frame->hit_depth = hit_depths(frame->depth, frame->sample_count);
             }
             const double cost = seconds_since(start);
-            frame_cost = full_frame_made ? 0.5 * (frame_cost + cost) : cost;
+            const double pixels = double(w) * h;
+            frame_cost = frame_cost_pixels == pixels ? 0.5 * (frame_cost + cost) : cost;
+            frame_cost_pixels = pixels;
             full_frame_made = true;
             unpublished = false;
             last_frame = Clock::now();
