@@ -843,9 +843,9 @@ TEST(RenderThread, FrameScheduleFollowsTheImagesAgeAndTheFramesCost) {
     EXPECT_FALSE(s.due(0.01, 0.01, 0.001));
     EXPECT_TRUE(s.due(100, 1.0, 0.001));        // an old one: a second
     EXPECT_FALSE(s.due(100, 0.9, 0.001));
-    // Frames costing 0.1 s (making and drawing) come at most every 0.5 s (a fifth of the time).
-    EXPECT_FALSE(s.due(0.2, 0.4, 0.1));
-    EXPECT_TRUE(s.due(0.2, 0.5, 0.1));
+    // Frames costing 0.1 s (making and drawing) come at most every 0.4 s (a quarter of the time).
+    EXPECT_FALSE(s.due(0.2, 0.35, 0.1));
+    EXPECT_TRUE(s.due(0.2, 0.4, 0.1));
     // Early, at a balanced count, where the next one would come later past the interval than
     // now is before it: 0.45 of 0.5 s with the next count 0.2 s away; not with it 0.05 s away,
     // nor before half the interval.

@@ -176,7 +176,7 @@ struct FrameSchedule {
     double age_fraction = 0.5;   // interval: half the image's age (frames at ages 1, 1.5, 2.25, ...)
     double min_interval = 1.0 / 60;
     double max_interval = 1.0;
-    double cost_share = 0.2;
+    double cost_share = 0.25;
     // The seconds the carried picture of an earlier view (reproject.h: the new view's first
     // surfaces traced, the picture reprojected) may add before a camera move's first full
     // frame, predicted from its measured cost per pixel (prior_first): a
