@@ -289,18 +289,32 @@ TEST(Accel, LaneClustersHoldEverySphereOnce) {
     }
     EXPECT_EQ(next, scene.spheres.size());
     EXPECT_GE(boxed, 60u / 8);
-    // Every lane tree of own's is scanned (kLaneOwnMaxSpheres spheres, the wall one of them);
-    // above it there is none: one path at a time down our tree.
-    static_assert(kLaneScanMaxSpheres >= kLaneOwnMaxSpheres);
-    const RenderScene most =
-        with_backend(random_spheres(int(kLaneOwnMaxSpheres) - 1, 1.0, 7, true), AccelBackend::own);
+    // Every lane tree of own's is scanned, on every kind of CPU (lane_tree_limits().own
+    // spheres, the wall one of them); above it there is none: one path at a time down our tree.
+    const size_t own = lane_tree_limits().own;
+    for (const CpuModel cpu : {CpuModel{false, 6}, CpuModel{true, 25}, CpuModel{true, 26}, CpuModel{}}) {
+        const LaneTreeLimits limits = lane_tree_limits(cpu);
+        EXPECT_LE(limits.beside_embree, limits.own);
+        EXPECT_LE(limits.own, kLaneScanMaxSpheres);
+    }
+    const RenderScene most = with_backend(random_spheres(int(own) - 1, 1.0, 7, true), AccelBackend::own);
     EXPECT_FALSE(most.bvh.lane_tree().nodes.empty());
     EXPECT_EQ(most.bvh.lane_tree().scan_f.size(), most.spheres.size());
-    const RenderScene many =
-        with_backend(random_spheres(int(kLaneOwnMaxSpheres) + 8, 1.0, 7, true), AccelBackend::own);
+    const RenderScene many = with_backend(random_spheres(int(own) + 8, 1.0, 7, true), AccelBackend::own);
     EXPECT_TRUE(many.bvh.lane_tree().nodes.empty());
     EXPECT_TRUE(many.bvh.lane_tree().clusters.empty());
     EXPECT_FALSE(many.bvh.lanes_cast());
+    // Beside Embree's tree (automatic), up to this CPU's other limit.
+    if (embree_available()) {
+        const size_t beside = lane_tree_limits().beside_embree;
+        const RenderScene within =
+            with_backend(random_spheres(int(beside) - 1, 1.0, 7, true), AccelBackend::automatic);
+        EXPECT_TRUE(within.bvh.lanes_cast());
+        EXPECT_EQ(within.bvh.lane_tree().scan_f.size(), within.spheres.size());
+        const RenderScene beyond =
+            with_backend(random_spheres(int(beside) + 8, 1.0, 7, true), AccelBackend::automatic);
+        EXPECT_FALSE(beyond.bvh.lanes_cast());
+    }
 }
 
 TEST(Accel, CoincidentCentresStillSplit) {

@@ -61,10 +61,12 @@ constexpr const char* kBenchUsage = R"(Usage:
               ns per ray and ns per ray / log2(N), and how paths were traced: in SIMD
               lanes (single-precision lanes scan the spheres a cluster at a time,
               double lanes walk a tree) or one path at a time. Under auto the lanes
-              take up to 1,800 spheres (eight float lanes 768, double lanes 128)
-              and Embree one path at a time above; under own, up to 2,048 (eight
-              float lanes 1,024, double lanes 320) and our own tree one path at a
-              time above (never Embree); embree always traces one path at a time.
+              take up to 1,800 spheres (2,800 on an AMD CPU of family 26:
+              `keithray --version` says this CPU's; eight float lanes 768, double
+              lanes 128) and Embree one path at a time above; under own, up to
+              2,048 (3,000 there; eight float lanes 1,024, double lanes 320) and our
+              own tree one path at a time above (never Embree); embree always
+              traces one path at a time.
               --runs rounds each render every count once (each BVH in turn); the
               table gives their medians, so that a burst of load on a shared
               machine moves one run of many counts rather than one count's median.

@@ -550,6 +550,19 @@ LaneTree build_lane_tree(const std::vector<SphereGeom>& spheres) {
 
 }  // namespace
 
+LaneTreeLimits lane_tree_limits(const CpuModel& cpu) {
+    // Where the sixteen float lanes' scan meets Embree's one path and our tree's, measured per
+    // kind of CPU (`bench --stress N --accel own,embree` with the limits raised, `--kernels
+    // off` for our tree's one path).
+    if (cpu.amd && cpu.family == 26) return {2800, 3000};
+    return {1800, 2048};
+}
+
+LaneTreeLimits lane_tree_limits() {
+    static const LaneTreeLimits limits = lane_tree_limits(cpu_model());
+    return limits;
+}
+
 void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backend) {
     static std::atomic<uint64_t> builds{0};
     build_id_ = ++builds;
@@ -561,7 +574,7 @@ void SphereBvh::build(const std::vector<SphereGeom>& spheres, AccelBackend backe
     wide_.reset();
     lane_tree_ = {};
     if (backend != AccelBackend::embree && spheres.size() > size_t(kMaxLeafSpheres) &&
-        spheres.size() <= (backend == AccelBackend::own ? kLaneOwnMaxSpheres : kLaneTreeMaxSpheres))
+        spheres.size() <= (backend == AccelBackend::own ? lane_tree_limits().own : lane_tree_limits().beside_embree))
         lane_tree_ = build_lane_tree(spheres);
     if (backend == AccelBackend::embree) {
         const EmbreeModule& functions = embree_module();

@@ -12,6 +12,7 @@
 
 #include "core/math.h"
 #include "core/enum_names.h"
+#include "render/lanes/levels.h"
 
 namespace kr {
 
@@ -39,15 +40,19 @@ bool embree_available();
 inline constexpr double kEmbreeExtentMin = 0x1.0p-50, kEmbreeExtentMax = 0x1.0p50;
 bool embree_fits(const std::vector<SphereGeom>& spheres);
 
-// Up to this many spheres, AccelBackend::automatic builds the lanes' tree (lane_tree()) as
-// well: above it Embree's tree, one path at a time, is the faster (docs/performance.md,
-// "Switch points": the sixteen single-precision lanes' scan meets Embree at about 1,800
-// spheres, the eight at about 900; the double lanes stop earlier, lanes/targets.h).
-inline constexpr size_t kLaneTreeMaxSpheres = 1800;
-// Up to this many, AccelBackend::own builds it: above it one path down our own tree is the
-// faster (the sixteen float lanes' scan meets it at about 2,500 spheres; eight at about 1,200
-// and the double lanes at about 350 stop earlier, lanes/targets.h).
-inline constexpr size_t kLaneOwnMaxSpheres = 2048;
+// The sixteen single-precision lanes' sphere limits on this CPU, beyond one BVH leaf: up to
+// `beside_embree` spheres AccelBackend::automatic builds the lanes' tree (lane_tree()) as
+// well, above it Embree's tree, one path at a time, is the faster; up to `own`,
+// AccelBackend::own builds it, above it one path down our own tree is the faster. Where the
+// lanes' scan meets them depends on the CPU, so they are measured per kind of CPU
+// (docs/performance.md, "Switch points"): an Intel Xeon 1,800 and 2,048, an AMD EPYC of
+// family 26 (Zen 5) 2,800 and 3,000; other CPUs take the Xeon's. The eight float lanes and
+// the double lanes stop earlier (lanes/targets.h).
+struct LaneTreeLimits {
+    size_t beside_embree, own;
+};
+LaneTreeLimits lane_tree_limits(const CpuModel& cpu);  // those measured on that kind of CPU
+LaneTreeLimits lane_tree_limits();                     // this CPU's
 
 // Four spheres in structure-of-arrays form. Unused lanes have r2 = -1 (never hit) and id -2.
 struct alignas(32) SphereBlock {
@@ -73,10 +78,10 @@ struct LaneSphere {
 };
 // Up to this many spheres the float lanes scan them all, a cluster at a time, rather than
 // walk the lane tree (docs/performance.md, "Switch points": where the scan is the cheaper,
-// measured per lane count). It covers every lane
-// tree built for the float lanes under `--kernels best` (kLaneOwnMaxSpheres): their tree walk
-// runs only with kernels named for measuring, and the double lanes always walk it.
-inline constexpr size_t kLaneScanMaxSpheres = 2048;
+// measured per lane count). It covers every lane tree built for the float lanes under
+// `--kernels best` on every kind of CPU (lane_tree_limits().own): their tree walk runs only
+// with kernels named for measuring, and the double lanes always walk it.
+inline constexpr size_t kLaneScanMaxSpheres = 3072;
 // Spheres near each other that the scan tests after their box (boxed), or a sphere it tests
 // alone: scan_f[first, first + count).
 struct LaneCluster {
@@ -122,7 +127,7 @@ public:
     // Whether it is our one leaf, which the lanes test sphere by sphere without a box.
     bool one_leaf() const { return !embree_ && nodes_.size() == 1; }
     // The tree the lanes walk, built beside ours or Embree's for more than 16 spheres: up to
-    // kLaneTreeMaxSpheres under `automatic`, kLaneOwnMaxSpheres under `own`, never under
+    // lane_tree_limits()'s beside_embree under `automatic`, own under `own`, never under
     // `embree` (which so measures one path through Embree's tree).
     const LaneTree& lane_tree() const { return lane_tree_; }
 

@@ -1,5 +1,10 @@
 #include "render/lanes/levels.h"
 
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <cpuid.h>
+#endif
+#include <cstring>
+
 namespace kr {
 
 CpuLevel cpu_level() {
@@ -20,6 +25,26 @@ CpuLevel cpu_level() {
 #endif
     }();
     return level;
+}
+
+CpuModel cpu_model() {
+    static const CpuModel model = [] {
+        CpuModel m;
+#if defined(__x86_64__) && defined(__GNUC__)
+        unsigned a = 0, b = 0, c = 0, d = 0;
+        if (!__get_cpuid(0, &a, &b, &c, &d)) return m;
+        char vendor[13] = {};
+        std::memcpy(vendor, &b, 4);
+        std::memcpy(vendor + 4, &d, 4);
+        std::memcpy(vendor + 8, &c, 4);
+        m.amd = std::strcmp(vendor, "AuthenticAMD") == 0;
+        if (!__get_cpuid(1, &a, &b, &c, &d)) return m;
+        const int base = int((a >> 8) & 0xf), extended = int((a >> 20) & 0xff);
+        m.family = base == 0xf ? base + extended : base;
+#endif
+        return m;
+    }();
+    return model;
 }
 
 }  // namespace kr

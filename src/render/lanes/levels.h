@@ -30,6 +30,14 @@ enum class CpuLevel { x86_64, x86_64_v3, x86_64_v4 };
 // sanitizer builds) the same question, by the features of each level the code needs.
 CpuLevel cpu_level();
 
+// The CPU's maker and family (cpuid leaves 0 and 1; the family with its extension), what the
+// lanes' switch points are measured per (accel.h, lane_tree_limits). {false, 0} off x86-64.
+struct CpuModel {
+    bool amd = false;
+    int family = 0;
+};
+CpuModel cpu_model();
+
 }  // namespace kr
 
 // Where GCC multi-versions functions: not under a sanitizer (the loader runs the IFUNC
