@@ -324,7 +324,9 @@ RenderScene many_spheres(int n, int lights, uint64_t seed) {
 }
 
 TEST_P(Lanes, ManySpheresAsOneByOne) {
-    for (const auto& [n, lights] : {std::pair{40, 2}, std::pair{100, 20}}) {
+    // 24, 40 and 80 spheres: the sixteen lanes' wide columns looked up by one two-source
+    // permute, by two, and by a gather (tables.h, kPermutedEntries).
+    for (const auto& [n, lights] : {std::pair{24, 2}, std::pair{40, 2}, std::pair{80, 2}, std::pair{100, 20}}) {
         const RenderScene scene = many_spheres(n, lights, uint64_t(n));
         ASSERT_TRUE(scene.bvh.lanes_cast());
         ASSERT_FALSE(scene.bvh.one_leaf());
@@ -337,7 +339,7 @@ TEST_P(Lanes, ManySpheresAsOneByOne) {
         for (const SphereGeom& s : scene.spheres) smallest = std::min(smallest, s.radius);
         EXPECT_GT(2004, kFloatSizeRatio * smallest) << n;
         EXPECT_TRUE(float_sizes_fit(scene)) << n;
-        EXPECT_EQ(float_lanes_fit(scene), n == 40) << n << " " << scene.float_gaps_resolved;
+        EXPECT_EQ(float_lanes_fit(scene), n != 100) << n << " " << scene.float_gaps_resolved;
         for (LightSampling light : {LightSampling::brief, LightSampling::cone, LightSampling::area})
             for (Estimator estimator : {Estimator::sobol, Estimator::uniform}) {
                 RenderSettings settings = settings_of(scene);

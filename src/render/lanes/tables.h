@@ -64,6 +64,7 @@ struct ColumnOf {
 template <>
 struct ColumnOf<true> {
     real* v = nullptr;  // into the batch's buffer (WideStore)
+    size_t n = 0;       // its entries
     real* data() { return v; }
     const real* data() const { return v; }
 };
@@ -76,6 +77,7 @@ struct IndexColumnOf {
 template <>
 struct IndexColumnOf<true> {
     lane_int* v = nullptr;
+    size_t n = 0;
     lane_int* data() { return v; }
     const lane_int* data() const { return v; }
 };
@@ -102,11 +104,36 @@ KR_LANES vm look_up(const IndexColumnOf<false>& column, vm index) {
     __builtin_memcpy(&lanes, &v, sizeof lanes);
     return lanes;
 }
+// A wide column of up to 64 entries: up to four registers, each pair looked up by one
+// two-source permute (vpermt2ps, vpermt2d) and the pairs blended by the index's sixth bit. On
+// CPUs whose gathers are microcoded that costs far less than a gather (an AMD EPYC's sweep
+// stepped +20 % from 16 spheres to 17: docs/performance.md, "Switch points"). The registers
+// may read past the column's end: WideStore pads its buffers.
+constexpr size_t kPermutedEntries = 64;
+KR_LANES __m512 pair_look_up(const real* v, __m512i index) {
+    return _mm512_maskz_permutex2var_ps(0xffff, _mm512_loadu_ps(v), index, _mm512_loadu_ps(v + 16));
+}
+KR_LANES __m512i pair_look_up(const lane_int* v, __m512i index) {
+    return _mm512_maskz_permutex2var_epi32(0xffff, _mm512_loadu_si512(v), index, _mm512_loadu_si512(v + 16));
+}
+template <class T>
+KR_LANES auto wide_look_up(const T* v, size_t n, vm index) {
+    const __m512i i = permute_index(index);
+    if (n <= kPermutedEntries / 2) return pair_look_up(v, i);
+    const auto low = pair_look_up(v, i), high = pair_look_up(v + 32, i);
+    const __mmask16 upper = _mm512_mask_cmpgt_epi32_mask(0xffff, i, _mm512_set1_epi32(31));
+    if constexpr (std::is_same_v<T, real>) return _mm512_mask_blend_ps(upper, low, high);
+    else return _mm512_mask_blend_epi32(upper, low, high);
+}
 KR_LANES vf look_up(const ColumnOf<true>& column, vm index) {
+    if (column.n <= kPermutedEntries) return wide_look_up(column.v, column.n, index);
     return _mm512_mask_i32gather_ps(_mm512_setzero_ps(), 0xffff, permute_index(index), column.v, 4);
 }
 KR_LANES vm look_up(const IndexColumnOf<true>& column, vm index) {
-    const __m512i v = _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xffff, permute_index(index), column.v, 4);
+    const __m512i v =
+        column.n <= kPermutedEntries
+            ? wide_look_up(column.v, column.n, index)
+            : _mm512_mask_i32gather_epi32(_mm512_setzero_si512(), 0xffff, permute_index(index), column.v, 4);
     vm lanes;
     __builtin_memcpy(&lanes, &v, sizeof lanes);
     return lanes;
@@ -159,14 +186,17 @@ KR_LANES V3 look_up(const Column3Of<kWide>& column, vm index) {
 }
 
 // A wide table's columns, in one buffer per batch: `bind` points each column at its part.
+// The buffers end in 64 entries more, which a look-up of the last column in four registers
+// may read (never use).
 struct WideStore {
+    static constexpr size_t kPad = 64;
     std::vector<real> reals;
     std::vector<lane_int> ints;
     size_t n = 0, next_real = 0, next_int = 0;
     explicit WideStore(size_t count, size_t real_columns, size_t int_columns)
-        : reals(count * real_columns), ints(count * int_columns), n(count) {}
-    void bind(ColumnOf<true>& c) { c.v = reals.data() + n * next_real++; }
-    void bind(IndexColumnOf<true>& c) { c.v = ints.data() + n * next_int++; }
+        : reals(count * real_columns + kPad), ints(count * int_columns + kPad), n(count) {}
+    void bind(ColumnOf<true>& c) { c.v = reals.data() + n * next_real++, c.n = n; }
+    void bind(IndexColumnOf<true>& c) { c.v = ints.data() + n * next_int++, c.n = n; }
     void bind(Column3Of<true>& c) { bind(c.x), bind(c.y), bind(c.z); }
 };
 
