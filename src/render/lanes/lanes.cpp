@@ -158,7 +158,9 @@ LaneKernels casting_kernels(const RenderScene& scene, const RenderSettings& sett
     // the sphere count (beyond one leaf) where one path at a time becomes the faster: down
     // Embree's tree where `automatic` built it beside the lanes' tree, else down our own.
     const Target& t = target(kernels);
-    const size_t most = scene.bvh.backend() == AccelBackend::embree ? t.max_spheres_beside_embree : t.max_spheres_own;
+    const bool beside_embree = scene.bvh.backend() == AccelBackend::embree;
+    size_t most = beside_embree ? t.max_spheres_beside_embree : t.max_spheres_own;
+    if (most == kThisCpusLimit) most = beside_embree ? lane_tree_limits().beside_embree : lane_tree_limits().own;
     if (settings.kernels == LaneChoice::best && !scene.bvh.one_leaf() && scene.spheres.size() > most)
         return LaneKernels::one_path;
     return kernels;

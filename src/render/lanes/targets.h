@@ -13,15 +13,18 @@
 //   spheres `best` gives it beyond one BVH leaf beside Embree's tree, the same down our own
 //   tree). The sphere limits: where one path at a time becomes the faster, measured on the
 //   stress scenes (docs/performance.md, "Switch points"); the sixteen float lanes' are the
-//   lane tree's own limits, measured per kind of CPU (accel.h, lane_tree_limits).
+//   lane tree's own limits, measured per kind of CPU: kThisCpusLimit, lane_tree_limits() of
+//   the CPU it runs on (accel.h), looked up when a scene's kernels are chosen, so that the
+//   rows stay constants.
 #define KR_LANE_TARGETS(X)                                                                            \
     X(x86_64_v3_float, "x86-64-v3 float lanes", x86_64_v3, float, 8, 768, 1024)                    \
     X(x86_64_v3, "x86-64-v3 lanes", x86_64_v3, double, 4, 128, 320)                                 \
     X(x86_64, "x86-64 lanes", x86_64, double, 4, 128, 320)                                          \
-    X(x86_64_v4_float, "x86-64-v4 float lanes", x86_64_v4, float, 16, lane_tree_limits().beside_embree,   \
-      lane_tree_limits().own)
+    X(x86_64_v4_float, "x86-64-v4 float lanes", x86_64_v4, float, 16, kThisCpusLimit, kThisCpusLimit)
 
 namespace kr {
+
+inline constexpr size_t kThisCpusLimit = 0;  // a sphere limit of the CPU's own (above)
 
 struct PixelSums;
 struct Ray;
