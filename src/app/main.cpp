@@ -72,15 +72,17 @@ int print_version() {
         std::printf("SIMD kernels on this CPU: none, one path at a time (%s)\n",
                     cpu_lane_kernels(LaneChoice::any) == LaneKernels::x86_64 ? "the CPU lacks AVX2 and FMA"
                                                                         : "not built for this CPU");
-    else if (lane_count(kernels) == 16)  // its sphere limits are measured per kind of CPU (accel.h)
-        std::printf("SIMD kernels on this CPU: %s (sixteen paths at a time in single precision, up to %zu spheres "
-                    "beside Embree's tree and %zu down our own; x86-64-v3 lanes, four in double, where a scene's "
-                    "sizes or gaps need it)\n",
-                    name.c_str(), lane_tree_limits().beside_embree, lane_tree_limits().own);
-    else
-        std::printf("SIMD kernels on this CPU: %s (%s paths at a time in single precision; x86-64-v3 lanes, "
+    else {
+        // The sixteen lanes' sphere limits are measured per kind of CPU (accel.h).
+        const int lanes = lane_count(kernels);
+        const std::string limits = lanes == 16 ? ", up to " + std::to_string(lane_tree_limits().beside_embree) +
+                                                     " spheres beside Embree's tree and " +
+                                                     std::to_string(lane_tree_limits().own) + " down our own"
+                                               : "";
+        std::printf("SIMD kernels on this CPU: %s (%s paths at a time in single precision%s; x86-64-v3 lanes, "
                     "four in double, where a scene's sizes or gaps need it)\n",
-                    name.c_str(), lane_count(kernels) == 8 ? "eight" : "four");
+                    name.c_str(), lanes == 16 ? "sixteen" : lanes == 8 ? "eight" : "four", limits.c_str());
+    }
 #ifdef KEITHRAY_HAVE_EMBREE
     std::printf("Embree: yes (%s): scenes of more than 32 spheres (%s)\n", KEITHRAY_EMBREE_VERSION,
                 module_place("embree").c_str());
