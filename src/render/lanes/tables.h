@@ -186,10 +186,14 @@ KR_LANES V3 look_up(const Column3Of<kWide>& column, vm index) {
 }
 
 // A wide table's columns, in one buffer per batch: `bind` points each column at its part.
-// The buffers end in 64 entries more, which a look-up of the last column in four registers
-// may read (never use).
+// For the sixteen lanes the buffers end in 64 entries more, which a look-up of the last
+// column in four registers may read (never use).
 struct WideStore {
-    static constexpr size_t kPad = 64;
+#ifdef KR_LANES_V4
+    static constexpr size_t kPad = kPermutedEntries;
+#else
+    static constexpr size_t kPad = 0;
+#endif
     std::vector<real> reals;
     std::vector<lane_int> ints;
     size_t n = 0, next_real = 0, next_int = 0;
