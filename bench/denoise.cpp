@@ -3,7 +3,8 @@
 //   keithray_bench_denoise cost [ROUNDS [SCENE [FINAL_ROUNDS]]]
 //       each filter alone on scene 3's 4 spp estimates at 512x512 and 1920x1080 (medians of
 //       ROUNDS runs of the a-trous filter, of at most FINAL_ROUNDS (3) of the final one;
-//       OMP_NUM_THREADS sets the threads)
+//       OMP_NUM_THREADS sets the threads; KR_BENCH_PARAMS='key=value ...' the final filter's
+//       parameters, as for tune)
 //   keithray_bench_denoise error SIZE REFERENCE_SPP SPP,SPP,... SCENE.json...
 //       each scene at SIZE x SIZE: a reference at REFERENCE_SPP (seed 99, exact light
 //       sampling), then renders at each SPP (seed 1) raw and denoised by each filter (the
@@ -26,6 +27,12 @@
 //       the goals per scene (see goals()): relMSE of the final filter at 16 spp against
 //       raw at 256 and 1,024 spp, and against raw at the file's spp (KR_BENCH_MAX_FILE_SPP
 //       caps it), and the ratios' medians; KR_BENCH_CACHE as for error.
+//   keithray_bench_denoise dump SIZE REFERENCE_SPP SPP DIR SCENE.json...
+//       for analysis, per scene DIR/NAME-KEY.f32 (float32 planes, row-major, channels
+//       interleaved): the reference, raw, a-trous and final images at SPP, the feature
+//       buffers, the depth and the variance of the raw mean; with
+//       KR_BENCH_VARIANTS='NAME:key=value ...;NAME:...' also the final filter's image for each
+//       variant of its parameters (KR_BENCH_CACHE as for error).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -92,6 +99,16 @@ RenderState render(const Prepared& p, int spp, uint64_t seed, const std::string&
     return state;
 }
 
+// The layers the product's paths read to develop a render with `options`' denoising, by either
+// filter (outputs.h develop_reads: `render --denoise` and Save read the halves, the display
+// the samples of a Whitted render), so that the figures are of the images users get.
+unsigned denoise_reads(const DevelopOptions& options) {
+    DevelopOptions interactive = options, final = options;
+    interactive.interactive = true;
+    final.interactive = false;
+    return kLayerRadiance | develop_reads(interactive) | develop_reads(final);
+}
+
 double rel_mse(const Image& a, const Image& ref) {
     double sum = 0;
     for (size_t i = 0; i < ref.pixels.size(); ++i) {
@@ -149,12 +166,15 @@ double median(std::vector<double> v) {
     return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
+// NlmParams from "key=value key=value ..." (defined below).
+NlmParams parse_params(const std::string& text);
+
 int cost(int rounds, const std::string& scene_file, int final_rounds) {
     final_rounds = std::min(rounds, final_rounds);
     for (const auto& [w, h] : {std::pair{512, 512}, std::pair{1920, 1080}}) {
         const Prepared p = prepare(scene_file, w, h, false);
         const RenderState state = render(p, 4, 1);
-        RenderEstimates est = render_estimates(state, kAllLayers);
+        RenderEstimates est = render_estimates(state, kAllLayers | kLayerHalves);  // the final filter's input
         feature_buffers(p.rs, p.settings, w, h, est.albedo, est.normal);
         const DenoiseInput in = denoise_input(est, est.radiance, true);
         std::vector<double> ms, cpu_ms, feature_ms, final_ms, final_cpu_ms;
@@ -170,7 +190,8 @@ int cost(int rounds, const std::string& scene_file, int final_rounds) {
             if (r < final_rounds) {
                 const double f0 = cpu_seconds();
                 const auto s0 = std::chrono::steady_clock::now();
-                const Image final = denoise_nlmeans(in, {}, &workspace);
+                const char* pv = std::getenv("KR_BENCH_PARAMS");
+                const Image final = denoise_nlmeans(in, parse_params(pv ? pv : ""), &workspace);
                 final_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - s0).count());
                 final_cpu_ms.push_back(1e3 * (cpu_seconds() - f0));
                 if (final.pixels.empty()) return 1;
@@ -235,7 +256,7 @@ int error(int size, int reference_spp, const std::vector<int>& spps, const std::
             options.denoise = Denoise::on;
             options.sampling = p.settings;
             options.sampling.seed = seed;
-            const RenderEstimates estimates = render_estimates(state, kAllLayers);
+            const RenderEstimates estimates = render_estimates(state, denoise_reads(options));
             options.interactive = true;
             const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
             options.interactive = false;
@@ -280,7 +301,7 @@ int goals(int size, int reference_spp, int max_file_spp, const std::vector<std::
             options.denoise = Denoise::on;
             options.sampling = p.settings;
             options.sampling.seed = 1;
-            const Developed out = develop(p.rs, render_estimates(state, kAllLayers), options, kLayerRadiance);
+            const Developed out = develop(p.rs, render_estimates(state, denoise_reads(options)), options, kLayerRadiance);
             return std::pair{rel_mse_trimmed(out.radiance, reference), rel_mse_trimmed(out.raw, reference)};
         };
         const int file_spp = std::min(max_file_spp, int(p.scene.renderer.samples));
@@ -303,7 +324,66 @@ int goals(int size, int reference_spp, int max_file_spp, const std::vector<std::
     return 0;
 }
 
-// NlmParams from "key=value key=value ..." (the names of its fields), over the defaults.
+// Diagnostic planes for analysis (float32, row-major, interleaved channels): per scene
+// DIR/NAME-KEY.f32 for the reference, raw, a-trous and final at SPP, the feature buffers,
+// the depth and the variance of the raw mean.
+int dump(int size, int reference_spp, int spp, const std::string& dir, const std::vector<std::string>& scenes) {
+    std::filesystem::create_directories(dir);
+    for (const std::string& file : scenes) {
+        const Prepared p = prepare(file, size, size, true);
+        const std::string name = std::filesystem::path(file).stem().string();
+        const RenderState reference_state = render(p, reference_spp, 99, name);
+        const RenderState state = render(p, spp, 1, name);
+        DevelopOptions options;
+        options.denoise = Denoise::on;
+        options.sampling = p.settings;
+        options.sampling.seed = 1;
+        RenderEstimates estimates = render_estimates(state, denoise_reads(options));
+        feature_buffers(p.rs, options.sampling, size, size, estimates.albedo, estimates.normal);
+        options.interactive = true;
+        const Developed fast = develop(p.rs, estimates, options, kLayerRadiance);
+        options.interactive = false;
+        const Developed final = develop(p.rs, estimates, options, kLayerRadiance);
+        const auto put = [&](const std::string& key, const std::vector<float>& v) {
+            const std::string bytes(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(float));
+            write_file_atomic(std::filesystem::path(dir) / (name + "-" + key + ".f32"), bytes);
+        };
+        const auto colors = [](const Image& im) {
+            std::vector<float> v;
+            for (const Color& c : im.pixels) v.insert(v.end(), {float(c.x), float(c.y), float(c.z)});
+            return v;
+        };
+        if (const char* vs = std::getenv("KR_BENCH_VARIANTS")) {
+            std::string all = vs;
+            size_t at = 0;
+            while (at < all.size()) {
+                size_t end = all.find(';', at);
+                if (end == std::string::npos) end = all.size();
+                const std::string item = all.substr(at, end - at);
+                at = end + 1;
+                const size_t colon = item.find(':');
+                const DenoiseInput in = denoise_input(estimates, estimates.radiance, true);
+                put(item.substr(0, colon), colors(denoise_nlmeans(in, parse_params(item.substr(colon + 1)))));
+            }
+        }
+        put("ref", colors(reference_state.radiance()));
+        put("raw", colors(final.raw));
+        put("final", colors(final.radiance));
+        put("atrous", colors(fast.radiance));
+        put("albedo", estimates.albedo);
+        put("normal", estimates.normal);
+        std::vector<float> depth(estimates.depth.begin(), estimates.depth.end()), variance;
+        for (const Color& c : estimates.variance) variance.insert(variance.end(), {float(c.x), float(c.y), float(c.z)});
+        put("depth", depth);
+        put("var", variance);
+        std::printf("%s written\n", name.c_str());
+    }
+    return 0;
+}
+
+// NlmParams from "key=value key=value ..." over the defaults: the names of its fields, and k1
+// .. k3, n1 .. n3 for the candidates' distance scales and normal stops, `candidates` for
+// their count.
 NlmParams parse_params(const std::string& text) {
     NlmParams params;
     size_t at = 0;
@@ -319,11 +399,14 @@ NlmParams parse_params(const std::string& text) {
         const double value = std::stod(item.substr(eq + 1));
         if (key == "radius") params.radius = int(value);
         else if (key == "patch") params.patch = int(value);
-        else if (key == "k") params.k = float(value);
-        else if (key == "k_weak") params.k_weak = float(value);
+        else if (key.size() == 2 && (key[0] == 'k' || key[0] == 'n') && key[1] >= '1' &&
+                 key[1] < '1' + kMaxNlmCandidates) {
+            // k1 .. k3, n1 .. n3: candidate 1 .. 3's distance scale and normal stop
+            NlmCandidate& c = params.candidates[key[1] - '1'];
+            (key[0] == 'k' ? c.k : c.sigma_normal) = float(value);
+        } else if (key == "candidates") params.candidate_count = int(value);
         else if (key == "select_radius") params.select_radius = int(value);
         else if (key == "own_error_stop") params.own_error_stop = float(value);
-        else if (key == "sigma_normal") params.sigma_normal = float(value);
         else if (key == "sigma_albedo") params.sigma_albedo = float(value);
         else if (key == "sigma_depth") params.sigma_depth = float(value);
         else if (key == "fade_error") params.fade_error = float(value);
@@ -344,7 +427,7 @@ int tune(int size, int reference_spp, int spp, const std::vector<std::string>& v
         const Image reference = render(p, reference_spp, 99, name).radiance();
         const double raw256 = rel_mse_trimmed(render(p, 256, 1, name).radiance(), reference);
         const RenderState state = render(p, spp, 1, name);
-        RenderEstimates est = render_estimates(state, kAllLayers);
+        RenderEstimates est = render_estimates(state, kAllLayers | kLayerHalves);  // the final filter's input
         RenderSettings sampling = p.settings;
         sampling.seed = 1;
         feature_buffers(p.rs, sampling, size, size, est.albedo, est.normal);
@@ -397,6 +480,9 @@ int run(int argc, char** argv) {
         }
         return tune(std::stoi(argv[2]), std::stoi(argv[3]), std::stoi(argv[4]), variants, scenes);
     }
+    if (mode == "dump" && argc > 6)
+        return dump(std::stoi(argv[2]), std::stoi(argv[3]), std::stoi(argv[4]), argv[5],
+                    std::vector<std::string>(argv + 6, argv + argc));
     if (mode == "goals" && argc > 4)
         return goals(std::stoi(argv[2]), std::stoi(argv[3]), std::getenv("KR_BENCH_MAX_FILE_SPP")
                                                                  ? std::stoi(std::getenv("KR_BENCH_MAX_FILE_SPP"))
@@ -404,7 +490,8 @@ int run(int argc, char** argv) {
                      std::vector<std::string>(argv + 4, argv + argc));
     std::fprintf(stderr,
                  "usage: keithray_bench_denoise cost [ROUNDS [SCENE [FINAL_ROUNDS]]] | error SIZE REFERENCE_SPP SPP,SPP,... SCENE... "
-                 "| goals SIZE REFERENCE_SPP SCENE... | tune SIZE REFERENCE_SPP SPP VARIANT... -- SCENE...\n");
+                 "| goals SIZE REFERENCE_SPP SCENE... | tune SIZE REFERENCE_SPP SPP VARIANT... -- SCENE... "
+                 "| dump SIZE REFERENCE_SPP SPP DIR SCENE...\n");
     return 2;
 }
 

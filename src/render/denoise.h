@@ -33,6 +33,14 @@ struct DenoiseInput {
     std::span<const uint32_t> half_count[2];
 };
 
+// One of the final filter's candidates: a non-local means filter of the halves, its own
+// patch distance scale and normal stop (the other stops are shared).
+struct NlmCandidate {
+    float k;             // patch distance scale, in standard deviations of the difference
+    float sigma_normal;  // normal stop: exp(-sigma (1 - n.n')); 0: none
+};
+inline constexpr int kMaxNlmCandidates = 3;
+
 // The interactive filter's parameters (docs/denoising.md says how they were chosen).
 struct AtrousParams {
     int iterations = 5;            // 3x3 B-spline taps at steps 1, 2, 4, ...: reach 2^iterations - 1 pixels
@@ -61,15 +69,15 @@ struct DenoiseBasePlanes {
 struct DenoiseAtrousPlanes {
     std::vector<float> radiance[3], variance, luminance;
 };
-// The final filter's own, per half of the samples (g) or per strength (s).
+// The final filter's own, per half of the samples (g) or per candidate (c).
 struct DenoiseNlmPlanes {
     std::vector<float> half_radiance[2][3];  // [g][channel]: the demodulated radiance, a guide
     std::vector<float> half_variance[2][3];  // [g][channel]: its mean's variance, 3x3-prefiltered
     std::vector<float> distance[2];          // [g]: the patch distances of one offset, summed along rows
-    std::vector<float> sums[2][4];           // [g]: the filtered sums of the three channels and of the weights
+    std::vector<float> sums[kMaxNlmCandidates][2][4];  // [c][g]: the filtered sums of the three channels and of the weights
     std::vector<float> own_variance[2];      // [g]: the pixel's own variance, summed over the channels
-    std::vector<float> candidate[2][4];      // [s]: the filtered image, then its relative gain (box mean)
-    std::vector<float> own_gain[2];          // [s]: the pixel's own estimate of that gain
+    std::vector<float> candidate[kMaxNlmCandidates][4];  // [c]: the filtered image, then its relative gain (box mean)
+    std::vector<float> own_gain[kMaxNlmCandidates];      // [c]: the pixel's own estimate of that gain
 };
 // The float planes per pixel of one of the structs above.
 template <class Planes>
@@ -113,11 +121,14 @@ Image denoise_atrous(const DenoiseInput& input, const AtrousParams& params = {},
 struct NlmParams {
     int radius = 5;             // search window: (2 radius + 1)^2 pixels
     int patch = 1;              // patch: (2 patch + 1)^2 pixels
-    float k = 0.45f;            // patch distance scale, in standard deviations of the difference
-    float k_weak = 0.25f;       // the second candidate's (per pixel the one of least estimated error)
+    // The filters the selection chooses from per pixel besides the raw mean, all made in one
+    // sweep over the window's offsets: a strong and a weak one that stop at normals, and a
+    // stronger one that crosses them (the shading of small spheres, whose normals turn from
+    // one pixel to the next).
+    NlmCandidate candidates[kMaxNlmCandidates] = {{0.45f, 128}, {0.25f, 128}, {0.6f, 32}};
+    int candidate_count = kMaxNlmCandidates;  // the first this many are made (1 to kMaxNlmCandidates)
     int select_radius = 3;      // the estimated relative errors are averaged over (2 r + 1)^2 pixels
     float own_error_stop = 300;  // a filtered value this many of the pixel's own standard errors off is refused
-    float sigma_normal = 128;   // normal stop: exp(-sigma (1 - n.n'))
     float sigma_albedo = 0.1f;  // albedo stop: exp(-|a - a'|^2 / sigma^2)
     float sigma_depth = 1;      // depth stop in units of the local depth gradient times the offset
     float fade_error = 0.01f;   // as AtrousParams::fade_error
@@ -128,8 +139,7 @@ struct NlmParams {
 // noise, over the variance of the difference) taken on the albedo-demodulated radiance,
 // times edge stops on normal, albedo and depth. Each half of the samples is filtered with
 // weights from the other half, so each filtered half is linear in its own samples and Stein's
-// unbiased risk estimate gives its error; per pixel, of the two strengths (k, k_weak) and
-// the raw mean, the one of least risk relative to the pixel's squared luminance (averaged
+// unbiased risk estimate gives its error; per pixel, of the candidates and the raw mean, the one of least risk relative to the pixel's squared luminance (averaged
 // over a small box) is kept, with the pixel's own samples overruling the box where they are
 // decisive (docs/denoising.md). The halves are
 // averaged, the albedo multiplied back, and the result faded towards the raw radiance as a

@@ -116,11 +116,11 @@ void prepare_halves(const DenoiseInput& in, DenoiseWorkspace& p) {
                     clamped[i] = count >= 4 ? std::clamp(mine[i], lo, hi) : std::clamp(mine[i], all_lo, all_hi);
                 }
             // Both halves are clamped against the other's unclamped values: the clamped ones
-            // wait in nlm.sums, then become the halves' radiance, and nlm.sums keeps the
+            // wait in nlm.sums[0], then become the halves' radiance, and nlm.sums[0] keeps the
             // unclamped ones for the comparison below.
-            std::swap(p.nlm.sums[g][k], clamped);
+            std::swap(p.nlm.sums[0][g][k], clamped);
         }
-        for (int g = 0; g < 2; ++g) std::swap(p.nlm.half_radiance[g][k], p.nlm.sums[g][k]);
+        for (int g = 0; g < 2; ++g) std::swap(p.nlm.half_radiance[g][k], p.nlm.sums[0][g][k]);
     }
     // The raw candidate of a pixel whose halves were clamped is their clamped mean.
     p.clamped.assign(n, 0);
@@ -130,7 +130,7 @@ void prepare_halves(const DenoiseInput& in, DenoiseWorkspace& p) {
         const size_t i = size_t(li);
         bool changed = false;
         for (int g = 0; g < 2; ++g)
-            for (int k = 0; k < 3; ++k) changed |= p.nlm.half_radiance[g][k][i] != p.nlm.sums[g][k][i];
+            for (int k = 0; k < 3; ++k) changed |= p.nlm.half_radiance[g][k][i] != p.nlm.sums[0][g][k][i];
         if (!changed) continue;
         p.clamped[i] = 1;
         const double t = second_half_share(in, true, i);
@@ -140,11 +140,12 @@ void prepare_halves(const DenoiseInput& in, DenoiseWorkspace& p) {
 
 // One guide's patch distance terms along a row, for the pixels [x0, x1) of the row at `at`
 // against those at `at + off` (Rousselle et al. 2012): per channel the squared difference
-// less its expected noise, over eps + k^2 times the variance of the difference, averaged.
+// less its expected noise, over the variance of the difference (plus a guard), summed. A
+// candidate's distance scale k divides it by k^2 later.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 __attribute__((target_clones("avx2", "default")))
 #endif
-void patch_terms(const float* const u[3], const float* const v[3], size_t at, ptrdiff_t off, int x0, int x1, float k2,
+void patch_terms(const float* const u[3], const float* const v[3], size_t at, ptrdiff_t off, int x0, int x1,
                  float* out) {
     for (int x = x0; x < x1; ++x) out[x] = 0;
     for (int c = 0; c < 3; ++c) {
@@ -153,27 +154,36 @@ void patch_terms(const float* const u[3], const float* const v[3], size_t at, pt
         for (int x = x0; x < x1; ++x) {
             const float d = up[x] - uq[x];
             const float noise = vp[x] + std::min(vp[x], vq[x]);
-            out[x] += (d * d - noise) / (1e-10f + k2 * (vp[x] + vq[x]));
+            out[x] += (d * d - noise) / (1e-10f + vp[x] + vq[x]);
         }
     }
 }
 
 
-// One non-local means filter of both halves at distance scale k: p.nlm.sums[g] gets half g's
-// sums with weights from the other half, and their weights (the centre's is 1).
-void nlm_filter(const NlmParams& params, float k, DenoiseWorkspace& p) {
+// The candidates' non-local means filters of both halves, in one sweep over the window's
+// offsets (the patch distances are taken once; a candidate scales them by 1/k^2):
+// p.nlm.sums[c][g] gets half g's sums with candidate c's weights from the other half, and
+// their weights (the centre's is 1).
+void nlm_filter(const NlmParams& params, DenoiseWorkspace& p) {
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
-    for (int g = 0; g < 2; ++g) {
-        p.nlm.distance[g].assign(n, 0.f);
-        for (auto& plane : p.nlm.sums[g]) plane.assign(n, 0.f);
-    }
+    const int count = std::clamp(params.candidate_count, 1, kMaxNlmCandidates);
+    for (int g = 0; g < 2; ++g) p.nlm.distance[g].assign(n, 0.f);
+    for (int c = 0; c < count; ++c)
+        for (auto& half : p.nlm.sums[c])
+            for (auto& plane : half) plane.assign(n, 0.f);
     const int r = std::max(0, params.radius), f = std::max(0, params.patch);
-    const float k2 = k * k, inv_patch = 1.f / float((2 * f + 1) * (2 * f + 1));
+    const float inv_patch = 1.f / float((2 * f + 1) * (2 * f + 1));
     const float inv_albedo2 = 1.f / (params.sigma_albedo * params.sigma_albedo);
+    float inv_k2[kMaxNlmCandidates], sigma_normal[kMaxNlmCandidates];
+    for (int c = 0; c < count; ++c) {
+        inv_k2[c] = 1 / (params.candidates[c].k * params.candidates[c].k);
+        sigma_normal[c] = params.candidates[c].sigma_normal;
+    }
 #pragma omp parallel
     {
-        std::vector<float> terms(static_cast<size_t>(w)), wf(static_cast<size_t>(w));
+        std::vector<float> terms(static_cast<size_t>(w)), normal_term(static_cast<size_t>(w)),
+            other_terms(static_cast<size_t>(w)), distance(static_cast<size_t>(w));
         for (int oy = -r; oy <= r; ++oy)
             for (int ox = -r; ox <= r; ++ox) {
                 // The pixels whose offset neighbour q = p + (ox, oy) lies in the image.
@@ -191,7 +201,7 @@ void nlm_filter(const NlmParams& params, float k, DenoiseWorkspace& p) {
                                                    p.nlm.half_radiance[g][2].data()};
                         const float* const v[3] = {p.nlm.half_variance[g][0].data(), p.nlm.half_variance[g][1].data(),
                                                    p.nlm.half_variance[g][2].data()};
-                        patch_terms(u, v, row, off, x0, x1, k2, terms.data());
+                        patch_terms(u, v, row, off, x0, x1, terms.data());
                         float* hb = p.nlm.distance[g].data() + row;
                         float sum = 0;
                         for (int dx = -f; dx <= f; ++dx) sum += terms[size_t(std::clamp(x0 + dx, x0, x1 - 1))];
@@ -202,8 +212,8 @@ void nlm_filter(const NlmParams& params, float k, DenoiseWorkspace& p) {
                     }
                 }
                 // 2. The patch distance (the column sums over the patch's rows, the image's
-                //    ends repeated), its weight times the feature stops, and each half's
-                //    sums with the other half's weights.
+                //    ends repeated), the feature stops, and per candidate its weight and each
+                //    half's sums with the other half's weights.
                 const float zscale = params.sigma_depth * float(std::max(std::abs(ox), std::abs(oy)));
 #pragma omp for schedule(static)
                 for (int y = y0; y < y1; ++y) {
@@ -223,31 +233,39 @@ void nlm_filter(const NlmParams& params, float k, DenoiseWorkspace& p) {
                     for (int x = x0; x < x1; ++x) {
                         const float fd = f0[x] * q0[x] + f1[x] * q1[x] + f2[x] * q2[x] + f3[x] * q3[x];
                         const float da0 = a0[x] - b0[x], da1 = a1[x] - b1[x], da2 = a2[x] - b2[x];
-                        wf[size_t(x)] = params.sigma_normal * std::max(0.f, 1.f - fd) +
-                                        (da0 * da0 + da1 * da1 + da2 * da2) * inv_albedo2 +
-                                        std::fabs(z[x] - qz[x]) / (zscale * zg[x] + 1e-3f * z[x] + 1e-9f);
+                        normal_term[size_t(x)] = std::max(0.f, 1.f - fd);
+                        other_terms[size_t(x)] = (da0 * da0 + da1 * da1 + da2 * da2) * inv_albedo2 +
+                                                 std::fabs(z[x] - qz[x]) / (zscale * zg[x] + 1e-3f * z[x] + 1e-9f);
                     }
                     for (int g = 0; g < 2; ++g) {
                         const float* rows[16];
                         const int taps = std::min(2 * f + 1, 16);
                         for (int t = 0; t < taps; ++t)
                             rows[t] = p.nlm.distance[g].data() + size_t(std::clamp(y + t - f, y0, y1 - 1)) * size_t(w);
-                        // Guide g's weights filter the other half.
-                        const int o = 1 - g;
-                        float *sr = p.nlm.sums[o][0].data() + row, *sg = p.nlm.sums[o][1].data() + row,
-                              *sb = p.nlm.sums[o][2].data() + row, *sw = p.nlm.sums[o][3].data() + row;
-                        const float *ur = p.nlm.half_radiance[o][0].data() + qrow,
-                                    *ug = p.nlm.half_radiance[o][1].data() + qrow,
-                                    *ub = p.nlm.half_radiance[o][2].data() + qrow;
 #pragma omp simd
                         for (int x = x0; x < x1; ++x) {
                             float dist = 0;
                             for (int t = 0; t < taps; ++t) dist += rows[t][x];
-                            const float wt = fast_exp_neg(std::max(0.f, dist * inv_patch) + wf[size_t(x)]);
-                            sw[x] += wt;
-                            sr[x] += wt * ur[x];
-                            sg[x] += wt * ug[x];
-                            sb[x] += wt * ub[x];
+                            distance[size_t(x)] = std::max(0.f, dist * inv_patch);
+                        }
+                        // Guide g's weights filter the other half.
+                        const int o = 1 - g;
+                        const float *ur = p.nlm.half_radiance[o][0].data() + qrow,
+                                    *ug = p.nlm.half_radiance[o][1].data() + qrow,
+                                    *ub = p.nlm.half_radiance[o][2].data() + qrow;
+                        for (int c = 0; c < count; ++c) {
+                            float *sr = p.nlm.sums[c][o][0].data() + row, *sg = p.nlm.sums[c][o][1].data() + row,
+                                  *sb = p.nlm.sums[c][o][2].data() + row, *sw = p.nlm.sums[c][o][3].data() + row;
+                            const float scale = inv_k2[c], stop = sigma_normal[c];
+#pragma omp simd
+                            for (int x = x0; x < x1; ++x) {
+                                const float wt = fast_exp_neg(distance[size_t(x)] * scale + stop * normal_term[size_t(x)] +
+                                                              other_terms[size_t(x)]);
+                                sw[x] += wt;
+                                sr[x] += wt * ur[x];
+                                sg[x] += wt * ug[x];
+                                sb[x] += wt * ub[x];
+                            }
                         }
                     }
                 }
@@ -300,9 +318,10 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     // in radiance), so that the box compares relative errors, as relMSE does: in absolute
     // terms a few bright noisy pixels outvote the dark ones beside them, whose every sample
     // was dark and which the filter would light with the bright ones' noise.
-    const float strengths[2] = {params.k, params.k_weak};
-    for (int c = 0; c < 2; ++c) {
-        nlm_filter(params, strengths[c], p);
+    const int count = std::clamp(params.candidate_count, 1, kMaxNlmCandidates);
+    nlm_filter(params, p);
+    for (int c = 0; c < count; ++c) {
+        const auto& sums = p.nlm.sums[c];
         for (auto& plane : p.nlm.candidate[c]) plane.resize(n);
         p.nlm.own_gain[c].resize(n);
 #pragma omp parallel for schedule(static)
@@ -311,18 +330,18 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
             const double t = second_half_share(input, halves, i);
             float gain = 0;
             for (int g = 0; g < 2; ++g) {
-                const float inv = 1 / p.nlm.sums[g][3][i];
+                const float inv = 1 / sums[g][3][i];
                 float d2 = 0;
                 for (int k = 0; k < 3; ++k) {
-                    const float d = p.nlm.sums[g][k][i] * inv - p.nlm.half_radiance[g][k][i];
+                    const float d = sums[g][k][i] * inv - p.nlm.half_radiance[g][k][i];
                     d2 += d * d;
                 }
                 gain += d2 - 2 * (1 - inv) * p.nlm.own_variance[g][i];
             }
             float lum_f = 0, lum_raw = 0;
             for (int k = 0; k < 3; ++k) {
-                const float f0 = p.nlm.sums[0][k][i] / p.nlm.sums[0][3][i],
-                            f1 = p.nlm.sums[1][k][i] / p.nlm.sums[1][3][i];
+                const float f0 = sums[0][k][i] / sums[0][3][i],
+                            f1 = sums[1][k][i] / sums[1][3][i];
                 p.nlm.candidate[c][k][i] = float(f0 + t * (f1 - f0));
                 lum_f += kLum[k] * p.nlm.candidate[c][k][i] * p.base.albedo[k][i];
                 lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.base.albedo[k][i];
@@ -338,7 +357,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
         std::swap(p.nlm.candidate[c][3], p.nlm.distance[1]);
     }
     // Per pixel the candidate of the largest estimated gain over the box, or the raw mean
-    // where neither gains (a converged or noiseless region). Then the pixel's own samples:
+    // where none gains (a converged or noiseless region). Then the pixel's own samples:
     // - where the box keeps the raw mean but the pixel's own estimate says a filter gains (a
     //   firefly among dark pixels, which the box's dark pixels outvote), that filter;
     // - where the box filters but the result lies more than own_error_stop of the pixel's own
@@ -351,15 +370,18 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     // The raw candidate is the clamped mean, or where nothing was clamped NaN, which
     // remodulate_and_fade reads as the raw radiance, bit for bit.
     const float stop2 = params.own_error_stop * params.own_error_stop;
+    constexpr int kRaw = -1;
 #pragma omp parallel for schedule(static)
     for (long li = 0; li < long(n); ++li) {
         const size_t i = size_t(li);
-        int c = p.nlm.candidate[1][3][i] < p.nlm.candidate[0][3][i] ? 1 : 0;
+        int c = 0;
+        for (int o = 1; o < count; ++o)
+            if (p.nlm.candidate[o][3][i] < p.nlm.candidate[c][3][i]) c = o;
         if (!(p.nlm.candidate[c][3][i] < 0)) {
-            c = 2;
+            c = kRaw;
             if (halves) {
                 float best = 0;
-                for (int o = 0; o < 2; ++o)
+                for (int o = 0; o < count; ++o)
                     if (p.nlm.own_gain[o][i] < best) {
                         best = p.nlm.own_gain[o][i];
                         c = o;
@@ -373,9 +395,9 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
                 lum_raw += kLum[k] * mean_of_halves(p, k, i, t) * p.base.albedo[k][i];
                 var += kLum[k] * kLum[k] * float(input.variance[i][k] * p.var_scale);
             }
-            if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = 2;
+            if (var > 0 && std::isfinite(var) && (lum_f - lum_raw) * (lum_f - lum_raw) > stop2 * var) c = kRaw;
         }
-        if (c < 2)
+        if (c != kRaw)
             for (int k = 0; k < 3; ++k) p.base.radiance[k][i] = p.nlm.candidate[c][k][i];
         else if (!p.clamped[i])
             p.base.radiance[0][i] = NAN;
