@@ -284,6 +284,42 @@ TEST(Denoise, AtrousDoesNotDependOnTheThreadCount) {
     }
 }
 
+// The final filter too: its candidates' sweep over the window's offsets splits rows between
+// threads, and its result is the same bits at 1, 2 and 3 threads, with and without a
+// workspace reused from a larger image, on images narrower than its window.
+TEST(Denoise, FinalFilterDoesNotDependOnTheThreadCount) {
+    const int threads = omp_get_max_threads();
+    for (const auto [w, h] : {std::pair{61, 45}, std::pair{20, 7}, std::pair{1, 3}}) {
+        Synthetic s(w, h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool left = x < w / 2, top = y < h / 3;
+                s.set(x, y, left ? 0.2 : 0.8, top ? 0.3 : 0.6, left ? Vec3{-0.7071, 0, -0.7071} : Vec3{0, 0, -1},
+                      top ? 5 + 0.1 * x : 50);
+            }
+        s.add_noise_halves(0.2);
+        DenoiseWorkspace reused;
+        {
+            Synthetic big(70, 50);
+            big.add_noise_halves(0.1);
+            (void)denoise_nlmeans(big.input(), {}, &reused);
+        }
+        std::vector<Image> out;
+        for (const int n : {1, 2, 3}) {
+            omp_set_num_threads(n);
+            out.push_back(denoise_nlmeans(s.input()));
+            out.push_back(denoise_nlmeans(s.input(), {}, &reused));
+        }
+        omp_set_num_threads(threads);
+        for (const Image& img : out)
+            for (size_t i = 0; i < img.pixels.size(); ++i)
+                for (int k = 0; k < 3; ++k) {
+                    ASSERT_TRUE(std::isfinite(img.pixels[i][k])) << w << "x" << h << " pixel " << i;
+                    ASSERT_EQ(img.pixels[i][k], out[0].pixels[i][k]) << w << "x" << h << " pixel " << i;
+                }
+    }
+}
+
 // With every weight at one (distances scaled away, flat features, no fade) the final filter
 // is the mean over its (2 radius + 1)^2 window: i.i.d. noise's variance drops by that count.
 TEST(Denoise, FinalFilterNoiseOnAConstantDropsByTheWindowsCount) {
