@@ -166,6 +166,19 @@ double median(std::vector<double> v) {
     return (v[(v.size() - 1) / 2] + v[v.size() / 2]) / 2;
 }
 
+// The items of `text` between `separator`s, empty ones left out.
+std::vector<std::string> split(const std::string& text, char separator) {
+    std::vector<std::string> items;
+    size_t at = 0;
+    while (at < text.size()) {
+        size_t end = text.find(separator, at);
+        if (end == std::string::npos) end = text.size();
+        if (end > at) items.push_back(text.substr(at, end - at));
+        at = end + 1;
+    }
+    return items;
+}
+
 // NlmParams from "key=value key=value ..." (defined below).
 NlmParams parse_params(const std::string& text);
 
@@ -353,19 +366,12 @@ int dump(int size, int reference_spp, int spp, const std::string& dir, const std
             for (const Color& c : im.pixels) v.insert(v.end(), {float(c.x), float(c.y), float(c.z)});
             return v;
         };
-        if (const char* vs = std::getenv("KR_BENCH_VARIANTS")) {
-            std::string all = vs;
-            size_t at = 0;
-            while (at < all.size()) {
-                size_t end = all.find(';', at);
-                if (end == std::string::npos) end = all.size();
-                const std::string item = all.substr(at, end - at);
-                at = end + 1;
+        if (const char* variants = std::getenv("KR_BENCH_VARIANTS"))
+            for (const std::string& item : split(variants, ';')) {
                 const size_t colon = item.find(':');
                 const DenoiseInput in = denoise_input(estimates, estimates.radiance, true);
                 put(item.substr(0, colon), colors(denoise_nlmeans(in, parse_params(item.substr(colon + 1)))));
             }
-        }
         put("ref", colors(reference_state.radiance()));
         put("raw", colors(final.raw));
         put("final", colors(final.radiance));
@@ -386,13 +392,7 @@ int dump(int size, int reference_spp, int spp, const std::string& dir, const std
 // their count.
 NlmParams parse_params(const std::string& text) {
     NlmParams params;
-    size_t at = 0;
-    while (at < text.size()) {
-        size_t end = text.find(' ', at);
-        if (end == std::string::npos) end = text.size();
-        const std::string item = text.substr(at, end - at);
-        at = end + 1;
-        if (item.empty()) continue;
+    for (const std::string& item : split(text, ' ')) {
         const size_t eq = item.find('=');
         if (eq == std::string::npos) throw std::invalid_argument("parameter '" + item + "' has no '='");
         const std::string key = item.substr(0, eq);
@@ -460,13 +460,7 @@ int run(int argc, char** argv) {
                     argc > 4 ? std::stoi(argv[4]) : 3);
     if (mode == "error" && argc > 5) {
         std::vector<int> spps;
-        for (size_t at = 0; at < std::string(argv[4]).size();) {
-            const std::string list = argv[4];
-            size_t end = list.find(',', at);
-            if (end == std::string::npos) end = list.size();
-            spps.push_back(std::stoi(list.substr(at, end - at)));
-            at = end + 1;
-        }
+        for (const std::string& spp : split(argv[4], ',')) spps.push_back(std::stoi(spp));
         return error(std::stoi(argv[2]), std::stoi(argv[3]), spps, std::vector<std::string>(argv + 5, argv + argc));
     }
     if (mode == "tune" && argc > 5) {
