@@ -330,8 +330,8 @@ TEST(Denoise, FinalFilterNoiseOnAConstantDropsByTheWindowsCount) {
 
 // Normals that turn from one pixel to the next (small spheres, a bumpy surface) under the
 // same light: the candidate that crosses normals (the third, its normal stop at 32) takes
-// the noise the two that stop at normals (128) leave, and a crease whose sides differ in
-// light (NormalEdgeIsKept) still keeps them apart: the selection's risk sees the bias.
+// the noise the two that stop at normals (128) leave; a crease at right angles
+// (NormalEdgeIsKept) is still kept, its weight exp(-32) under that stop too.
 TEST(Denoise, FinalFilterSmoothsShadingAcrossTurningNormals) {
     Synthetic s(96, 96);
     std::mt19937 rng(7);
