@@ -139,12 +139,12 @@ struct NlmParams {
 // noise, over the variance of the difference) taken on the albedo-demodulated radiance,
 // times edge stops on normal, albedo and depth. Each half of the samples is filtered with
 // weights from the other half, so each filtered half is linear in its own samples and Stein's
-// unbiased risk estimate gives its error; per pixel, of the candidates and the raw mean, the one of least risk relative to the pixel's squared luminance (averaged
-// over a small box) is kept, with the pixel's own samples overruling the box where they are
-// decisive (docs/denoising.md). The halves are
-// averaged, the albedo multiplied back, and the result faded towards the raw radiance as a
-// pixel converges, as denoise_atrous does. Parallel over rows (OpenMP); the result does not
-// depend on the thread count (denoise_nlmeans.cpp).
+// unbiased risk estimate gives its error; per pixel, of the candidates and the raw mean, the
+// one of least risk relative to the pixel's squared luminance (averaged over a small box) is
+// kept, with the pixel's own samples overruling the box where they are decisive
+// (docs/denoising.md). The halves are averaged, the albedo multiplied back, and the result
+// faded towards the raw radiance as a pixel converges, as denoise_atrous does. Parallel over
+// rows (OpenMP); the result does not depend on the thread count (denoise_nlmeans.cpp).
 Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params = {}, DenoiseWorkspace* workspace = nullptr);
 
 // Working memory of the filters, per pixel (render_memory_bytes): the workspace, the feature

@@ -160,6 +160,9 @@ void patch_terms(const float* const u[3], const float* const v[3], size_t at, pt
 }
 
 
+// The candidates made: the first params.candidate_count, at least one.
+int candidates_made(const NlmParams& params) { return std::clamp(params.candidate_count, 1, kMaxNlmCandidates); }
+
 // The candidates' non-local means filters of both halves, in one sweep over the window's
 // offsets (the patch distances are taken once; a candidate scales them by 1/k^2):
 // p.nlm.sums[c][g] gets half g's sums with candidate c's weights from the other half, and
@@ -167,7 +170,7 @@ void patch_terms(const float* const u[3], const float* const v[3], size_t at, pt
 void nlm_filter(const NlmParams& params, DenoiseWorkspace& p) {
     const int w = p.w, h = p.h;
     const size_t n = size_t(w) * size_t(h);
-    const int count = std::clamp(params.candidate_count, 1, kMaxNlmCandidates);
+    const int count = candidates_made(params);
     for (int g = 0; g < 2; ++g) p.nlm.distance[g].assign(n, 0.f);
     for (int c = 0; c < count; ++c)
         for (auto& half : p.nlm.sums[c])
@@ -318,7 +321,7 @@ Image denoise_nlmeans(const DenoiseInput& input, const NlmParams& params, Denois
     // in radiance), so that the box compares relative errors, as relMSE does: in absolute
     // terms a few bright noisy pixels outvote the dark ones beside them, whose every sample
     // was dark and which the filter would light with the bright ones' noise.
-    const int count = std::clamp(params.candidate_count, 1, kMaxNlmCandidates);
+    const int count = candidates_made(params);
     nlm_filter(params, p);
     for (int c = 0; c < count; ++c) {
         const auto& sums = p.nlm.sums[c];
